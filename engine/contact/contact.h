@@ -1,0 +1,76 @@
+// What a contact law sees and returns. Laws are stateless: they read an immutable ContactGeometry
+// and the pair's coefficients, update the contact's own ContactHistory, and return a ContactForce.
+// Body 1 is the particle with the smaller index (or the particle in a particle-wall contact);
+// body 2 is the other particle or the wall. The unit normal n points from body 1 to body 2.
+#pragma once
+#include <vector>
+
+#include "engine/core/material.h"
+#include "engine/core/types.h"
+
+namespace gravsweep {
+
+struct ContactGeometry {
+  Vec3 n;                 ///< unit normal, body 1 -> body 2
+  double overlap_m;       ///< delta_n > 0 while touching
+  double distance_m;      ///< centre distance (wall: centre-to-surface distance)
+  double r1_m, r2_m;      ///< radii (r2 unused for walls)
+  double R_eff_m;         ///< effective radius R* (wall: R, or R Rc/(Rc-R) on a concave cylinder)
+  double m_eff_kg;        ///< effective mass m* (wall: the particle's mass, wall of infinite mass)
+  Vec3 v1, v2;            ///< centre velocities used for forces (wall: v2 = 0)
+  Vec3 w1, w2;            ///< angular velocities (wall: w2 = 0)
+  bool wall;              ///< body 2 is a fixed wall
+};
+
+/// Per-contact state that survives from step to step (and across neighbour-list rebuilds).
+/// One fixed layout for all laws; a law uses the fields it needs.
+struct ContactHistory {
+  Vec3 shear_m = Vec3::Zero();     ///< tangential spring (Chrono delta_t / pkdgrav S)
+  Vec3 n_old = Vec3::Zero();       ///< normal of the previous step (pkdgrav frame rotation)
+  Vec3 roll_rad = Vec3::Zero();    ///< rolling spring angle phi_R (Zhang 2017)
+  double twist_rad = 0;            ///< twisting spring angle phi_Q (Zhang 2017)
+  double duration_s = 0;           ///< time since first touch (Chrono contact_duration)
+  double gate_s = 0;               ///< Chrono's rolling/spinning activation time t_collision
+  bool active = false;             ///< false: no history yet (new contact)
+};
+
+/// Law-wide switches, shared by all pairs.
+struct ContactOptions {
+  bool clamp_normal = false;         ///< clamp F_n >= 0 (Chrono does not; dem-physics.md 4.2)
+  double min_slip_vel_m_s = 1e-4;    ///< Chrono min_slip_vel
+  double min_roll_vel_m_s = 1e-4;    ///< Chrono min_roll_vel
+  double min_spin_vel_rad_s = 1e-4;  ///< Chrono min_spin_vel
+};
+
+/// Result of one contact evaluation, plus the quantities the rolling models need.
+struct ContactForce {
+  Vec3 force_on_2 = Vec3::Zero();  ///< body 1 receives the opposite
+  Vec3 torque_1 = Vec3::Zero();
+  Vec3 torque_2 = Vec3::Zero();
+  double normal_force_N = 0;       ///< signed damped normal force (> 0 repulsive)
+  double kn_N_m = 0, kt_N_m = 0;   ///< instantaneous stiffnesses
+  double cn_N_s_m = 0, ct_N_s_m = 0;  ///< instantaneous damping coefficients
+  Vec3 u_contact = Vec3::Zero();   ///< relative contact-point velocity (2 minus 1)
+  double lever1_m = 0, lever2_m = 0;  ///< distances from centres to the contact plane
+  Quat frame_rotation = Quat::Identity();  ///< rotation of the contact frame this step
+  double elastic_energy_J = 0;     ///< normal spring energy (for energy checks)
+};
+
+}  // namespace gravsweep
+
+namespace gravsweep {
+
+/// What a law needs to check its parameters and the time step before a run.
+struct LawSetup {
+  const std::vector<Material>& materials;
+  const PairTable& pairs;
+  /// Smallest radius and mass of the particles of each material (0 when no particle has it);
+  /// walls use their material with is_wall_material true.
+  const std::vector<double>& min_radius_m;
+  const std::vector<double>& min_mass_kg;
+  const std::vector<bool>& is_wall_material;
+  double dt_s;
+  bool check_time_step;
+};
+
+}  // namespace gravsweep

@@ -1,0 +1,123 @@
+// `hertz`: Chrono::Multicore SMC, Hertz law on the material-property path, MultiStep tangential
+// history. Exactly as dem-physics.md 1.3-1.5 (Chrono ChIterativeSolverMulticoreSMC.cpp).
+#pragma once
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "engine/contact/contact.h"
+#include "engine/core/error.h"
+
+namespace gravsweep {
+
+struct HertzChrono {
+  static constexpr const char* name = "hertz";
+  static constexpr const char* description =
+      "Chrono::Multicore SMC Hertz law (E, nu, COR -> kn, kt, gn, gt), MultiStep tangential "
+      "history projected onto the tangent plane with Coulomb back-solve";
+
+  /// Chrono's damping factor -2 sqrt(5/6) beta with beta = ln e / sqrt(ln^2 e + pi^2) >= 0.
+  static double damping_factor(double cor) {
+    const double loge = std::log(std::max(cor, std::numeric_limits<double>::epsilon()));
+    const double beta = loge / std::sqrt(loge * loge + kPi * kPi);
+    return -2.0 * std::sqrt(5.0 / 6.0) * beta;
+  }
+
+  /// Rayleigh time T_R = pi R sqrt(rho/G) / (0.1631 nu + 0.8766), G = E / (2(1+nu)) (dem-physics 4.3).
+  static double rayleigh_time_s(const Material& m, double radius_m) {
+    const double G = m.young_modulus_Pa / (2 * (1 + m.poisson_ratio));
+    return kPi * radius_m * std::sqrt(m.density_kg_m3 / G) / (0.1631 * m.poisson_ratio + 0.8766);
+  }
+
+  /// Largest stable step: a fraction of the Rayleigh time of the smallest particle of each
+  /// particle material.
+  static constexpr double kMaxDtOverRayleigh = 0.3;
+  static void check(const LawSetup& s) {
+    for (std::size_t m = 0; m < s.materials.size(); ++m) {
+      if (s.is_wall_material[m] || s.min_radius_m[m] <= 0 || !s.check_time_step) continue;
+      const Material& mat = s.materials[m];
+      const double limit = kMaxDtOverRayleigh * rayleigh_time_s(mat, s.min_radius_m[m]);
+      if (s.dt_s > limit)
+        throw ConfigError(fmt::format(
+            "contact law 'hertz': dt = {:.3g} s exceeds the stability bound {:.3g} s "
+            "(0.3 x Rayleigh time of material '{}' at radius {:.3g} m)",
+            s.dt_s, limit, mat.name, s.min_radius_m[m]));
+    }
+  }
+
+  static void evaluate(const ContactGeometry& g, const PairCoefficients& c,
+                       const ContactOptions& opt, ContactHistory& h, double dt_s,
+                       ContactForce& out) {
+    const Vec3& n = g.n;
+    const double delta = g.overlap_m;
+    // Contact points on each surface with full-radius levers (ChNarrowphasePRIMS sphere_sphere).
+    const Vec3 s1 = g.r1_m * n;
+    const Vec3 vP1 = g.v1 + g.w1.cross(s1);
+    Vec3 s2 = Vec3::Zero();
+    Vec3 vP2 = Vec3::Zero();
+    if (!g.wall) {
+      s2 = -g.r2_m * n;
+      vP2 = g.v2 + g.w2.cross(s2);
+    }
+    const Vec3 v_rel = vP2 - vP1;
+    const double v_n = v_rel.dot(n);  // negative while approaching
+    const Vec3 v_t = v_rel - v_n * n;
+
+    // Stiffness and damping, dem-physics.md 1.3.
+    const double sqrt_Rd = std::sqrt(g.R_eff_m * delta);
+    const double Sn = 2.0 * c.E_eff_Pa * sqrt_Rd;
+    const double St = 8.0 * c.G_eff_Pa * sqrt_Rd;
+    const double kn = (2.0 / 3.0) * Sn;
+    const double kt = St;
+    const double damp_n = damping_factor(c.cor_normal);
+    const double gn = damp_n * std::sqrt(Sn * g.m_eff_kg);
+    const double gt = damp_n * std::sqrt(St * g.m_eff_kg);
+    double Fn = kn * delta - gn * v_n;  // unclamped, as in Chrono
+    if (opt.clamp_normal && Fn < 0) Fn = 0;
+
+    // MultiStep history (1.4): new contact -> zero; else accumulate duration.
+    if (!h.active) {
+      h = ContactHistory{};
+      h.active = true;
+      // Rolling/spinning activation gate t_collision (1.5), with delta-free Hertz constants.
+      const double kn_s = (4.0 / 3.0) * c.E_eff_Pa * std::sqrt(g.R_eff_m);
+      const double gn_s = damp_n * std::sqrt(2.0 * c.E_eff_Pa * std::sqrt(g.R_eff_m) * g.m_eff_kg);
+      const double d = gn_s / (2.0 * g.m_eff_kg * std::sqrt(kn_s / g.m_eff_kg));
+      h.gate_s = d < 1 ? kPi * std::sqrt(g.m_eff_kg / (kn_s * (1 - d * d))) : 0.0;
+    } else {
+      h.duration_s += dt_s;
+    }
+    h.shear_m += v_t * dt_s;
+    h.shear_m -= h.shear_m.dot(n) * n;  // project onto the current tangent plane, no rescale
+    Vec3 Ft = kt * h.shear_m + gt * v_t;
+    const double Ft_max = c.mu_static * std::abs(Fn);
+    const double Ft_mag = Ft.norm();
+    if (Ft_mag > Ft_max) {
+      if (h.shear_m.norm() > kTinyLength_m) {
+        Ft *= Ft_max / Ft_mag;
+        h.shear_m = (Ft - gt * v_t) / kt;  // back-solve the spring at the Coulomb limit
+      } else {
+        Ft.setZero();
+      }
+    }
+
+    out.force_on_2 = Fn * n - Ft;
+    out.torque_1 = s1.cross(-out.force_on_2);
+    out.torque_2 = g.wall ? Vec3::Zero() : Vec3(s2.cross(out.force_on_2));
+    out.normal_force_N = Fn;
+    out.kn_N_m = kn;
+    out.kt_N_m = kt;
+    out.cn_N_s_m = gn;
+    out.ct_N_s_m = gt;
+    out.u_contact = v_rel;
+    out.lever1_m = g.r1_m;
+    out.lever2_m = g.wall ? kInf : g.r2_m;
+    out.frame_rotation = Quat::Identity();
+    // U = integral of (4/3) E* sqrt(R*) d^1.5 = (8/15) E* sqrt(R*) d^2.5
+    out.elastic_energy_J = (8.0 / 15.0) * c.E_eff_Pa * std::sqrt(g.R_eff_m) * delta * delta * std::sqrt(delta);
+  }
+};
+
+}  // namespace gravsweep

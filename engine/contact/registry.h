@@ -1,0 +1,24 @@
+// The registry of contact laws and rolling models: one table each (registry.cpp).
+//
+// To add a contact law: write engine/contact/<name>.h with a struct that has `name`,
+// `description`, `static void check(const LawSetup&)` and `static void evaluate(...)` (see
+// hertz_chrono.h), then add the struct to the ContactLaws list in registry.cpp. A rolling model is
+// the same with `apply(...)` (see engine/rolling/) and the RollingModels list.
+#pragma once
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "engine/contact/contact.h"
+#include "engine/system/system.h"
+
+namespace gravsweep {
+
+/// The force function for a (contact law, rolling model) pair; unknown names are ConfigErrors
+/// that list the valid names.
+ForceFunction select_force_function(std::string_view law, std::string_view rolling);
+
+/// Runs the named law's parameter and time-step checks.
+void check_contact_law(std::string_view law, const LawSetup& setup);
+
+}  // namespace gravsweep

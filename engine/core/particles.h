@@ -1,0 +1,95 @@
+// Particle storage as a structure of arrays: one contiguous array per field, indexed by ParticleIndex.
+// Every particle is a sphere with its own radius, mass, moment of inertia and material; the projectile
+// is a particle like the grains, with its own size class and material.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "engine/core/types.h"
+
+namespace gravsweep {
+
+/// Size class of a particle, used to pick the pair parameters (grain-grain, grain-projectile, ...).
+enum class SizeClass : std::uint8_t { grain = 0, projectile = 1 };
+
+struct Particles {
+  // State (engine frame, z up).
+  std::vector<Vec3> position_m;
+  std::vector<Vec3> velocity_m_s;
+  std::vector<Vec3> omega_rad_s;
+  // Velocities used by the force evaluation. Equal to the state for semi-implicit Euler and
+  // velocity Verlet; pkdgrav's predicted velocities v_n + dt a_n for the KDK leapfrog.
+  std::vector<Vec3> eval_velocity_m_s;
+  std::vector<Vec3> eval_omega_rad_s;
+  // Accumulated this step (contact + gravity for force; contact for torque).
+  std::vector<Vec3> force_N;
+  std::vector<Vec3> torque_N_m;
+  // Properties.
+  std::vector<double> radius_m;
+  std::vector<double> mass_kg;
+  std::vector<double> inv_mass_1_kg;         ///< 0 for a fixed particle
+  std::vector<double> inv_inertia_1_kg_m2;   ///< solid sphere I = 2/5 m r^2; 0 for fixed
+  std::vector<std::uint8_t> material;        ///< index into the material table
+  std::vector<SizeClass> size_class;
+
+  [[nodiscard]] std::size_t size() const { return position_m.size(); }
+
+  /// Appends a free (or fixed) solid sphere at rest and returns its index.
+  ParticleIndex add(const Vec3& pos, double radius, double mass, std::uint8_t material_id,
+                    SizeClass cls, bool fixed = false) {
+    position_m.push_back(pos);
+    velocity_m_s.push_back(Vec3::Zero());
+    omega_rad_s.push_back(Vec3::Zero());
+    eval_velocity_m_s.push_back(Vec3::Zero());
+    eval_omega_rad_s.push_back(Vec3::Zero());
+    force_N.push_back(Vec3::Zero());
+    torque_N_m.push_back(Vec3::Zero());
+    radius_m.push_back(radius);
+    mass_kg.push_back(mass);
+    inv_mass_1_kg.push_back(fixed ? 0.0 : 1.0 / mass);
+    const double inertia = 0.4 * mass * radius * radius;  // solid sphere
+    inv_inertia_1_kg_m2.push_back(fixed ? 0.0 : 1.0 / inertia);
+    material.push_back(material_id);
+    size_class.push_back(cls);
+    return static_cast<ParticleIndex>(position_m.size() - 1);
+  }
+
+  /// Removes the particles whose flag is true, keeping the order of the others.
+  void remove_if(const std::vector<bool>& remove) {
+    std::size_t w = 0;
+    for (std::size_t r = 0; r < size(); ++r) {
+      if (remove[r]) continue;
+      if (w != r) {
+        position_m[w] = position_m[r];
+        velocity_m_s[w] = velocity_m_s[r];
+        omega_rad_s[w] = omega_rad_s[r];
+        eval_velocity_m_s[w] = eval_velocity_m_s[r];
+        eval_omega_rad_s[w] = eval_omega_rad_s[r];
+        force_N[w] = force_N[r];
+        torque_N_m[w] = torque_N_m[r];
+        radius_m[w] = radius_m[r];
+        mass_kg[w] = mass_kg[r];
+        inv_mass_1_kg[w] = inv_mass_1_kg[r];
+        inv_inertia_1_kg_m2[w] = inv_inertia_1_kg_m2[r];
+        material[w] = material[r];
+        size_class[w] = size_class[r];
+      }
+      ++w;
+    }
+    position_m.resize(w);
+    velocity_m_s.resize(w);
+    omega_rad_s.resize(w);
+    eval_velocity_m_s.resize(w);
+    eval_omega_rad_s.resize(w);
+    force_N.resize(w);
+    torque_N_m.resize(w);
+    radius_m.resize(w);
+    mass_kg.resize(w);
+    inv_mass_1_kg.resize(w);
+    inv_inertia_1_kg_m2.resize(w);
+    material.resize(w);
+    size_class.resize(w);
+  }
+};
+
+}  // namespace gravsweep

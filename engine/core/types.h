@@ -1,0 +1,23 @@
+// Basic numeric types and named constants shared by the whole engine.
+// Conventions: SI units everywhere; z is up in the engine's frame (gravity along -z by default).
+#pragma once
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+
+namespace gravsweep {
+
+using Vec3 = Eigen::Vector3d;
+using Quat = Eigen::Quaterniond;
+
+inline constexpr double kPi = std::numbers::pi;
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+/// Small-number guard used by Chrono for |delta_t| and contact-circle radii (dem-physics.md 1.4).
+inline constexpr double kTinyLength_m = 1e-12;
+
+/// Index of a particle inside Particles (structure of arrays).
+using ParticleIndex = std::uint32_t;
+
+}  // namespace gravsweep

@@ -1,0 +1,104 @@
+#include "engine/integrate/integrators.h"
+
+#include <fmt/format.h>
+
+#include "engine/core/error.h"
+
+namespace gravsweep {
+
+namespace {
+
+/// Chrono::Multicore: v_{n+1} = v_n + h a(x_n, v_n); x_{n+1} = x_n + h v_{n+1} (dem-physics.md 1.6).
+class SemiImplicitEuler final : public Integrator {
+ public:
+  void begin_step(Particles&, double) override {}
+  void end_step(Particles& p, double dt) override {
+    const std::size_t n = p.size();
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      p.velocity_m_s[i] += dt * p.inv_mass_1_kg[i] * p.force_N[i];
+      p.omega_rad_s[i] += dt * p.inv_inertia_1_kg_m2[i] * p.torque_N_m[i];
+      if (p.inv_mass_1_kg[i] > 0) p.position_m[i] += dt * p.velocity_m_s[i];
+    }
+  }
+};
+
+/// Velocity Verlet (kick-drift-kick); forces are evaluated with the half-step velocities.
+class VelocityVerlet final : public Integrator {
+ public:
+  bool needs_initial_forces() const override { return true; }
+  void begin_step(Particles& p, double dt) override {
+    const std::size_t n = p.size();
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      p.velocity_m_s[i] += 0.5 * dt * p.inv_mass_1_kg[i] * p.force_N[i];
+      p.omega_rad_s[i] += 0.5 * dt * p.inv_inertia_1_kg_m2[i] * p.torque_N_m[i];
+      if (p.inv_mass_1_kg[i] > 0) p.position_m[i] += dt * p.velocity_m_s[i];
+    }
+  }
+  void end_step(Particles& p, double dt) override {
+    const std::size_t n = p.size();
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      p.velocity_m_s[i] += 0.5 * dt * p.inv_mass_1_kg[i] * p.force_N[i];
+      p.omega_rad_s[i] += 0.5 * dt * p.inv_inertia_1_kg_m2[i] * p.torque_N_m[i];
+    }
+  }
+};
+
+/// pkdgrav: kick-drift-kick leapfrog; forces at x_{n+1} with predicted velocities
+/// v_pred = v_n + dt a_n, w_pred = w_n + dt wdot_n (dem-physics.md 2.4).
+class LeapfrogKdk final : public Integrator {
+ public:
+  bool needs_initial_forces() const override { return true; }
+  bool uses_eval_velocities() const override { return true; }
+  void begin_step(Particles& p, double dt) override {
+    const std::size_t n = p.size();
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 a = p.inv_mass_1_kg[i] * p.force_N[i];
+      const Vec3 alpha = p.inv_inertia_1_kg_m2[i] * p.torque_N_m[i];
+      p.eval_velocity_m_s[i] = p.velocity_m_s[i] + dt * a;
+      p.eval_omega_rad_s[i] = p.omega_rad_s[i] + dt * alpha;
+      p.velocity_m_s[i] += 0.5 * dt * a;
+      p.omega_rad_s[i] += 0.5 * dt * alpha;
+      if (p.inv_mass_1_kg[i] > 0) p.position_m[i] += dt * p.velocity_m_s[i];
+    }
+  }
+  void end_step(Particles& p, double dt) override {
+    const std::size_t n = p.size();
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      p.velocity_m_s[i] += 0.5 * dt * p.inv_mass_1_kg[i] * p.force_N[i];
+      p.omega_rad_s[i] += 0.5 * dt * p.inv_inertia_1_kg_m2[i] * p.torque_N_m[i];
+    }
+  }
+};
+
+template <class T>
+std::unique_ptr<Integrator> make() {
+  return std::make_unique<T>();
+}
+
+}  // namespace
+
+const std::vector<IntegratorEntry>& integrator_table() {
+  static const std::vector<IntegratorEntry> table = {
+      {"semi_implicit_euler", "symplectic Euler, velocity first (Chrono::Multicore)", &make<SemiImplicitEuler>},
+      {"leapfrog_kdk", "kick-drift-kick leapfrog with predicted velocities (pkdgrav)", &make<LeapfrogKdk>},
+      {"velocity_verlet", "velocity Verlet, forces with half-step velocities", &make<VelocityVerlet>},
+  };
+  return table;
+}
+
+std::unique_ptr<Integrator> make_integrator(std::string_view name) {
+  std::string valid;
+  for (const auto& e : integrator_table()) {
+    if (name == e.name) return e.make();
+    valid += valid.empty() ? "" : ", ";
+    valid += e.name;
+  }
+  throw ConfigError(fmt::format("unknown integrator '{}'; valid integrators: {}", name, valid));
+}
+
+}  // namespace gravsweep

@@ -1,0 +1,197 @@
+#include "engine/neighbor/verlet_list.h"
+
+#include <fmt/format.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "engine/core/error.h"
+
+namespace gravsweep {
+
+namespace {
+constexpr std::size_t kMaxCells = std::size_t{1} << 26;
+}
+
+void VerletList::clear() {
+  offset.clear();
+  neighbor_.clear();
+  history.clear();
+  position_at_build_.clear();
+}
+
+std::size_t VerletList::bytes() const {
+  return offset.capacity() * sizeof(std::uint32_t) + neighbor_.capacity() * sizeof(std::uint32_t) +
+         history.capacity() * sizeof(ContactHistory) + position_at_build_.capacity() * sizeof(Vec3) +
+         (cell_start_.capacity() + cell_particles_.capacity() + particle_cell_.capacity() +
+          count_.capacity()) *
+             sizeof(std::uint32_t);
+}
+
+bool VerletList::needs_rebuild(const Particles& p) const {
+  const std::size_t n = p.size();
+  if (position_at_build_.size() != n || offset.size() != n + 1) return true;
+  const double limit2 = 0.25 * skin_m_ * skin_m_;
+  int rebuild = 0;
+#pragma omp parallel for schedule(static) reduction(| : rebuild)
+  for (std::size_t i = 0; i < n; ++i) {
+    if ((p.position_m[i] - position_at_build_[i]).squaredNorm() > limit2) rebuild = 1;
+  }
+  return rebuild != 0;
+}
+
+void VerletList::build(const Particles& p, double skin_m, int threads) {
+  const std::size_t n = p.size();
+  skin_m_ = skin_m;
+  ++builds_;
+  if (n == 0) {
+    clear();
+    offset.assign(1, 0);
+    return;
+  }
+  // Classify: small particles go into cells, large ones are scanned against the cells.
+  double r_min = kInf;
+  for (double r : p.radius_m) r_min = std::min(r_min, r);
+  const double large_threshold = kLargeRadiusFactor * r_min;
+  double r_small_max = 0;
+  std::vector<std::uint32_t> large;
+  Vec3 lo = Vec3::Constant(kInf), hi = Vec3::Constant(-kInf);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (p.radius_m[i] > large_threshold) {
+      large.push_back(static_cast<std::uint32_t>(i));
+      continue;
+    }
+    r_small_max = std::max(r_small_max, p.radius_m[i]);
+    lo = lo.cwiseMin(p.position_m[i]);
+    hi = hi.cwiseMax(p.position_m[i]);
+  }
+  const bool have_small = r_small_max > 0;
+  const double cell = 2 * r_small_max + skin_m;
+  std::array<long, 3> dims{1, 1, 1};
+  if (have_small) {
+    for (int a = 0; a < 3; ++a) {
+      if (!std::isfinite(lo[a]) || !std::isfinite(hi[a]))
+        throw NumericalFailure("neighbour list: a particle position is not finite", -1, -1);
+      dims[a] = std::max<long>(1, static_cast<long>((hi[a] - lo[a]) / cell) + 1);
+    }
+    if (static_cast<double>(dims[0]) * dims[1] * dims[2] > static_cast<double>(kMaxCells))
+      throw NumericalFailure(
+          fmt::format("neighbour list: particles spread over {:.3g} x {:.3g} x {:.3g} m, too many "
+                      "cells; a grain has probably left the container",
+                      hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]),
+          -1, -1);
+  }
+  const std::size_t n_cells = static_cast<std::size_t>(dims[0] * dims[1] * dims[2]);
+  auto cell_coord = [&](const Vec3& x, int a) {
+    return std::clamp<long>(static_cast<long>((x[a] - lo[a]) / cell), 0, dims[a] - 1);
+  };
+  // Counting sort of small particles by cell.
+  particle_cell_.assign(n, UINT32_MAX);
+  cell_start_.assign(n_cells + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (p.radius_m[i] > large_threshold) continue;
+    const long c = (cell_coord(p.position_m[i], 2) * dims[1] + cell_coord(p.position_m[i], 1)) *
+                       dims[0] +
+                   cell_coord(p.position_m[i], 0);
+    particle_cell_[i] = static_cast<std::uint32_t>(c);
+    ++cell_start_[c + 1];
+  }
+  for (std::size_t c = 0; c < n_cells; ++c) cell_start_[c + 1] += cell_start_[c];
+  cell_particles_.resize(cell_start_[n_cells]);
+  {
+    std::vector<std::uint32_t> fill(cell_start_.begin(), cell_start_.end() - 1);
+    for (std::size_t i = 0; i < n; ++i)
+      if (particle_cell_[i] != UINT32_MAX) cell_particles_[fill[particle_cell_[i]]++] = static_cast<std::uint32_t>(i);
+  }
+
+  // Pairs with a large particle: scan the cells its cutoff box covers; large-large by brute force.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> large_pairs;
+  for (std::uint32_t L : large) {
+    const Vec3& xL = p.position_m[L];
+    const double reach = p.radius_m[L] + r_small_max + skin_m;
+    if (have_small) {
+      std::array<long, 3> c0{}, c1{};
+      for (int a = 0; a < 3; ++a) {
+        c0[a] = std::clamp<long>(static_cast<long>(std::floor((xL[a] - reach - lo[a]) / cell)), 0, dims[a] - 1);
+        c1[a] = std::clamp<long>(static_cast<long>(std::floor((xL[a] + reach - lo[a]) / cell)), 0, dims[a] - 1);
+      }
+      for (long cz = c0[2]; cz <= c1[2]; ++cz)
+        for (long cy = c0[1]; cy <= c1[1]; ++cy)
+          for (long cx = c0[0]; cx <= c1[0]; ++cx) {
+            const long c = (cz * dims[1] + cy) * dims[0] + cx;
+            for (std::uint32_t k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
+              const std::uint32_t j = cell_particles_[k];
+              const double cut = p.radius_m[L] + p.radius_m[j] + skin_m;
+              if ((p.position_m[j] - xL).squaredNorm() < cut * cut)
+                large_pairs.emplace_back(std::min(L, j), std::max(L, j));
+            }
+          }
+    }
+    for (std::uint32_t M : large) {
+      if (M <= L) continue;
+      const double cut = p.radius_m[L] + p.radius_m[M] + skin_m;
+      if ((p.position_m[M] - xL).squaredNorm() < cut * cut) large_pairs.emplace_back(L, M);
+    }
+  }
+
+  // Small-small pairs: two passes (count, then fill) over the 27 neighbouring cells.
+  count_.assign(n + 1, 0);
+  auto for_small_neighbours = [&](std::size_t i, auto&& emit) {
+    const Vec3& xi = p.position_m[i];
+    const long cx = cell_coord(xi, 0), cy = cell_coord(xi, 1), cz = cell_coord(xi, 2);
+    for (long z = std::max(0L, cz - 1); z <= std::min(dims[2] - 1, cz + 1); ++z)
+      for (long y = std::max(0L, cy - 1); y <= std::min(dims[1] - 1, cy + 1); ++y)
+        for (long x = std::max(0L, cx - 1); x <= std::min(dims[0] - 1, cx + 1); ++x) {
+          const long c = (z * dims[1] + y) * dims[0] + x;
+          for (std::uint32_t k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
+            const std::uint32_t j = cell_particles_[k];
+            if (j <= i) continue;
+            const double cut = p.radius_m[i] + p.radius_m[j] + skin_m;
+            if ((p.position_m[j] - xi).squaredNorm() < cut * cut) emit(j);
+          }
+        }
+  };
+#pragma omp parallel for schedule(dynamic, 256) num_threads(threads)
+  for (std::size_t i = 0; i < n; ++i) {
+    if (particle_cell_[i] == UINT32_MAX) continue;
+    std::uint32_t c = 0;
+    for_small_neighbours(i, [&](std::uint32_t) { ++c; });
+    count_[i + 1] = c;
+  }
+  for (const auto& pr : large_pairs) ++count_[pr.first + 1];
+  std::vector<std::uint32_t> new_offset(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) new_offset[i + 1] = new_offset[i] + count_[i + 1];
+  std::vector<std::uint32_t> new_neighbor(new_offset[n]);
+  std::vector<std::uint32_t> cursor(new_offset.begin(), new_offset.end() - 1);
+  for (const auto& pr : large_pairs) new_neighbor[cursor[pr.first]++] = pr.second;
+#pragma omp parallel for schedule(dynamic, 256) num_threads(threads)
+  for (std::size_t i = 0; i < n; ++i) {
+    if (particle_cell_[i] != UINT32_MAX) {
+      std::uint32_t w = cursor[i];
+      for_small_neighbours(i, [&](std::uint32_t j) { new_neighbor[w++] = j; });
+    }
+    std::sort(new_neighbor.begin() + new_offset[i], new_neighbor.begin() + new_offset[i + 1]);
+  }
+
+  // Carry histories over: both lists are sorted by j within each i, so merge.
+  std::vector<ContactHistory> new_history(new_neighbor.size());
+  const bool have_old = offset.size() == n + 1;
+#pragma omp parallel for schedule(dynamic, 256) num_threads(threads)
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!have_old) continue;
+    std::uint32_t a = offset[i];
+    const std::uint32_t a_end = offset[i + 1];
+    for (std::uint32_t b = new_offset[i]; b < new_offset[i + 1] && a < a_end; ++b) {
+      while (a < a_end && neighbor_[a] < new_neighbor[b]) ++a;
+      if (a < a_end && neighbor_[a] == new_neighbor[b]) new_history[b] = history[a];
+    }
+  }
+  offset = std::move(new_offset);
+  neighbor_ = std::move(new_neighbor);
+  history = std::move(new_history);
+  position_at_build_ = p.position_m;
+}
+
+}  // namespace gravsweep

@@ -1,0 +1,49 @@
+// Half Verlet neighbour list with a skin, built from a cell list. Each unordered pair (i, j), i < j,
+// appears once, under i, with its ContactHistory stored beside it; histories survive rebuilds.
+//
+// Large particles (radius above kLargeRadiusFactor x the smallest radius, e.g. the 10 cm projectile
+// among 1 cm grains) are kept out of the cells; their pairs come from scanning the cells their
+// bounding box covers, so the cell size stays set by the grains (correct for any size ratio and for
+// polydisperse grains).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "engine/contact/contact.h"
+#include "engine/core/particles.h"
+
+namespace gravsweep {
+
+class VerletList {
+ public:
+  static constexpr double kLargeRadiusFactor = 2.5;
+
+  /// Rebuilds the list for cutoff r_i + r_j + skin, carrying over histories of pairs still listed.
+  void build(const Particles& p, double skin_m, int threads);
+
+  /// True when some particle moved more than skin/2 since the last build (or nothing is built).
+  [[nodiscard]] bool needs_rebuild(const Particles& p) const;
+
+  [[nodiscard]] std::size_t pairs() const { return neighbor_.size(); }
+  [[nodiscard]] long long builds() const { return builds_; }
+  [[nodiscard]] double skin_m() const { return skin_m_; }
+  [[nodiscard]] std::size_t bytes() const;
+
+  // CSR storage: pairs of particle i are [offset[i], offset[i+1]).
+  std::vector<std::uint32_t> offset;
+  std::vector<std::uint32_t> neighbor_;
+  std::vector<ContactHistory> history;
+
+  /// Forget everything (after particles were added or removed: indices changed).
+  void clear();
+
+ private:
+  std::vector<Vec3> position_at_build_;
+  double skin_m_ = 0;
+  long long builds_ = 0;
+  // Scratch reused across builds.
+  std::vector<std::uint32_t> cell_start_, cell_particles_, particle_cell_;
+  std::vector<std::uint32_t> count_;
+};
+
+}  // namespace gravsweep

@@ -1,0 +1,14 @@
+// `none`: no rolling or twisting resistance.
+#pragma once
+#include "engine/contact/contact.h"
+
+namespace gravsweep {
+
+struct RollingNone {
+  static constexpr const char* name = "none";
+  static constexpr const char* description = "no rolling or twisting resistance";
+  static void apply(const ContactGeometry&, const PairCoefficients&, const ContactOptions&,
+                    ContactHistory&, double, ContactForce&) {}
+};
+
+}  // namespace gravsweep

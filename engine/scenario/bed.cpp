@@ -1,0 +1,192 @@
+#include "engine/scenario/bed.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "engine/core/error.h"
+
+namespace gravsweep {
+
+const char* to_string(BedPhase p) {
+  switch (p) {
+    case BedPhase::fill: return "fill";
+    case BedPhase::settle: return "settle";
+    case BedPhase::flatten: return "flatten";
+    case BedPhase::relax: return "relax";
+  }
+  return "?";
+}
+
+void add_container_walls(System& sys, const ContainerSpec& c, double height_m,
+                         std::uint8_t wall_material) {
+  const double R = 0.5 * c.diameter_m;
+  sys.walls.push_back(Wall::disk("bottom", Vec3::Zero(), Vec3::UnitZ(), R, wall_material));
+  sys.walls.push_back(Wall::cylinder("side", Vec3::Zero(), Vec3::UnitZ(), R, height_m, wall_material));
+  // A particle centre outside the container (with a margin of one radius) is a numerical failure.
+  sys.mutable_config().domain = Domain{Vec3(-R, -R, -0.05 * R), Vec3(R, R, height_m + 10 * R)};
+}
+
+std::size_t place_grains(System& sys, const BedSpec& spec) {
+  const auto& g = spec.grains;
+  const double R_c = 0.5 * spec.container.diameter_m;
+  const double d_max = g.diameter_m + 2 * g.diameter_spread_m;
+  const double grain_volume = kPi / 6 * std::pow(g.diameter_m, 3);
+  const double bed_volume = kPi * R_c * R_c * spec.fill_height_m;
+  const auto target = static_cast<std::size_t>(
+      std::ceil(spec.overfill_factor * spec.packing_fraction * bed_volume / grain_volume));
+  std::mt19937_64 rng(spec.seed);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  const double spacing = 1.04 * d_max;
+  const double jitter = 0.5 * (spacing - d_max) * 0.9;
+  // Triangular lattice in each layer, layers offset; stop when the target count is reached.
+  const double row = spacing * std::sqrt(3.0) / 2;
+  const double r_free = R_c - 0.5 * d_max - 1e-4;
+  std::size_t placed = 0;
+  for (int layer = 0; placed < target; ++layer) {
+    const double z = 0.5 * d_max + 1e-4 + layer * spacing;
+    const double shift = (layer % 2) * 0.5 * spacing;
+    const int n_rows = static_cast<int>(std::ceil(2 * r_free / row)) + 1;
+    for (int r = -n_rows / 2; r <= n_rows / 2 && placed < target; ++r) {
+      const double y = r * row;
+      const double x0 = (r % 2 != 0 ? 0.5 * spacing : 0.0) + shift;
+      const int n_cols = static_cast<int>(std::ceil(2 * r_free / spacing)) + 2;
+      for (int c = -n_cols / 2; c <= n_cols / 2 && placed < target; ++c) {
+        Vec3 pos(x0 + c * spacing + jitter * uni(rng), y + jitter * uni(rng), z + jitter * uni(rng));
+        if (std::hypot(pos.x(), pos.y()) > r_free) continue;
+        const double diameter = g.diameter_m + g.diameter_spread_m * uni(rng);
+        const double radius = 0.5 * diameter;
+        const double mass = g.density_kg_m3 * kPi / 6 * diameter * diameter * diameter;
+        const ParticleIndex i = sys.particles.add(pos, radius, mass, spec.grain_material, SizeClass::grain);
+        // Small random velocities mix the pour (paper: "mix and settle").
+        sys.particles.velocity_m_s[i] = 0.05 * Vec3(uni(rng), uni(rng), uni(rng));
+        ++placed;
+      }
+    }
+  }
+  sys.invalidate();
+  return placed;
+}
+
+void grain_speeds(const System& sys, double& rms_m_s, double& max_m_s) {
+  double sum2 = 0, mx2 = 0;
+  std::size_t n = 0;
+  const auto& p = sys.particles;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.size_class[i] != SizeClass::grain || p.inv_mass_1_kg[i] == 0) continue;
+    const double v2 = p.velocity_m_s[i].squaredNorm();
+    sum2 += v2;
+    mx2 = std::max(mx2, v2);
+    ++n;
+  }
+  rms_m_s = n > 0 ? std::sqrt(sum2 / static_cast<double>(n)) : 0.0;
+  max_m_s = std::sqrt(mx2);
+}
+
+bool settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress,
+            BedPhase phase, double* rms_out, double* max_out) {
+  const double dt = sys.config().dt_s;
+  const auto check_steps = std::max<long long>(1, std::llround(c.check_interval_s / dt));
+  const double t0 = sys.time_s();
+  double rms = 0, mx = 0;
+  bool met = false;
+  while (sys.time_s() - t0 < c.max_time_s) {
+    sys.advance(check_steps);
+    grain_speeds(sys, rms, mx);
+    const double elapsed = sys.time_s() - t0;
+    if (progress) {
+      // Progress: the larger of the time fraction and how close the RMS speed is to its target
+      // on a log scale (settling is roughly exponential).
+      const double speed_frac = rms > 0 ? std::clamp(1.0 - std::log10(rms / c.rms_speed_m_s) / 4.0, 0.0, 1.0) : 1.0;
+      progress(phase, std::max(elapsed / c.max_time_s, speed_frac),
+               fmt::format("t={:.3f}s rms={:.2e}m/s max={:.2e}m/s", elapsed, rms, mx));
+    }
+    if (elapsed >= min_time_s && rms < c.rms_speed_m_s && mx < c.max_speed_m_s) {
+      met = true;
+      break;
+    }
+  }
+  if (rms_out) *rms_out = rms;
+  if (max_out) *max_out = mx;
+  return met;
+}
+
+double surface_height(const System& sys, double container_radius_m) {
+  // Mean top height of the grains within 60 % of the container radius that stand highest in
+  // their column: bin the central disk on a grid of ~1.5 grain diameters and average bin maxima.
+  const auto& p = sys.particles;
+  double d = 0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.size_class[i] == SizeClass::grain) { d += 2 * p.radius_m[i]; ++n; }
+  if (n == 0) return 0;
+  d /= static_cast<double>(n);
+  const double reach = 0.6 * container_radius_m;
+  const double bin = 1.5 * d;
+  const int nb = static_cast<int>(std::ceil(2 * reach / bin));
+  std::vector<double> top(static_cast<std::size_t>(nb * nb), -kInf);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.size_class[i] != SizeClass::grain) continue;
+    const Vec3& x = p.position_m[i];
+    if (std::hypot(x.x(), x.y()) > reach) continue;
+    const int bx = std::clamp(static_cast<int>((x.x() + reach) / bin), 0, nb - 1);
+    const int by = std::clamp(static_cast<int>((x.y() + reach) / bin), 0, nb - 1);
+    double& t = top[static_cast<std::size_t>(by * nb + bx)];
+    t = std::max(t, x.z() + p.radius_m[i]);
+  }
+  double sum = 0;
+  std::size_t cnt = 0;
+  for (double t : top)
+    if (std::isfinite(t)) { sum += t; ++cnt; }
+  return cnt > 0 ? sum / static_cast<double>(cnt) : 0.0;
+}
+
+BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progress) {
+  if (!(spec.fill_height_m > 0)) throw ConfigError("bed: fill_height_m must be > 0");
+  if (!(spec.grains.diameter_m > 0)) throw ConfigError("bed: grain diameter_m must be > 0");
+  if (!(spec.grains.diameter_spread_m >= 0 && spec.grains.diameter_spread_m < 0.5 * spec.grains.diameter_m))
+    throw ConfigError("bed: grain diameter_spread_m must be in [0, diameter/2)");
+  if (!(spec.container.diameter_m > 4 * spec.grains.diameter_m))
+    throw ConfigError("bed: container diameter_m must exceed 4 grain diameters");
+  BedReport rep;
+  if (progress) progress(BedPhase::fill, 0.0, "placing grains");
+  rep.grains_placed = place_grains(sys, spec);
+  double top = 0;
+  for (std::size_t i = 0; i < sys.particles.size(); ++i)
+    top = std::max(top, sys.particles.position_m[i].z() + sys.particles.radius_m[i]);
+  const double wall_h = spec.container.wall_height_m > 0 ? spec.container.wall_height_m
+                                                         : std::max(top, spec.fill_height_m) + 0.1;
+  add_container_walls(sys, spec.container, wall_h, spec.wall_material);
+  sys.invalidate();
+  if (progress) progress(BedPhase::fill, 1.0, fmt::format("{} grains", rep.grains_placed));
+  // Settle under gravity.
+  const double t0 = sys.time_s();
+  bool met = settle(sys, spec.settle, 0.0, progress, BedPhase::settle, &rep.rms_speed_m_s, &rep.max_speed_m_s);
+  rep.settle_time_s = sys.time_s() - t0;
+  // Flatten: delete grains whose centre lies above the fill height.
+  std::vector<bool> remove(sys.particles.size(), false);
+  for (std::size_t i = 0; i < sys.particles.size(); ++i)
+    remove[i] = sys.particles.size_class[i] == SizeClass::grain &&
+                sys.particles.position_m[i].z() > spec.fill_height_m;
+  sys.particles.remove_if(remove);
+  sys.invalidate();
+  if (progress) progress(BedPhase::flatten, 1.0, fmt::format("{} grains kept", sys.particles.size()));
+  // Relax the new surface.
+  const double t1 = sys.time_s();
+  met = settle(sys, spec.settle, spec.relax_time_s, progress, BedPhase::relax, &rep.rms_speed_m_s,
+               &rep.max_speed_m_s) && met;
+  rep.relax_time_s = sys.time_s() - t1;
+  rep.settled = met;
+  rep.grains_kept = sys.particles.size();
+  rep.surface_height_m = surface_height(sys, 0.5 * spec.container.diameter_m);
+  double mass = 0;
+  for (double m : sys.particles.mass_kg) mass += m;
+  const double R = 0.5 * spec.container.diameter_m;
+  rep.bulk_density_kg_m3 = rep.surface_height_m > 0 ? mass / (kPi * R * R * rep.surface_height_m) : 0;
+  return rep;
+}
+
+}  // namespace gravsweep

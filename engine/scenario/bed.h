@@ -1,0 +1,85 @@
+// Bed preparation (Sunday et al. 2021 Sect. 2.2): place grains without overlap in a cylindrical
+// container, settle them under gravity until the RMS and the largest grain speed fall below the
+// criteria, delete the grains above the fill height, and let the surface relax.
+// Engine frame: z up, container axis along z through the origin, bottom disk at z = 0.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "engine/system/system.h"
+
+namespace gravsweep {
+
+struct ContainerSpec {
+  double diameter_m = 0.315;       ///< inner diameter of the cylinder (paper: 31.5 cm)
+  double wall_height_m = 0.0;      ///< 0 = as tall as the initial grain column
+};
+
+struct GrainSpec {
+  double diameter_m = 0.01;        ///< mean grain diameter (paper: 1 cm)
+  double diameter_spread_m = 5e-4; ///< uniform spread +/- (paper, Chrono: 1 +/- 0.05 cm)
+  double density_kg_m3 = 2480.0;
+};
+
+struct SettleCriteria {
+  double rms_speed_m_s = 1e-5;     ///< paper: RMS grain speed < 1e-3 cm/s
+  double max_speed_m_s = 1e-3;     ///< paper: fastest grain < 0.1 cm/s
+  double max_time_s = 2.0;         ///< cap on simulated settling time per settling phase
+  double check_interval_s = 1e-3;  ///< how often the criteria are evaluated
+};
+
+struct BedSpec {
+  ContainerSpec container;
+  GrainSpec grains;
+  double fill_height_m = 0.10;     ///< bed depth after flattening (paper: 10 cm, 21 cm at low g)
+  double overfill_factor = 1.15;   ///< grains poured relative to the fill volume
+  double packing_fraction = 0.60;  ///< assumed random packing, for the grain count
+  std::uint64_t seed = 1;
+  SettleCriteria settle;
+  double relax_time_s = 0.05;      ///< minimum relaxation after flattening
+  std::uint8_t grain_material = 0;
+  std::uint8_t wall_material = 1;
+};
+
+/// Phase of bed preparation, for progress reporting.
+enum class BedPhase { fill, settle, flatten, relax };
+const char* to_string(BedPhase p);
+
+/// progress(phase, fraction in [0, 1], detail)
+using BedProgress = std::function<void(BedPhase, double, const std::string&)>;
+
+struct BedReport {
+  std::size_t grains_placed = 0;
+  std::size_t grains_kept = 0;
+  double settle_time_s = 0;
+  double relax_time_s = 0;
+  bool settled = false;            ///< criteria met (false: the time cap ended a phase)
+  double rms_speed_m_s = 0;
+  double max_speed_m_s = 0;
+  double surface_height_m = 0;     ///< mean height of the top of the grains near the axis
+  double bulk_density_kg_m3 = 0;
+};
+
+/// Adds the container walls (disk bottom at z = 0, cylinder side) to the system.
+void add_container_walls(System& sys, const ContainerSpec& c, double height_m,
+                         std::uint8_t wall_material);
+
+/// Places grains without overlap on a jittered lattice filling the container up to the height
+/// needed for the grain count; returns the number placed.
+std::size_t place_grains(System& sys, const BedSpec& spec);
+
+/// Runs until the grains meet the criteria or the time cap; returns true if the criteria were met.
+bool settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress,
+            BedPhase phase, double* rms_out = nullptr, double* max_out = nullptr);
+
+/// The whole preparation: walls, placement, settling, flattening, relaxation.
+BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progress = {});
+
+/// Height of the bed surface: mean of the highest grain tops in the central region.
+double surface_height(const System& sys, double container_radius_m);
+
+/// RMS and maximum speed of the free grains (size class grain).
+void grain_speeds(const System& sys, double& rms_m_s, double& max_m_s);
+
+}  // namespace gravsweep

@@ -1,0 +1,191 @@
+// The one pair loop, written once and templated on the contact law and the rolling model, so the
+// contact loop has no virtual call. Half neighbour list; each OpenMP thread accumulates into its own
+// force/torque buffer, then buffers are summed in a fixed order: results are deterministic for a
+// given thread count.
+#pragma once
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "engine/core/particles.h"
+#include "engine/geometry/walls.h"
+#include "engine/neighbor/verlet_list.h"
+#include "engine/system/system.h"
+
+namespace gravsweep {
+
+struct ForceContext {
+  Particles& p;
+  const std::vector<Wall>& walls;
+  VerletList& nlist;
+  std::vector<ContactHistory>& wall_history;
+  const PairTable& pairs;
+  const ContactOptions& options;
+  std::vector<std::vector<Vec3>>& thread_force;
+  std::vector<std::vector<Vec3>>& thread_torque;
+  Vec3 gravity_m_s2;
+  double dt_s;
+  bool use_eval_velocities;
+  bool track_energy;
+  int threads;
+  // Outputs.
+  StepStats stats{};
+  long long failed_particle = -1;
+  long long failed_other = -1;
+  double failed_overlap_ratio = 0;
+};
+
+/// Overlap beyond this fraction of the smaller radius is a numerical failure.
+inline constexpr double kMaxOverlapFraction = 0.5;
+
+template <class Law, class Rolling>
+void force_loop(ForceContext& c) {
+  Particles& p = c.p;
+  const std::size_t n = p.size();
+  const std::size_t n_walls = c.walls.size();
+  const Vec3* V = c.use_eval_velocities ? p.eval_velocity_m_s.data() : p.velocity_m_s.data();
+  const Vec3* W = c.use_eval_velocities ? p.eval_omega_rad_s.data() : p.omega_rad_s.data();
+  const Vec3* X = p.position_m.data();
+  const double* R = p.radius_m.data();
+  const double* M = p.mass_kg.data();
+  const double* inv_m = p.inv_mass_1_kg.data();
+  const std::uint8_t* mat = p.material.data();
+  const std::uint32_t* off = c.nlist.offset.data();
+  const std::uint32_t* nbr = c.nlist.neighbor_.data();
+  ContactHistory* hist = c.nlist.history.data();
+  const double dt = c.dt_s;
+  long long contacts = 0, wall_contacts = 0;
+  double energy = 0;
+  long long bad_i = -1, bad_j = -1;
+  double bad_ratio = 0;
+
+#pragma omp parallel num_threads(c.threads) reduction(+ : contacts, wall_contacts, energy)
+  {
+    const int t = omp_get_thread_num();
+    Vec3* F = c.thread_force[t].data();
+    Vec3* T = c.thread_torque[t].data();
+    std::fill(F, F + n, Vec3::Zero());
+    std::fill(T, T + n, Vec3::Zero());
+    long long my_bad_i = -1, my_bad_j = -1;
+    double my_ratio = 0;
+    ContactForce out;
+    ContactGeometry g;
+#pragma omp for schedule(static) nowait
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 xi = X[i];
+      const double ri = R[i];
+      for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+        const std::uint32_t j = nbr[k];
+        const Vec3 d = X[j] - xi;
+        const double rsum = ri + R[j];
+        const double dist2 = d.squaredNorm();
+        ContactHistory& h = hist[k];
+        if (dist2 >= rsum * rsum) {
+          h.active = false;  // contact ended: history erased
+          continue;
+        }
+        if (inv_m[i] == 0 && inv_m[j] == 0) continue;  // two fixed particles
+        const double dist = std::sqrt(dist2);
+        g.n = d / dist;
+        g.overlap_m = rsum - dist;
+        g.distance_m = dist;
+        g.r1_m = ri;
+        g.r2_m = R[j];
+        g.R_eff_m = ri * R[j] / rsum;
+        const double mi = inv_m[i] == 0 ? kInf : M[i], mj = inv_m[j] == 0 ? kInf : M[j];
+        g.m_eff_kg = std::isinf(mi) ? mj : std::isinf(mj) ? mi : mi * mj / (mi + mj);
+        g.v1 = V[i];
+        g.v2 = V[j];
+        g.w1 = W[i];
+        g.w2 = W[j];
+        g.wall = false;
+        const double ratio = g.overlap_m / std::min(ri, R[j]);
+        if (ratio > kMaxOverlapFraction && ratio > my_ratio) {
+          my_ratio = ratio;
+          my_bad_i = i;
+          my_bad_j = j;
+        }
+        const PairCoefficients& pc = c.pairs(mat[i], mat[j]);
+        Law::evaluate(g, pc, c.options, h, dt, out);
+        Rolling::apply(g, pc, c.options, h, dt, out);
+        F[i] -= out.force_on_2;
+        F[j] += out.force_on_2;
+        T[i] += out.torque_1;
+        T[j] += out.torque_2;
+        ++contacts;
+        if (c.track_energy) energy += out.elastic_energy_J;
+      }
+    }
+    if (n_walls > 0) {
+#pragma omp for schedule(static) nowait
+      for (std::size_t i = 0; i < n; ++i) {
+        if (inv_m[i] == 0) continue;
+        for (std::size_t w = 0; w < n_walls; ++w) {
+          ContactHistory& h = c.wall_history[i * n_walls + w];
+          WallTouch touch;
+          if (!touch_wall(c.walls[w], X[i], R[i], touch)) {
+            h.active = false;
+            continue;
+          }
+          g.n = touch.n;
+          g.overlap_m = touch.overlap_m;
+          g.distance_m = touch.distance_m;
+          g.r1_m = R[i];
+          g.r2_m = kInf;
+          g.R_eff_m = touch.R_eff_m;
+          g.m_eff_kg = M[i];
+          g.v1 = V[i];
+          g.v2.setZero();
+          g.w1 = W[i];
+          g.w2.setZero();
+          g.wall = true;
+          const double ratio = touch.overlap_m / R[i];
+          if (ratio > kMaxOverlapFraction && ratio > my_ratio) {
+            my_ratio = ratio;
+            my_bad_i = i;
+            my_bad_j = -2 - static_cast<long long>(w);
+          }
+          const PairCoefficients& pc = c.pairs(mat[i], c.walls[w].material);
+          Law::evaluate(g, pc, c.options, h, dt, out);
+          Rolling::apply(g, pc, c.options, h, dt, out);
+          F[i] -= out.force_on_2;
+          T[i] += out.torque_1;
+          ++wall_contacts;
+          if (c.track_energy) energy += out.elastic_energy_J;
+        }
+      }
+    }
+    if (my_bad_i >= 0) {
+#pragma omp critical(gravsweep_force_failure)
+      if (my_ratio > bad_ratio) {
+        bad_ratio = my_ratio;
+        bad_i = my_bad_i;
+        bad_j = my_bad_j;
+      }
+    }
+  }
+  // Sum the thread buffers in a fixed order and add gravity.
+  const int nt = c.threads;
+#pragma omp parallel for schedule(static) num_threads(c.threads)
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec3 f = inv_m[i] > 0 ? Vec3(M[i] * c.gravity_m_s2) : Vec3::Zero();
+    Vec3 tq = Vec3::Zero();
+    for (int t = 0; t < nt; ++t) {
+      f += c.thread_force[t][i];
+      tq += c.thread_torque[t][i];
+    }
+    p.force_N[i] = f;
+    p.torque_N_m[i] = tq;
+  }
+  c.stats.contacts = contacts;
+  c.stats.wall_contacts = wall_contacts;
+  c.stats.elastic_energy_J = energy;
+  c.failed_particle = bad_i;
+  c.failed_other = bad_j;
+  c.failed_overlap_ratio = bad_ratio;
+}
+
+}  // namespace gravsweep

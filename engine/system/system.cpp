@@ -1,0 +1,218 @@
+#include "engine/system/system.h"
+
+#include <fmt/format.h>
+#include <omp.h>
+
+#include <cmath>
+
+#include "engine/contact/registry.h"
+#include "engine/core/error.h"
+#include "engine/system/force_loop.h"
+
+namespace gravsweep {
+
+System::System(SystemConfig config) : config_(std::move(config)) {}
+System::~System() = default;
+
+int System::threads() const {
+  if (particles.size() < config_.parallel_min_particles) return 1;
+  return config_.threads > 0 ? config_.threads : omp_get_max_threads();
+}
+
+void System::invalidate() {
+  initialized_ = false;
+  have_forces_ = false;
+  nlist_.clear();
+  wall_history_.clear();
+}
+
+void System::initialize() {
+  const std::size_t nm = config_.materials.size();
+  if (nm == 0) throw ConfigError("system: no materials defined");
+  if (!(config_.dt_s > 0)) throw ConfigError(fmt::format("system: dt_s = {} must be > 0", config_.dt_s));
+  for (const auto& m : config_.materials) validate_material(m);
+  // Pair table.
+  pairs_ = PairTable(nm);
+  for (std::size_t a = 0; a < nm; ++a)
+    for (std::size_t b = a; b < nm; ++b) {
+      const PairOverride* ov = nullptr;
+      if (config_.composition == Composition::explicit_pair) {
+        auto it = config_.pair_overrides.find({static_cast<int>(a), static_cast<int>(b)});
+        if (it != config_.pair_overrides.end()) ov = &it->second;
+      }
+      const PairCoefficients pc = compose_pair(config_.materials[a], config_.materials[b], ov);
+      auto bad = [&](const char* f, double v, const char* e) {
+        throw ConfigError(fmt::format("pair {}-{}: {} = {} is invalid; expected {}",
+                                      config_.materials[a].name, config_.materials[b].name, f, v, e));
+      };
+      if (!(pc.cor_normal > 0 && pc.cor_normal <= 1)) bad("cor_normal", pc.cor_normal, "COR in (0, 1]");
+      if (!(pc.cor_tangential > 0 && pc.cor_tangential <= 1))
+        bad("cor_tangential", pc.cor_tangential, "COR in (0, 1]");
+      if (!(pc.mu_static >= 0)) bad("mu_static", pc.mu_static, ">= 0");
+      pairs_.set(a, b, pc);
+    }
+  // Per-material extremes for the law's checks.
+  std::vector<double> min_r(nm, 0), min_m(nm, 0);
+  std::vector<bool> is_wall(nm, false);
+  for (const auto& w : walls) {
+    if (w.material >= nm) throw ConfigError(fmt::format("wall '{}': material id {} is not defined", w.name, w.material));
+    is_wall[w.material] = true;
+  }
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    const auto m = particles.material[i];
+    if (m >= nm) throw ConfigError(fmt::format("particle {}: material id {} is not defined", i, m));
+    if (!(particles.radius_m[i] > 0) || !(particles.mass_kg[i] > 0))
+      throw ConfigError(fmt::format("particle {}: radius {} m and mass {} kg must be > 0", i,
+                                    particles.radius_m[i], particles.mass_kg[i]));
+    min_r[m] = min_r[m] == 0 ? particles.radius_m[i] : std::min(min_r[m], particles.radius_m[i]);
+    min_m[m] = min_m[m] == 0 ? particles.mass_kg[i] : std::min(min_m[m], particles.mass_kg[i]);
+    is_wall[m] = false;  // a material used by particles is checked as a particle material
+  }
+  check_contact_law(config_.contact_law,
+                    LawSetup{config_.materials, pairs_, min_r, min_m, is_wall, config_.dt_s,
+                             config_.check_time_step});
+  force_fn_ = select_force_function(config_.contact_law, config_.rolling_model);
+  integrator_ = make_integrator(config_.integrator);
+
+  if (config_.skin_m <= 0) {
+    double rmin = kInf;
+    for (double r : particles.radius_m) rmin = std::min(rmin, r);
+    config_.skin_m = std::isfinite(rmin) ? 0.2 * rmin : 1e-3;
+  }
+  const int nt = threads();
+  thread_force_.assign(nt, std::vector<Vec3>(particles.size(), Vec3::Zero()));
+  thread_torque_.assign(nt, std::vector<Vec3>(particles.size(), Vec3::Zero()));
+  if (wall_history_.size() != particles.size() * walls.size())
+    wall_history_.assign(particles.size() * walls.size(), ContactHistory{});
+  if (nlist_.offset.size() != particles.size() + 1) nlist_.clear();
+  nlist_.build(particles, config_.skin_m, nt);
+  initialized_ = true;
+}
+
+void System::compute_forces() {
+  if (!initialized_) initialize();
+  if (nlist_.needs_rebuild(particles)) nlist_.build(particles, config_.skin_m, threads());
+  ForceContext ctx{particles,
+                   walls,
+                   nlist_,
+                   wall_history_,
+                   pairs_,
+                   config_.options,
+                   thread_force_,
+                   thread_torque_,
+                   config_.gravity_m_s2,
+                   config_.dt_s,
+                   integrator_->uses_eval_velocities() && have_forces_,
+                   config_.track_energy,
+                   threads()};
+  force_fn_(ctx);
+  stats_ = ctx.stats;
+  have_forces_ = true;
+  if (ctx.failed_particle >= 0) {
+    std::string other = ctx.failed_other >= 0
+                            ? fmt::format("particle {}", ctx.failed_other)
+                            : fmt::format("wall '{}'", walls[-2 - ctx.failed_other].name);
+    throw NumericalFailure(
+        fmt::format("step {} (t = {:.6g} s): particle {} overlaps {} by {:.0f} % of the smaller "
+                    "radius (limit {:.0f} %): the time step is too large or the contact too soft",
+                    step_, time_s_, ctx.failed_particle, other, 100 * ctx.failed_overlap_ratio,
+                    100 * kMaxOverlapFraction),
+        step_, ctx.failed_particle);
+  }
+}
+
+void System::check_state() {
+  const std::size_t n = particles.size();
+  long long bad = -1;
+  int cause = 0;  // 1 NaN, 2 outside domain
+  const bool have_domain = config_.domain.has_value();
+  const Domain dom = have_domain ? *config_.domain : Domain{};
+#pragma omp parallel for schedule(static) num_threads(threads())
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3& x = particles.position_m[i];
+    const Vec3& v = particles.velocity_m_s[i];
+    int c = 0;
+    if (!x.allFinite() || !v.allFinite() || !particles.omega_rad_s[i].allFinite()) c = 1;
+    else if (have_domain && ((x.array() < dom.lo_m.array()).any() || (x.array() > dom.hi_m.array()).any())) c = 2;
+    if (c != 0) {
+#pragma omp critical(gravsweep_state_failure)
+      if (bad < 0 || static_cast<long long>(i) < bad) {
+        bad = static_cast<long long>(i);
+        cause = c;
+      }
+    }
+  }
+  if (bad >= 0) {
+    const Vec3& x = particles.position_m[bad];
+    if (cause == 1)
+      throw NumericalFailure(fmt::format("step {} (t = {:.6g} s): particle {} has a non-finite "
+                                         "position or velocity (NaN/inf)",
+                                         step_, time_s_, bad),
+                             step_, bad);
+    throw NumericalFailure(
+        fmt::format("step {} (t = {:.6g} s): particle {} left the container: position ({:.4g}, "
+                    "{:.4g}, {:.4g}) m is outside the domain",
+                    step_, time_s_, bad, x.x(), x.y(), x.z()),
+        step_, bad);
+  }
+}
+
+void System::step() {
+  if (!initialized_) initialize();
+  const double dt = config_.dt_s;
+  omp_set_num_threads(threads());  // integrators use the default team size
+  if (integrator_->needs_initial_forces() && !have_forces_) compute_forces();
+  integrator_->begin_step(particles, dt);
+  compute_forces();
+  integrator_->end_step(particles, dt);
+  ++step_;
+  time_s_ += dt;
+  check_state();
+}
+
+void System::advance(long long steps) {
+  for (long long s = 0; s < steps; ++s) step();
+}
+
+double System::kinetic_energy_J() const {
+  double e = 0;
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    if (particles.inv_mass_1_kg[i] == 0) continue;
+    e += 0.5 * particles.mass_kg[i] * particles.velocity_m_s[i].squaredNorm();
+    e += 0.5 / particles.inv_inertia_1_kg_m2[i] * particles.omega_rad_s[i].squaredNorm();
+  }
+  return e;
+}
+
+double System::potential_energy_J() const {
+  double e = 0;
+  for (std::size_t i = 0; i < particles.size(); ++i)
+    if (particles.inv_mass_1_kg[i] > 0)
+      e -= particles.mass_kg[i] * config_.gravity_m_s2.dot(particles.position_m[i]);
+  return e;
+}
+
+int System::contact_count(ParticleIndex i) const {
+  int count = 0;
+  const std::size_t n = particles.size();
+  for (std::size_t a = 0; a < n; ++a)
+    for (std::uint32_t k = nlist_.offset[a]; k < nlist_.offset[a + 1]; ++k)
+      if ((a == i || nlist_.neighbor_[k] == i) && nlist_.history[k].active) ++count;
+  const std::size_t nw = walls.size();
+  for (std::size_t w = 0; w < nw && i * nw + w < wall_history_.size(); ++w)
+    if (wall_history_[i * nw + w].active) ++count;
+  return count;
+}
+
+double System::bytes_per_particle() const {
+  const std::size_t n = std::max<std::size_t>(1, particles.size());
+  const std::size_t per_particle_state =
+      7 * sizeof(Vec3) + 4 * sizeof(double) + sizeof(std::uint8_t) + sizeof(SizeClass);
+  std::size_t bytes = particles.size() * per_particle_state + nlist_.bytes() +
+                      wall_history_.capacity() * sizeof(ContactHistory);
+  for (const auto& v : thread_force_) bytes += v.capacity() * sizeof(Vec3);
+  for (const auto& v : thread_torque_) bytes += v.capacity() * sizeof(Vec3);
+  return static_cast<double>(bytes) / static_cast<double>(n);
+}
+
+}  // namespace gravsweep

@@ -1,0 +1,120 @@
+// The DEM system: particles, walls, the selected contact law, rolling model and integrator, and
+// the neighbour list. It knows nothing of files or databases.
+#pragma once
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "engine/contact/contact.h"
+#include "engine/core/material.h"
+#include "engine/core/particles.h"
+#include "engine/geometry/walls.h"
+#include "engine/integrate/integrators.h"
+#include "engine/neighbor/verlet_list.h"
+
+namespace gravsweep {
+
+struct ForceContext;
+using ForceFunction = void (*)(ForceContext&);
+
+/// Axis-aligned region; a particle centre outside it is a numerical failure ("left the container").
+struct Domain {
+  Vec3 lo_m, hi_m;
+};
+
+struct SystemConfig {
+  std::string contact_law = "hertz";               ///< see contact_law_names()
+  std::string rolling_model = "sunday";            ///< see rolling_model_names()
+  std::string integrator = "semi_implicit_euler";  ///< see integrator_table()
+  double dt_s = 1e-6;
+  Vec3 gravity_m_s2 = Vec3(0, 0, -9.81);
+  std::vector<Material> materials;                 ///< indexed by material id
+  Composition composition = Composition::explicit_pair;
+  /// explicit_pair overrides, keyed by (material a, material b) with a <= b.
+  std::map<std::pair<int, int>, PairOverride> pair_overrides;
+  ContactOptions options;
+  double skin_m = 0;                                ///< Verlet skin; 0 = 0.2 x smallest radius
+  int threads = 0;                                  ///< OpenMP threads; 0 = OpenMP default
+  /// Systems smaller than this run on one thread (thread start-up costs more than it saves).
+  std::size_t parallel_min_particles = 512;
+  std::optional<Domain> domain;
+  bool track_energy = false;                        ///< accumulate the normal spring energy
+  bool check_time_step = true;                      ///< reject dt above the law's stability bound
+};
+
+/// Per-step counters from the force evaluation.
+struct StepStats {
+  long long contacts = 0;        ///< touching particle-particle pairs
+  long long wall_contacts = 0;   ///< touching particle-wall pairs
+  double elastic_energy_J = 0;   ///< sum of normal spring energies (track_energy only)
+};
+
+class System {
+ public:
+  explicit System(SystemConfig config);
+  ~System();
+  System(const System&) = delete;
+  System& operator=(const System&) = delete;
+
+  Particles particles;
+  std::vector<Wall> walls;
+
+  /// Validates parameters, builds the pair table and the neighbour list. Called by step() when
+  /// needed; call it after changing particles, walls or config (or use invalidate()).
+  void initialize();
+  /// Marks particle indices as changed (after adding or removing particles).
+  void invalidate();
+
+  void step();
+  void advance(long long steps);
+
+  [[nodiscard]] double time_s() const { return time_s_; }
+  [[nodiscard]] long long step_count() const { return step_; }
+  [[nodiscard]] const SystemConfig& config() const { return config_; }
+  SystemConfig& mutable_config() { initialized_ = false; return config_; }
+  [[nodiscard]] const StepStats& stats() const { return stats_; }
+  [[nodiscard]] const PairTable& pair_table() const { return pairs_; }
+  [[nodiscard]] const VerletList& neighbor_list() const { return nlist_; }
+  [[nodiscard]] int threads() const;
+
+  /// Translational + rotational kinetic energy.
+  [[nodiscard]] double kinetic_energy_J() const;
+  /// Gravitational potential energy -m g.x, relative to the origin.
+  [[nodiscard]] double potential_energy_J() const;
+  /// Number of contacts of particle i at the last force evaluation (walls included).
+  [[nodiscard]] int contact_count(ParticleIndex i) const;
+  /// Approximate memory held per particle by the engine (state + neighbour list + histories).
+  [[nodiscard]] double bytes_per_particle() const;
+
+  /// Evaluates forces on the current state without advancing (used by integrators and tests).
+  void compute_forces();
+
+ private:
+  SystemConfig config_;
+  PairTable pairs_;
+  VerletList nlist_;
+  std::unique_ptr<Integrator> integrator_;
+  ForceFunction force_fn_ = nullptr;
+  std::vector<ContactHistory> wall_history_;  ///< [particle * walls + wall]
+  std::vector<std::vector<Vec3>> thread_force_, thread_torque_;
+  std::vector<int> contact_count_;
+  StepStats stats_;
+  double time_s_ = 0;
+  long long step_ = 0;
+  bool initialized_ = false;
+  bool have_forces_ = false;
+
+  void check_state();
+  friend struct ForceContextBuilder;
+};
+
+/// Names of the registered contact laws and rolling models (engine/contact/registry.cpp).
+std::vector<std::string> contact_law_names();
+std::vector<std::string> rolling_model_names();
+std::string contact_law_description(const std::string& name);
+std::string rolling_model_description(const std::string& name);
+
+}  // namespace gravsweep

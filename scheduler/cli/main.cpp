@@ -1,0 +1,60 @@
+// `gravsweep`: one binary, one subcommand per verb (see verbs.h). main() only wires them up and
+// turns exceptions into the exit codes of exit_codes.h.
+#include <fmt/format.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+
+#include "engine/core/error.h"
+#include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/verbs.h"
+
+namespace {
+
+using SetupFn = void (*)(CLI::App&);
+// The verb table: one row per verb, in the order `gravsweep --help` lists them.
+constexpr SetupFn kVerbs[] = {
+    &gravsweep::cli::setup_bench,
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace gravsweep;
+  CLI::App app{
+      "gravsweep: campaigns of granular impact simulations (soft-sphere DEM) across gravity levels,\n"
+      "and the comparison of collision models with laboratory measurements.\n\n"
+      "Typical session:\n"
+      "  gravsweep run examples/impact_1g.json --out runs/1g     # one impact, end to end\n"
+      "  gravsweep bench                                         # engine speed on the paper's bed\n\n"
+      "Run `gravsweep <verb> --help` for each verb, with an example.",
+      "gravsweep"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string(GRAVSWEEP_VERSION));
+  for (SetupFn setup : kVerbs) setup(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return cli::kExitUsage;
+  } catch (const cli::UsageError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return cli::kExitUsage;
+  } catch (const ConfigError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return cli::kExitUsage;
+  } catch (const NumericalFailure& e) {
+    std::fprintf(stderr, "numerical failure: %s\n", e.what());
+    return cli::kExitNumerical;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return cli::kExitFailure;
+  }
+  return cli::kExitOk;
+}

@@ -1,0 +1,11 @@
+// One file pair per CLI verb: scheduler/cli/verb_<name>.{h,cpp} defines setup_<name>(CLI::App&),
+// which adds the subcommand, its options, its --help text (with an example) and its callback.
+// The table in main.cpp lists every verb once; adding a verb is one file pair and one row.
+#pragma once
+#include <CLI/CLI.hpp>
+
+namespace gravsweep::cli {
+
+void setup_bench(CLI::App& app);
+
+}  // namespace gravsweep::cli

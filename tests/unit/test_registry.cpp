@@ -1,0 +1,90 @@
+// Registries and set-up validation: unknown names and bad parameters are refused with messages
+// that name the law/model and the parameter.
+#include <gtest/gtest.h>
+
+#include "engine/core/error.h"
+#include "engine/scenario/paper_params.h"
+#include "engine/system/system.h"
+
+using namespace gravsweep;
+
+namespace {
+std::string init_error(SystemConfig cfg, double radius = 0.005) {
+  System s(std::move(cfg));
+  s.particles.add(Vec3::Zero(), radius, 1e-3, 0, SizeClass::grain);
+  try {
+    s.initialize();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(Registry, ListsLawsModelsAndIntegrators) {
+  EXPECT_EQ(contact_law_names(), (std::vector<std::string>{"hertz", "hooke"}));
+  EXPECT_EQ(rolling_model_names(), (std::vector<std::string>{"none", "sunday", "zhang"}));
+  EXPECT_EQ(integrator_table().size(), 3u);
+  EXPECT_FALSE(contact_law_description("hertz").empty());
+}
+
+TEST(Registry, UnknownContactLawListsValidNames) {
+  auto cfg = chrono_table1_config();
+  cfg.contact_law = "hertzz";
+  const std::string msg = init_error(cfg);
+  EXPECT_NE(msg.find("unknown contact law 'hertzz'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("hertz, hooke"), std::string::npos) << msg;
+}
+
+TEST(Registry, UnknownRollingModelAndIntegrator) {
+  auto cfg = chrono_table1_config();
+  cfg.rolling_model = "spring";
+  EXPECT_NE(init_error(cfg).find("valid rolling models: none, sunday, zhang"), std::string::npos);
+  cfg = chrono_table1_config();
+  cfg.integrator = "rk4";
+  EXPECT_NE(init_error(cfg).find("valid integrators: semi_implicit_euler"), std::string::npos);
+}
+
+TEST(Validation, PoissonRatioOutsideRange) {
+  auto cfg = chrono_table1_config();
+  cfg.materials[0].poisson_ratio = 0.5;
+  const std::string msg = init_error(cfg);
+  EXPECT_NE(msg.find("material 'grain'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("poisson_ratio"), std::string::npos) << msg;
+}
+
+TEST(Validation, RestitutionAndModulus) {
+  auto cfg = chrono_table1_config();
+  cfg.materials[1].cor_normal = 1.2;
+  EXPECT_NE(init_error(cfg).find("cor_normal"), std::string::npos);
+  cfg = chrono_table1_config();
+  cfg.materials[0].young_modulus_Pa = 0;
+  EXPECT_NE(init_error(cfg).find("young_modulus_Pa"), std::string::npos);
+  cfg = chrono_table1_config();
+  cfg.materials[0].cor_normal = 0.0;
+  EXPECT_NE(init_error(cfg).find("COR in (0, 1]"), std::string::npos);
+}
+
+TEST(Validation, HertzTimeStepAboveStabilityBound) {
+  auto cfg = chrono_table1_config();
+  cfg.dt_s = 5e-5;  // Rayleigh time of a 5 mm glass bead at 700 MPa is 50.8 us
+  const std::string msg = init_error(cfg);
+  EXPECT_NE(msg.find("contact law 'hertz'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("dt"), std::string::npos) << msg;
+  cfg.dt_s = 1e-5;
+  EXPECT_EQ(init_error(cfg), "");
+}
+
+TEST(Validation, HookeNeedsSpringAndStableStep) {
+  auto cfg = chrono_table1_config();
+  cfg.contact_law = "hooke";
+  cfg.rolling_model = "zhang";
+  std::string msg = init_error(cfg);
+  EXPECT_NE(msg.find("contact law 'hooke': kn_N_m"), std::string::npos) << msg;
+  for (auto& m : cfg.materials) m.kn_N_m = 7.48e5;
+  cfg.dt_s = 5e-7;
+  EXPECT_EQ(init_error(cfg), "");
+  cfg.dt_s = 2e-5;  // grain-grain contact ~93 us -> bound 9.3 us
+  msg = init_error(cfg);
+  EXPECT_NE(msg.find("stability bound"), std::string::npos) << msg;
+}
