@@ -1,0 +1,57 @@
+// A projectile trace and the paper's processing of it (Sunday et al. 2021 Sect. 2.3). The same
+// code processes DEM traces (results of `gravsweep run`) and laboratory accelerometer records.
+//
+// Conventions: depth z positive DOWN, zero at the bed surface; velocity positive down;
+// acceleration as the accelerometer format (shared/formats/measurements.md): the projectile's
+// vertical kinematic acceleration, positive UP, so free fall reads -g and rest reads 0.
+// (Equivalently accel_up = -dv_down/dt.)
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace gravsweep::results {
+
+struct Trace {
+  std::vector<double> t_s;
+  std::vector<double> accel_up_m_s2;
+  /// Optional (DEM traces have them; lab records usually not): same length as t_s when present.
+  std::vector<double> depth_m;
+  std::vector<double> velocity_down_m_s;
+};
+
+struct MetricOptions {
+  double gravity_m_s2 = 9.81;
+  double cutoff_hz = 500.0;            ///< 2nd-order Butterworth low-pass (paper: 500 Hz)
+  int filter_order = 2;
+  double end_threshold_g = 0.1;        ///< collision ends when |a| < 0.1 g (paper)
+  /// Speed at first contact, used to integrate a into v and z when the trace has none.
+  std::optional<double> impact_velocity_m_s;
+  /// For the rebound flag: bed depth and grain diameter (a projectile within one grain of the
+  /// floor has "hit the bottom").
+  std::optional<double> fill_height_m;
+  std::optional<double> grain_diameter_m;
+  double projectile_diameter_m = 0.1;
+};
+
+/// The paper's metrics of one collision.
+struct Metrics {
+  double vc_m_s = 0;         ///< collision velocity (speed at collision start)
+  double apeak_m_s2 = 0;     ///< peak (upward) acceleration of the filtered trace
+  double zstop_m = 0;        ///< penetration depth at collision end
+  double tstop_s = 0;        ///< collision duration (end - start)
+  double t_start_s = 0;      ///< collision start: no longer in free fall
+  double t_end_s = 0;        ///< collision end: acceleration below end_threshold_g after the peak
+  bool rebound = false;      ///< moved up after contact, or came within one grain of the floor
+  std::string note;          ///< why a metric could not be found, if so
+};
+
+/// Zero-phase (forward-backward) Butterworth low-pass of order `order` at `cutoff_hz`.
+std::vector<double> butterworth_lowpass(const std::vector<double>& x, double sample_rate_hz,
+                                        double cutoff_hz, int order = 2);
+
+/// Computes the metrics as the paper does; throws std::invalid_argument with the reason when the
+/// trace is too short, never makes contact or has non-increasing time.
+Metrics compute_metrics(const Trace& trace, const MetricOptions& options);
+
+}  // namespace gravsweep::results
