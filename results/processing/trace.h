@@ -6,6 +6,7 @@
 // vertical kinematic acceleration, positive UP, so free fall reads -g and rest reads 0.
 // (Equivalently accel_up = -dv_down/dt.)
 #pragma once
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
@@ -46,6 +47,22 @@ struct Metrics {
   std::string note;          ///< why a metric could not be found, if so
 };
 
+/// A processed trace: the filtered, bias-corrected acceleration, the velocity and depth (the
+/// trace's own, or integrated from the impact speed) and the metrics.
+struct ProcessedTrace {
+  Metrics metrics;
+  std::vector<double> t_s;
+  std::vector<double> accel_up_m_s2;      ///< filtered, bias removed
+  std::vector<double> velocity_down_m_s;  ///< positive down
+  std::vector<double> depth_m;            ///< positive down, 0 at first contact (integrated case)
+  double sample_rate_hz = 0;
+  double bias_m_s2 = 0;                   ///< removed sensor bias
+  std::size_t free_fall_samples = 0;      ///< samples used for the bias from free fall
+  std::size_t rest_samples = 0;           ///< samples used for the bias from rest
+  std::size_t i_start = 0;                ///< last sample before the collision start
+  std::size_t i_end = 0;                  ///< first sample after the collision end
+};
+
 /// Zero-phase (forward-backward) Butterworth low-pass of order `order` at `cutoff_hz`.
 std::vector<double> butterworth_lowpass(const std::vector<double>& x, double sample_rate_hz,
                                         double cutoff_hz, int order = 2);
@@ -53,5 +70,8 @@ std::vector<double> butterworth_lowpass(const std::vector<double>& x, double sam
 /// Computes the metrics as the paper does; throws std::invalid_argument with the reason when the
 /// trace is too short, never makes contact or has non-increasing time.
 Metrics compute_metrics(const Trace& trace, const MetricOptions& options);
+
+/// The same processing, returning the processed arrays with the metrics (same errors).
+ProcessedTrace process_trace(const Trace& trace, const MetricOptions& options);
 
 }  // namespace gravsweep::results
