@@ -15,6 +15,12 @@ using SetupFn = void (*)(CLI::App&);
 // The verb table: one row per verb, in the order `gravsweep --help` lists them.
 constexpr SetupFn kVerbs[] = {
     &gravsweep::cli::setup_bench,
+    &gravsweep::cli::setup_submit,
+    &gravsweep::cli::setup_work,
+    &gravsweep::cli::setup_status,
+    &gravsweep::cli::setup_resume,
+    &gravsweep::cli::setup_results,
+    &gravsweep::cli::setup_bench_queue,
 };
 
 }  // namespace

@@ -7,5 +7,11 @@
 namespace gravsweep::cli {
 
 void setup_bench(CLI::App& app);
+void setup_submit(CLI::App& app);
+void setup_work(CLI::App& app);
+void setup_status(CLI::App& app);
+void setup_resume(CLI::App& app);
+void setup_results(CLI::App& app);
+void setup_bench_queue(CLI::App& app);
 
 }  // namespace gravsweep::cli

@@ -1,0 +1,163 @@
+// `gravsweep bench-queue`: the scheduler's own overhead with no-op jobs (claim, heartbeat,
+// complete), in jobs per second with 1 and more worker processes, and the time of `status` on a
+// large queue.
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/verbs.h"
+#include "scheduler/queue/queue.h"
+#include "scheduler/queue/spawn.h"
+#include "scheduler/queue/worker.h"
+#include "scheduler/sweep/spec.h"
+
+namespace gravsweep::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+struct BenchQueueOptions {
+  long jobs = 2000;
+  std::vector<int> workers{1, 4};
+  long status_jobs = 100000;
+  std::string dir;
+  bool keep = false;
+};
+
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// A noop sweep of n jobs into a fresh database; returns the submit time.
+double make_campaign(const fs::path& db_path, long n) {
+  nlohmann::json doc = {{"sweep", "bench"},
+                        {"job", "noop"},
+                        {"base", {{"i", 0}}},
+                        {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"range", {{"start", 0}, {"stop", n - 1}, {"step", 1}}}}}}};
+  const auto spec = sweep::parse_spec(doc, "<bench-queue>", ".");
+  const auto jobs = sweep::expand(spec, {});
+  fs::remove(db_path);
+  const auto t0 = Clock::now();
+  db::Database db(db_path.string());
+  queue::ensure_schema(db);
+  queue::submit(db, spec, jobs);
+  return since(t0);
+}
+
+std::int64_t count_done(const fs::path& db_path) {
+  db::Database db(db_path.string());
+  db::Statement st(db, "SELECT count(*) FROM jobs WHERE state='done'");
+  st.step();
+  return st.get_int(0);
+}
+
+void run_bench_queue(const BenchQueueOptions& o) {
+  fs::path dir = o.dir;
+  if (dir.empty()) {
+    std::string tmpl = (fs::temp_directory_path() / "gravsweep-bench-queue-XXXXXX").string();
+    if (!mkdtemp(tmpl.data())) throw std::runtime_error("cannot create a temporary directory");
+    dir = tmpl;
+  }
+  fs::create_directories(dir);
+  const std::string exe = queue::self_exe();
+  fmt::print("scheduler overhead with no-op jobs (each: claim in BEGIN IMMEDIATE, one heartbeat, output file "
+             "written + fsynced + renamed + checksummed, fenced completion with results row)\n\n");
+
+  // 1. In-process latency of each operation (one connection, no contention).
+  {
+    const fs::path db_path = dir / "ops.db";
+    const long n = std::min<long>(o.jobs, 1000);
+    make_campaign(db_path, n);
+    db::Database db(db_path.string());
+    const queue::CampaignPaths paths(db_path);
+    const auto who = queue::make_identity("bench", 1);
+    double t_claim = 0, t_beat = 0, t_done = 0;
+    long k = 0;
+    for (;; ++k) {
+      auto t0 = Clock::now();
+      auto c = queue::claim(db, who, paths, 60);
+      t_claim += since(t0);
+      if (!c) break;
+      t0 = Clock::now();
+      queue::heartbeat(db, *c, 60, 0.5, "noop", "");
+      t_beat += since(t0);
+      queue::Completion done;
+      done.output_rel = c->output_rel;
+      done.sha256 = std::string(64, '0');
+      done.metrics = {{"noop_value", k}};
+      t0 = Clock::now();
+      queue::complete(db, *c, done);
+      t_done += since(t0);
+    }
+    fmt::print("per operation, one process, {} jobs:  claim {:.3f} ms   heartbeat {:.3f} ms   complete {:.3f} ms\n\n", k,
+               1e3 * t_claim / std::max(1L, k), 1e3 * t_beat / std::max(1L, k), 1e3 * t_done / std::max(1L, k));
+  }
+
+  // 2. Worker processes end to end.
+  fmt::print("{:>8} {:>8} {:>10} {:>10} {:>10}\n", "workers", "jobs", "wall_s", "jobs_per_s", "all_done");
+  for (int w : o.workers) {
+    const fs::path db_path = dir / fmt::format("work_{}.db", w);
+    make_campaign(db_path, o.jobs);
+    const auto t0 = Clock::now();
+    const pid_t pid = queue::spawn_process(exe, {"work", "--db", db_path.string(), "--workers", std::to_string(w),
+                                                 "--threads", "1", "--quiet", "--poll", "0.01"});
+    const int code = queue::wait_process(pid);
+    const double wall = since(t0);
+    const auto done = count_done(db_path);
+    fmt::print("{:>8} {:>8} {:>10.2f} {:>10.0f} {:>10}\n", w, o.jobs, wall, static_cast<double>(done) / wall,
+               done == o.jobs && code == 0 ? "yes" : fmt::format("NO ({} done, exit {})", done, code));
+  }
+
+  // 3. status on a large queue.
+  {
+    const fs::path db_path = dir / "status.db";
+    const double submit_s = make_campaign(db_path, o.status_jobs);
+    db::Database db(db_path.string());
+    double best = 1e9;
+    for (int i = 0; i < 5; ++i) {
+      const auto t0 = Clock::now();
+      const auto s = queue::status(db);
+      best = std::min(best, since(t0));
+      if (s.per_sweep.empty()) throw std::runtime_error("bench-queue: status saw no jobs");
+    }
+    const auto t0 = Clock::now();
+    const pid_t pid = queue::spawn_process(exe, {"status", "--db", db_path.string()}, true);
+    const int code = queue::wait_process(pid);
+    const double cli_s = since(t0);
+    fmt::print("\n{} queued jobs: submit {:.2f} s ({:.0f} jobs/s); status query {:.1f} ms (best of 5); "
+               "`gravsweep status` process {:.1f} ms (exit {})\n",
+               o.status_jobs, submit_s, static_cast<double>(o.status_jobs) / submit_s, 1e3 * best, 1e3 * cli_s, code);
+  }
+  if (!o.keep && o.dir.empty()) fs::remove_all(dir);
+  else fmt::print("databases kept in {}\n", dir.string());
+}
+
+}  // namespace
+
+void setup_bench_queue(CLI::App& app) {
+  auto opt = std::make_shared<BenchQueueOptions>();
+  auto* sub = app.add_subcommand(
+      "bench-queue",
+      "Measure the scheduler's own overhead with no-op jobs: the latency of claim, heartbeat and\n"
+      "complete in one process, jobs per second with worker processes (each job is claimed, heartbeated,\n"
+      "writes and fsyncs a small output, and is completed with its checksum and results row), and\n"
+      "the time of `gravsweep status` on a queue of --status-jobs jobs. Uses fresh databases in a\n"
+      "temporary directory.\n\n"
+      "Examples:\n"
+      "  gravsweep bench-queue                              # 2000 jobs, 1 and 4 workers, status on 100,000\n"
+      "  gravsweep bench-queue --jobs 500 --workers 1,2,4 --status-jobs 20000");
+  sub->add_option("--jobs", opt->jobs, "no-op jobs per worker count")->check(CLI::Range(1L, 10000000L))->capture_default_str();
+  sub->add_option("--workers", opt->workers, "worker counts, comma separated")->delimiter(',')->capture_default_str();
+  sub->add_option("--status-jobs", opt->status_jobs, "queued jobs for the status timing")->check(CLI::Range(1L, 10000000L))->capture_default_str();
+  sub->add_option("--dir", opt->dir, "directory for the databases (kept)");
+  sub->add_flag("--keep", opt->keep, "keep the temporary databases");
+  sub->callback([opt]() { run_bench_queue(*opt); });
+}
+
+}  // namespace gravsweep::cli

@@ -1,0 +1,156 @@
+// `gravsweep status`: per-state counts per sweep, running jobs with progress, stale leases, ETA.
+#include <fmt/format.h>
+
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/progress.h"
+#include "scheduler/cli/verbs.h"
+#include "scheduler/queue/queue.h"
+#include "scheduler/queue/table.h"
+#include "scheduler/queue/worker.h"
+
+namespace gravsweep::cli {
+
+namespace {
+
+struct StatusOptions {
+  std::string db = "campaign.db";
+  std::string format = "table";
+  int max_running = 20;
+  double watch_s = 0;
+};
+
+std::string render_status(const queue::Status& s, const std::string& db, double query_s) {
+  std::string out;
+  std::int64_t total = 0;
+  queue::StateCounts all;
+  queue::TextTable t;
+  t.header = {"sweep", "kind", "waiting", "queued", "running", "failed", "done", "dead", "total"};
+  for (const auto& c : s.per_sweep) {
+    t.rows.push_back({c.sweep, c.kind, std::to_string(c.waiting), std::to_string(c.queued), std::to_string(c.running),
+                      std::to_string(c.failed), std::to_string(c.done), std::to_string(c.dead),
+                      std::to_string(c.total())});
+    total += c.total();
+    all.waiting += c.waiting, all.queued += c.queued, all.running += c.running, all.failed += c.failed;
+    all.done += c.done, all.dead += c.dead;
+  }
+  out += fmt::format("campaign {}: {} job memberships; {} done, {} dead, {} running, {} to run\n\n", db, total,
+                     all.done, all.dead, all.running, all.waiting + all.queued + all.failed);
+  out += queue::render_table(t);
+  const double now = queue::now_s();
+  if (!s.running.empty()) {
+    queue::TextTable r;
+    r.header = {"job_id", "kind", "attempt", "worker", "phase", "progress_pct", "elapsed_s", "heartbeat_age_s",
+                "lease_left_s", "detail"};
+    for (const auto& j : s.running)
+      r.rows.push_back({j.job_id, j.kind, std::to_string(j.attempt), j.owner, j.phase,
+                        fmt::format("{:.1f}", 100 * j.progress), fmt::format("{:.1f}", now - j.started_at),
+                        fmt::format("{:.1f}", now - j.heartbeat_at),
+                        j.stale ? "STALE" : fmt::format("{:.1f}", j.lease_expires - now), j.detail});
+    out += fmt::format("\nrunning jobs ({} active, {} stale lease{}):\n", s.active_workers, s.stale_leases,
+                       s.stale_leases == 1 ? "" : "s");
+    out += queue::render_table(r);
+  }
+  if (s.stale_leases > 0)
+    out += fmt::format("\n{} stale lease(s): their workers stopped heartbeating; the next claim or `gravsweep resume` "
+                       "requeues them.\n",
+                       s.stale_leases);
+  if (!s.runtimes.empty()) {
+    queue::TextTable k;
+    k.header = {"kind", "finished", "median_runtime_s", "remaining"};
+    for (const auto& r : s.runtimes)
+      k.rows.push_back({r.kind, std::to_string(r.finished), r.finished ? fmt::format("{:.2f}", r.median_s) : "-",
+                        std::to_string(r.remaining)});
+    out += "\nruntimes by kind:\n" + queue::render_table(k);
+  }
+  if (all.waiting + all.queued + all.failed + all.running > 0) {
+    out += s.eta_s >= 0 ? fmt::format("\nETA {} with {} active worker(s) (median runtime of finished jobs of each kind)\n",
+                                      format_duration(s.eta_s), std::max<std::int64_t>(1, s.active_workers))
+                        : "\nETA unknown: no job of some remaining kind has finished yet\n";
+  }
+  if (s.blocked > 0) out += fmt::format("{} job(s) dead because a bed they need is dead\n", s.blocked);
+  if (!s.recent_errors.empty()) {
+    out += "\ndead jobs (latest):\n";
+    for (const auto& [id, err] : s.recent_errors) out += fmt::format("  {}  {}\n", id, err.substr(0, 160));
+  }
+  out += fmt::format("\n(status query {:.1f} ms)\n", 1000 * query_s);
+  return out;
+}
+
+nlohmann::json status_json(const queue::Status& s) {
+  using nlohmann::json;
+  json j;
+  j["sweeps"] = json::array();
+  for (const auto& c : s.per_sweep)
+    j["sweeps"].push_back({{"sweep", c.sweep}, {"kind", c.kind}, {"waiting", c.waiting}, {"queued", c.queued},
+                           {"running", c.running}, {"failed", c.failed}, {"done", c.done}, {"dead", c.dead}});
+  j["running"] = json::array();
+  for (const auto& r : s.running)
+    j["running"].push_back({{"job_id", r.job_id}, {"kind", r.kind}, {"attempt", r.attempt}, {"worker", r.owner},
+                            {"phase", r.phase}, {"progress", r.progress}, {"detail", r.detail},
+                            {"started_at", r.started_at}, {"heartbeat_at", r.heartbeat_at},
+                            {"lease_expires", r.lease_expires}, {"stale", r.stale}});
+  j["stale_leases"] = s.stale_leases;
+  j["active_workers"] = s.active_workers;
+  j["eta_s"] = s.eta_s >= 0 ? json(s.eta_s) : json(nullptr);
+  j["runtimes"] = json::array();
+  for (const auto& r : s.runtimes)
+    j["runtimes"].push_back({{"kind", r.kind}, {"finished", r.finished}, {"median_runtime_s", r.median_s},
+                             {"remaining", r.remaining}});
+  j["dead_recent"] = json::array();
+  for (const auto& [id, err] : s.recent_errors) j["dead_recent"].push_back({{"job_id", id}, {"error", err}});
+  return j;
+}
+
+void run_status(const StatusOptions& o) {
+  if (!std::filesystem::exists(o.db)) throw UsageError(fmt::format("--db: no campaign database at '{}'", o.db));
+  db::Database db(o.db);
+  queue::ensure_schema(db);
+  if (o.watch_s > 0) queue::install_stop_signals();
+  do {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto s = queue::status(db, static_cast<std::size_t>(o.max_running));
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (o.format == "json") {
+      auto j = status_json(s);
+      j["query_s"] = secs;
+      fmt::print("{}\n", j.dump(2));
+    } else {
+      if (o.watch_s > 0) fmt::print("\x1b[H\x1b[2J");
+      fmt::print("{}", render_status(s, o.db, secs));
+    }
+    std::fflush(stdout);
+    if (o.watch_s <= 0) break;
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.watch_s);
+    while (!queue::stop_requested().load() && std::chrono::steady_clock::now() < until)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  } while (!queue::stop_requested().load());
+}
+
+}  // namespace
+
+void setup_status(CLI::App& app) {
+  auto opt = std::make_shared<StatusOptions>();
+  auto* sub = app.add_subcommand(
+      "status",
+      "Show a campaign: job counts per state for each sweep and kind, running jobs with their\n"
+      "progress and lease, stale leases (workers that stopped heartbeating), median runtimes and an\n"
+      "ETA (remaining jobs x median runtime of finished jobs of the same kind / active workers).\n"
+      "Counts come from indexed queries: fast on 100,000 jobs.\n\n"
+      "Examples:\n"
+      "  gravsweep status --db campaign.db\n"
+      "  gravsweep status --db campaign.db --watch 2        # refresh every 2 s\n"
+      "  gravsweep status --db campaign.db --format json");
+  sub->add_option("--db", opt->db, "campaign database")->capture_default_str();
+  sub->add_option("--format", opt->format, "table or json")->check(CLI::IsMember({"table", "json"}))->capture_default_str();
+  sub->add_option("--max-running", opt->max_running, "running jobs listed at most")->capture_default_str();
+  sub->add_option("--watch", opt->watch_s, "refresh every this many seconds (0: once)")->capture_default_str();
+  sub->callback([opt]() { run_status(*opt); });
+}
+
+}  // namespace gravsweep::cli

@@ -1,0 +1,176 @@
+// `gravsweep work`: worker processes that claim and run jobs until none is left.
+#include <fmt/format.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/verbs.h"
+#include "scheduler/queue/impact.h"
+#include "scheduler/queue/queue.h"
+#include "scheduler/queue/spawn.h"
+#include "scheduler/queue/worker.h"
+
+namespace gravsweep::cli {
+
+namespace {
+
+struct WorkOptions {
+  std::string db = "campaign.db";
+  int workers = 1;
+  int threads = 0;
+  bool follow = false;
+  double lease_s = 60;
+  double heartbeat_s = 0;
+  double poll_s = 0.5;
+  double backoff_s = 2.0;
+  long max_jobs = -1;
+  bool quiet = false;
+};
+
+/// Exit code after the workers stopped: 4 when some job is dead.
+int final_code(const std::string& db_path) {
+  db::Database db(db_path);
+  db::Statement st(db, "SELECT count(*) FROM jobs WHERE state='dead'");
+  st.step();
+  return st.get_int(0) > 0 ? kExitIncomplete : kExitOk;
+}
+
+int supervise(const WorkOptions& o, int threads) {
+  // Children are this binary again with --workers 1: each opens its own connection after exec.
+  std::vector<std::string> args = {"work", "--db", o.db, "--workers", "1", "--threads", std::to_string(threads),
+                                   "--lease", fmt::format("{}", o.lease_s), "--poll", fmt::format("{}", o.poll_s),
+                                   "--backoff", fmt::format("{}", o.backoff_s)};
+  if (o.heartbeat_s > 0) args.insert(args.end(), {"--heartbeat", fmt::format("{}", o.heartbeat_s)});
+  if (o.follow) args.push_back("--follow");
+  if (o.quiet) args.push_back("--quiet");
+  if (o.max_jobs >= 0) args.insert(args.end(), {"--max-jobs", std::to_string(o.max_jobs)});
+  // Block SIGINT/SIGTERM here while forking; the supervisor forwards them to the children.
+  sigset_t set, old;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  sigprocmask(SIG_BLOCK, &set, &old);
+  const std::string exe = queue::self_exe();
+  std::vector<pid_t> kids;
+  for (int i = 0; i < o.workers; ++i) {
+    pid_t pid = fork();
+    if (pid < 0) throw std::runtime_error("fork failed");
+    if (pid == 0) {
+      sigprocmask(SIG_SETMASK, &old, nullptr);
+      std::vector<char*> argv{const_cast<char*>(exe.c_str())};
+      for (auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+      argv.push_back(nullptr);
+      execv(exe.c_str(), argv.data());
+      _exit(127);
+    }
+    kids.push_back(pid);
+  }
+  if (!o.quiet)
+    fmt::print(stderr, "gravsweep work: {} worker processes ({} threads each) on {}\n", o.workers, threads, o.db);
+  bool interrupted = false;
+  int failures = 0;
+  std::size_t alive = kids.size();
+  while (alive > 0) {
+    // Wait for a child or a signal, whichever comes first.
+    int sig = 0;
+    timespec ts{0, 200'000'000};
+    siginfo_t info{};
+    sig = sigtimedwait(&set, &info, &ts);
+    if (sig == SIGINT || sig == SIGTERM) {
+      interrupted = true;
+      for (pid_t k : kids)
+        if (k > 0) kill(k, SIGTERM);
+    }
+    int status = 0;
+    pid_t done;
+    while ((done = waitpid(-1, &status, WNOHANG)) > 0) {
+      for (auto& k : kids) {
+        if (k != done) continue;
+        k = -1;
+        --alive;
+        const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        if (code == kExitInterrupted) interrupted = true;
+        else if (code != kExitOk && code != kExitIncomplete) {
+          ++failures;
+          fmt::print(stderr, "gravsweep work: worker {} exited with code {}\n", done, code);
+        }
+      }
+    }
+  }
+  sigprocmask(SIG_SETMASK, &old, nullptr);
+  if (interrupted) return kExitInterrupted;
+  if (failures > 0) return kExitFailure;
+  return final_code(o.db);
+}
+
+int run_work(const WorkOptions& o) {
+  if (!std::filesystem::exists(o.db)) throw UsageError(fmt::format("--db: no campaign database at '{}' (run `gravsweep submit` first)", o.db));
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads = o.threads > 0 ? o.threads : std::max(1, cores / std::max(1, o.workers));
+  if (o.workers > 1) return supervise(o, threads);
+  queue::install_stop_signals();
+  queue::WorkerOptions w;
+  w.db_path = o.db;
+  w.threads = threads;
+  w.lease_s = o.lease_s;
+  w.heartbeat_s = o.heartbeat_s;
+  w.follow = o.follow;
+  w.poll_s = o.poll_s;
+  w.max_jobs = o.max_jobs;
+  w.backoff_base_s = o.backoff_s;
+  w.code_version = GRAVSWEEP_VERSION;
+  w.verbose = !o.quiet;
+  const auto rep = queue::run_worker(w, queue::all_runners());
+  if (!o.quiet)
+    fmt::print(stderr, "worker {}: {} done, {} failed (will retry), {} dead, {} released, {} fenced out, {} expired leases reclaimed\n",
+               getpid(), rep.done, rep.failed, rep.dead, rep.released, rep.fenced_out, rep.reclaimed);
+  if (rep.interrupted) return kExitInterrupted;
+  return final_code(o.db);
+}
+
+}  // namespace
+
+void setup_work(CLI::App& app) {
+  auto opt = std::make_shared<WorkOptions>();
+  auto* sub = app.add_subcommand(
+      "work",
+      "Run the campaign's jobs: starts --workers worker processes (one SQLite connection each) that\n"
+      "claim jobs (bed preparation before the drops that need it), renew their lease with a\n"
+      "heartbeat carrying progress, and record each result with its trace path and checksum. They\n"
+      "stop when no job is left (--follow: keep waiting for new ones). A worker killed in any way\n"
+      "loses its lease after --lease seconds and another worker takes the job over. SIGINT/SIGTERM\n"
+      "stop the current job and give its lease back (exit 130). Exit 4 if some job is dead.\n\n"
+      "Examples:\n"
+      "  gravsweep work --db campaign.db --workers 2 --threads 1\n"
+      "  gravsweep work --db campaign.db --follow          # a worker that waits for new submissions");
+  sub->add_option("--db", opt->db, "campaign database")->capture_default_str();
+  sub->add_option("--workers", opt->workers, "worker processes")->check(CLI::Range(1, 256))->capture_default_str();
+  sub->add_option("--threads", opt->threads, "engine threads per worker (0: cores / workers)")->check(CLI::Range(0, 1024))->capture_default_str();
+  sub->add_flag("--follow", opt->follow, "keep waiting for new jobs when none is left");
+  sub->add_option("--lease", opt->lease_s, "lease length, s (renewed every lease/4)")->check(CLI::Range(0.5, 86400.0))->capture_default_str();
+  sub->add_option("--heartbeat", opt->heartbeat_s, "heartbeat interval, s (0: lease/4)")->check(CLI::Range(0.0, 3600.0))->capture_default_str();
+  sub->add_option("--poll", opt->poll_s, "wait between claims when nothing is runnable, s")->check(CLI::Range(0.01, 60.0))->capture_default_str();
+  sub->add_option("--backoff", opt->backoff_s, "retry backoff base, s (base * 2^(attempt-1), capped at 300 s)")->check(CLI::Range(0.0, 3600.0))->capture_default_str();
+  sub->add_option("--max-jobs", opt->max_jobs, "stop after this many jobs per worker (-1: no limit)")->capture_default_str();
+  sub->add_flag("--quiet", opt->quiet, "no per-job log lines");
+  sub->callback([opt]() {
+    const int code = run_work(*opt);
+    // main() maps exceptions to 0/1/2/3 only: the worker's own codes (4, 130) leave from here,
+    // after every database handle has been closed by run_work's scopes.
+    if (code != kExitOk) {
+      std::fflush(nullptr);
+      std::exit(code);
+    }
+  });
+}
+
+}  // namespace gravsweep::cli

@@ -1,0 +1,178 @@
+#include "scheduler/queue/filter.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+
+#include "scheduler/queue/queue.h"
+
+namespace gravsweep::queue {
+
+using nlohmann::json;
+
+namespace {
+
+struct Lexer {
+  const std::string& s;
+  std::size_t i = 0;
+  void skip() {
+    while (i < s.size() && std::isspace(static_cast<unsigned char>(s[i]))) ++i;
+  }
+  [[noreturn]] void fail(const std::string& expected) const {
+    const std::string found = i < s.size() ? fmt::format("'{}'", s.substr(i, 20)) : "the end";
+    throw std::invalid_argument(
+        fmt::format("--where '{}': at character {}: found {}, expected {}", s, i + 1, found, expected));
+  }
+  std::string ident() {
+    skip();
+    const std::size_t b = i;
+    while (i < s.size() && (std::isalnum(static_cast<unsigned char>(s[i])) || s[i] == '_')) ++i;
+    if (b == i || std::isdigit(static_cast<unsigned char>(s[b]))) {
+      i = b;
+      fail("a column name");
+    }
+    return s.substr(b, i - b);
+  }
+  std::string op() {
+    skip();
+    for (const char* o : {"<=", ">=", "==", "!=", "<>", "<", ">", "=", "~"}) {
+      const std::size_t n = std::char_traits<char>::length(o);
+      if (s.compare(i, n, o) == 0) {
+        i += n;
+        std::string r = o;
+        if (r == "==") r = "=";
+        if (r == "<>") r = "!=";
+        return r;
+      }
+    }
+    fail("an operator (< <= > >= = != ~)");
+  }
+  json value() {
+    skip();
+    if (i >= s.size()) fail("a value");
+    if (s[i] == '\'' || s[i] == '"') {
+      const char q = s[i++];
+      std::string out;
+      while (i < s.size() && s[i] != q) out.push_back(s[i++]);
+      if (i >= s.size()) fail(fmt::format("a closing {}", q));
+      ++i;
+      return out;
+    }
+    const std::size_t b = i;
+    while (i < s.size() && !std::isspace(static_cast<unsigned char>(s[i])) && s[i] != ',' && s[i] != '&') ++i;
+    const std::string word = s.substr(b, i - b);
+    if (word == "true") return true;
+    if (word == "false") return false;
+    char* end = nullptr;
+    const double d = std::strtod(word.c_str(), &end);
+    if (end && *end == '\0' && !word.empty()) {
+      if (word.find_first_of(".eE") == std::string::npos && std::abs(d) < 9e15) return static_cast<std::int64_t>(d);
+      return d;
+    }
+    return word;  // bare word: text
+  }
+  bool connector() {
+    skip();
+    if (i >= s.size()) return false;
+    if (s[i] == ',') {
+      ++i;
+      return true;
+    }
+    if (s.compare(i, 2, "&&") == 0) {
+      i += 2;
+      return true;
+    }
+    if (i + 3 <= s.size() && (s.compare(i, 3, "and") == 0 || s.compare(i, 3, "AND") == 0) &&
+        (i + 3 == s.size() || std::isspace(static_cast<unsigned char>(s[i + 3])))) {
+      i += 3;
+      return true;
+    }
+    fail("'and', ',' or the end of the filter");
+  }
+};
+
+std::string quote_ident(const std::string& n) { return "\"" + n + "\""; }
+
+}  // namespace
+
+std::vector<Condition> parse_where(const std::string& expr) {
+  Lexer lx{expr};
+  std::vector<Condition> out;
+  do {
+    Condition c;
+    c.column = lx.ident();
+    c.op = lx.op();
+    c.value = lx.value();
+    if (c.op == "~" && !c.value.is_string()) c.value = c.value.dump();
+    out.push_back(std::move(c));
+  } while (lx.connector());
+  return out;
+}
+
+ResultsTable query_results(db::Database& db, const ResultsQuery& q) {
+  const std::vector<std::string> all = result_columns(db);
+  auto check = [&](const std::string& col, const std::string& where) {
+    if (std::find(all.begin(), all.end(), col) == all.end()) {
+      std::string list;
+      for (const auto& a : all) list += (list.empty() ? "" : ", ") + a;
+      throw std::invalid_argument(fmt::format("{}: found column '{}', expected one of: {}", where, col, list));
+    }
+  };
+  ResultsTable t;
+  t.columns = q.columns.empty() ? all : q.columns;
+  for (const auto& c : t.columns) check(c, "--columns");
+  std::string sql = "SELECT ";
+  for (std::size_t i = 0; i < t.columns.size(); ++i) sql += (i ? ", " : "") + quote_ident(t.columns[i]);
+  sql += " FROM results";
+  std::vector<json> binds;
+  std::vector<std::string> clauses;
+  if (!q.sweep.empty()) {
+    clauses.push_back("sweep = ?");
+    binds.push_back(q.sweep);
+  }
+  for (const auto& w : q.where) {
+    for (const auto& c : parse_where(w)) {
+      check(c.column, fmt::format("--where '{}'", w));
+      if (c.op == "~") {
+        clauses.push_back(fmt::format("instr({}, ?) > 0", quote_ident(c.column)));
+      } else {
+        clauses.push_back(fmt::format("{} {} ?", quote_ident(c.column), c.op));  // op from a fixed list
+      }
+      binds.push_back(c.value);
+    }
+  }
+  for (std::size_t i = 0; i < clauses.size(); ++i) sql += (i ? " AND " : " WHERE ") + clauses[i];
+  if (!q.order_by.empty()) {
+    check(q.order_by, "--sort");
+    sql += " ORDER BY " + quote_ident(q.order_by);
+  } else {
+    sql += " ORDER BY sweep, rowid";
+  }
+  if (q.limit >= 0) sql += " LIMIT " + std::to_string(q.limit);  // an integer, not user text
+  db::Statement st(db, sql);
+  for (std::size_t i = 0; i < binds.size(); ++i) {
+    const json& v = binds[i];
+    const int idx = static_cast<int>(i + 1);
+    if (v.is_boolean()) st.bind(idx, static_cast<std::int64_t>(v.get<bool>()));
+    else if (v.is_number_integer()) st.bind(idx, v.get<std::int64_t>());
+    else if (v.is_number()) st.bind(idx, v.get<double>());
+    else st.bind(idx, v.get<std::string>());
+  }
+  while (st.step()) {
+    std::vector<json> row;
+    for (int c = 0; c < st.columns(); ++c) {
+      switch (st.column_type(c)) {
+        case SQLITE_NULL: row.emplace_back(nullptr); break;
+        case SQLITE_INTEGER: row.emplace_back(st.get_int(c)); break;
+        case SQLITE_FLOAT: row.emplace_back(st.get_double(c)); break;
+        default: row.emplace_back(st.get_text(c));
+      }
+    }
+    t.rows.push_back(std::move(row));
+  }
+  return t;
+}
+
+}  // namespace gravsweep::queue

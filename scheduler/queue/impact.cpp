@@ -1,0 +1,56 @@
+#include "scheduler/queue/impact.h"
+
+#include <fmt/format.h>
+
+#if __has_include("scheduler/pipeline/impact_job.h")
+#include "scheduler/pipeline/impact_job.h"
+#define GRAVSWEEP_HAVE_PIPELINE 1
+#else
+#define GRAVSWEEP_HAVE_PIPELINE 0
+#endif
+
+namespace gravsweep::queue {
+
+bool impact_available() { return GRAVSWEEP_HAVE_PIPELINE != 0; }
+
+sweep::BedKeyFn impact_bed_key() {
+#if GRAVSWEEP_HAVE_PIPELINE
+  return [](const nlohmann::json& scenario) { return pipeline::bed_key(scenario); };
+#else
+  return {};
+#endif
+}
+
+void add_impact_runners(RunnerTable& table) {
+#if GRAVSWEEP_HAVE_PIPELINE
+  table["bed"] = [](const RunContext& ctx) {
+    auto r = pipeline::run_bed_job(ctx.claim.scenario, ctx.output_tmp, ctx.threads, ctx.progress, ctx.stop);
+    if (r.bed_path != ctx.output_tmp && !r.bed_path.empty()) std::filesystem::rename(r.bed_path, ctx.output_tmp);
+    RunOutput out;
+    out.report = r.report;
+    return out;
+  };
+  table["drop"] = [](const RunContext& ctx) {
+    if (ctx.bed_path.empty())
+      throw std::runtime_error(fmt::format("drop job {} has no prepared bed", ctx.claim.job_id));
+    auto r = pipeline::run_drop_job(ctx.claim.scenario, ctx.bed_path, ctx.output_tmp, ctx.threads, ctx.progress,
+                                    ctx.stop);
+    if (r.trace_path != ctx.output_tmp && !r.trace_path.empty())
+      std::filesystem::rename(r.trace_path, ctx.output_tmp);
+    RunOutput out;
+    out.metrics = r.metrics;
+    return out;
+  };
+#else
+  (void)table;
+#endif
+}
+
+RunnerTable all_runners() {
+  RunnerTable t;
+  t["noop"] = noop_runner();
+  add_impact_runners(t);
+  return t;
+}
+
+}  // namespace gravsweep::queue

@@ -1,0 +1,171 @@
+// The job queue on SQLite (see shared/reference/job-queue.md): jobs with content-addressed ids,
+// dependencies (drop jobs wait for their bed job), claims in BEGIN IMMEDIATE with UPDATE ...
+// RETURNING, leases renewed by heartbeats that carry progress, completion fenced by the lease
+// token, retries with exponential backoff, a `dead` state after max_attempts, one attempts row per
+// try, and a results table with one column per swept parameter and per metric.
+//
+// Job states: waiting (dependencies not done) -> queued -> running -> done
+//                                                         \-> failed (backoff) -> running ...
+//                                                         \-> dead (budget spent / permanent error)
+// Every function opens and commits its own short transaction; none is held while a job runs.
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "scheduler/db/sqlite.h"
+#include "scheduler/sweep/spec.h"
+
+namespace gravsweep::queue {
+
+inline constexpr int kSchemaVersion = 1;
+
+/// Wall-clock seconds since the Unix epoch.
+double now_s();
+
+/// Creates the queue tables if missing (idempotent); checks the schema version.
+void ensure_schema(db::Database& db);
+
+/// Where a campaign keeps its files: <db dir>/<db stem>.files/{beds,traces,noop,tmp}.
+struct CampaignPaths {
+  std::filesystem::path db_dir;  ///< paths in the database are relative to this
+  std::filesystem::path root;
+  explicit CampaignPaths(const std::filesystem::path& db_path);
+  [[nodiscard]] std::filesystem::path tmp() const { return root / "tmp"; }
+  /// Relative path of the output of attempt `attempt` of job `job_id` of `kind`.
+  [[nodiscard]] std::string output_rel(const std::string& kind, const std::string& job_id, int attempt) const;
+  [[nodiscard]] std::filesystem::path abs(const std::string& rel) const { return db_dir / rel; }
+};
+
+// ---- submit ---------------------------------------------------------------------------------
+struct SubmitReport {
+  std::string sweep;
+  std::size_t planned = 0;       ///< jobs in the expanded spec
+  std::size_t added = 0;         ///< new jobs written
+  std::size_t present = 0;       ///< already in the campaign (same content hash)
+  std::size_t beds_added = 0;
+  std::size_t drops_added = 0;
+  bool sweep_new = false;
+};
+
+/// Writes the sweep and its jobs in one transaction: INSERT ... ON CONFLICT DO NOTHING, so a
+/// second submit of the same spec adds nothing and an extended axis adds only the new points.
+SubmitReport submit(db::Database& db, const sweep::SweepSpec& spec, const std::vector<sweep::PlannedJob>& jobs);
+
+// ---- workers --------------------------------------------------------------------------------
+struct WorkerIdentity {
+  std::string owner;  ///< unique per worker process: host:pid:start
+  std::string host;
+  int pid = 0;
+  std::string code_version;
+  int threads = 1;
+};
+WorkerIdentity make_identity(const std::string& code_version, int threads);
+
+struct Claim {
+  std::string job_id, kind, sweep_id;
+  nlohmann::json scenario, params;
+  int attempt = 0;                 ///< 1-based attempt number of this claim
+  std::int64_t token = 0;          ///< fencing token
+  std::int64_t attempt_row = 0;    ///< attempts.attempt_id
+  std::string output_rel;          ///< where this attempt's output must end up
+  std::string dep_output_rel;      ///< the bed file (drop jobs)
+  double claimed_at = 0;
+};
+
+/// Files of attempts whose lease expired, found by claim()/resume(): the caller deletes them after
+/// the transaction committed.
+struct Reclaimed {
+  std::vector<std::string> output_rels;  ///< planned outputs of lost attempts
+  std::vector<std::string> job_prefixes; ///< "<job>.a<k>" for temp files in tmp/
+  int lost = 0;                          ///< expired leases found
+  int dead = 0;                          ///< of which went dead (budget spent)
+};
+
+/// Claims one runnable job: first an expired lease (its attempt is closed as `lost`), then the
+/// highest-priority queued job, then a failed job whose backoff has passed. nullopt when none.
+std::optional<Claim> claim(db::Database& db, const WorkerIdentity& who, const CampaignPaths& paths,
+                           double lease_s, Reclaimed* reclaimed = nullptr);
+
+/// Renews the lease and records progress; false when the lease is no longer ours (stop the job).
+bool heartbeat(db::Database& db, const Claim& c, double lease_s, double fraction, const std::string& phase,
+               const std::string& detail);
+
+struct Completion {
+  std::string output_rel;
+  std::string sha256;
+  std::int64_t bytes = 0;
+  nlohmann::json metrics = nlohmann::json::object();  ///< flat {name_with_units: value}
+  nlohmann::json report = nlohmann::json::object();   ///< free-form, kept in attempts.report_json
+};
+/// Marks the job done (fenced), records output path and checksum, closes the attempt, writes the
+/// results row and releases the dependents, all in one transaction. false = fenced out.
+bool complete(db::Database& db, const Claim& c, const Completion& done);
+
+/// Records a failed attempt: `failed` with backoff (base * 2^(attempt-1), capped, with jitter)
+/// while attempts remain, else `dead`; permanent errors go `dead` at once. Returns the new state,
+/// or "" when fenced out.
+std::string fail(db::Database& db, const Claim& c, const std::string& error, int exit_code, bool permanent,
+                 double backoff_base_s = 2.0, double backoff_cap_s = 300.0);
+
+/// Gives the job back (interrupted worker): queued again, the attempt not counted. false = fenced out.
+bool release(db::Database& db, const Claim& c, const std::string& why);
+
+/// True while some job may still become runnable (queued, waiting, failed, running).
+bool work_remains(db::Database& db);
+
+// ---- resume -----------------------------------------------------------------------------------
+struct ResumeOptions {
+  bool retry_dead = false;     ///< also requeue dead jobs with `extra_attempts` more tries
+  int extra_attempts = 1;
+  bool remove_orphans = true;  ///< delete campaign files no job or live attempt refers to
+  bool dry_run = false;
+};
+struct ResumeReport {
+  int expired_requeued = 0, expired_dead = 0, failed_requeued = 0, dead_requeued = 0;
+  std::vector<std::string> orphans;  ///< relative paths found (removed unless dry_run)
+};
+ResumeReport resume(db::Database& db, const CampaignPaths& paths, const ResumeOptions& o);
+
+/// Deletes files of lost attempts (ignores missing files).
+void remove_lost_files(const CampaignPaths& paths, const Reclaimed& r);
+
+// ---- status ---------------------------------------------------------------------------------
+struct StateCounts {
+  std::string sweep, kind;
+  std::int64_t waiting = 0, queued = 0, running = 0, failed = 0, done = 0, dead = 0;
+  [[nodiscard]] std::int64_t total() const { return waiting + queued + running + failed + done + dead; }
+};
+struct RunningJob {
+  std::string job_id, kind, owner, phase, detail;
+  double progress = 0, started_at = 0, heartbeat_at = 0, lease_expires = 0;
+  int attempt = 0;
+  bool stale = false;
+};
+struct KindRuntime {
+  std::string kind;
+  std::int64_t finished = 0;
+  double median_s = 0;
+  std::int64_t remaining = 0;
+};
+struct Status {
+  std::vector<StateCounts> per_sweep;
+  std::vector<RunningJob> running;
+  std::vector<KindRuntime> runtimes;
+  std::int64_t stale_leases = 0;
+  std::int64_t blocked = 0;       ///< waiting on a dead dependency
+  std::int64_t active_workers = 0;
+  double eta_s = -1;              ///< < 0: unknown (no finished job of some remaining kind)
+  std::vector<std::pair<std::string, std::string>> recent_errors;  ///< (job_id, error) of dead jobs
+};
+Status status(db::Database& db, std::size_t max_running = 20);
+
+// ---- results ----------------------------------------------------------------------------------
+/// Column names of the results table, in display order (fixed, parameters, metrics).
+std::vector<std::string> result_columns(db::Database& db);
+
+}  // namespace gravsweep::queue

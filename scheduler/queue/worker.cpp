@@ -1,0 +1,286 @@
+#include "scheduler/queue/worker.h"
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <mutex>
+#include <thread>
+
+#include "engine/core/error.h"
+#include "scheduler/sweep/canonical.h"
+
+namespace gravsweep::queue {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+
+extern "C" void on_stop_signal(int) { g_stop.store(true); }
+
+void sleep_interruptible(double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (!g_stop.load() && std::chrono::steady_clock::now() < end)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+}
+
+/// Shared between the job and its heartbeat thread.
+struct JobSignals {
+  std::mutex m;
+  std::condition_variable cv;
+  bool finished = false;
+  std::string phase = "started", detail;
+  double fraction = 0;
+  std::atomic<bool> stop{false};        // tells the runner to end early
+  std::atomic<bool> lease_lost{false};
+};
+
+void heartbeat_loop(const WorkerOptions& o, const Claim& c, JobSignals& sig, double interval_s) {
+  std::unique_ptr<db::Database> db;
+  auto next = std::chrono::steady_clock::now();  // first beat at once: the job has started
+  std::unique_lock lock(sig.m);
+  while (!sig.finished) {
+    if (g_stop.load()) sig.stop.store(true);
+    if (std::chrono::steady_clock::now() >= next) {
+      const std::string phase = sig.phase, detail = sig.detail;
+      const double f = sig.fraction;
+      lock.unlock();
+      try {
+        if (!db) db = std::make_unique<db::Database>(o.db_path.string());
+        if (!heartbeat(*db, c, o.lease_s, f, phase, detail)) {
+          sig.lease_lost.store(true);
+          sig.stop.store(true);
+          std::fprintf(stderr, "worker %d: lease on job %s lost (another worker took it); stopping it\n",
+                       static_cast<int>(getpid()), c.job_id.c_str());
+        }
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "worker %d: heartbeat failed (will retry): %s\n", static_cast<int>(getpid()), e.what());
+      }
+      lock.lock();
+      next = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                    std::chrono::duration<double>(interval_s));
+      if (sig.lease_lost.load()) return;
+    }
+    sig.cv.wait_for(lock, std::chrono::milliseconds(50));
+  }
+}
+
+void remove_tmp_of(const fs::path& tmp_dir, const std::string& prefix) {
+  std::error_code ec;
+  if (!fs::exists(tmp_dir, ec)) return;
+  for (const auto& e : fs::directory_iterator(tmp_dir, ec))
+    if (e.path().filename().string().rfind(prefix, 0) == 0) fs::remove_all(e.path(), ec);
+}
+
+}  // namespace
+
+std::atomic<bool>& stop_requested() { return g_stop; }
+
+void install_stop_signals() {
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+void fsync_path(const fs::path& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
+}
+
+void write_file_synced(const fs::path& path, const std::string& text) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd < 0) throw std::runtime_error(fmt::format("cannot create '{}': {}", path.string(), std::strerror(errno)));
+  std::size_t off = 0;
+  while (off < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + off, text.size() - off);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int err = errno;
+      ::close(fd);
+      throw std::runtime_error(fmt::format("cannot write '{}': {}", path.string(), std::strerror(err)));
+    }
+    off += static_cast<std::size_t>(n);
+  }
+  ::fsync(fd);
+  ::close(fd);
+}
+
+Runner noop_runner() {
+  return [](const RunContext& ctx) {
+    const json& s = ctx.claim.scenario;
+    const double sleep_s = s.value("sleep_s", 0.0);
+    const int fail_attempts = s.value("fail_attempts", 0);
+    ctx.progress("noop", 0.0, "");
+    if (sleep_s > 0) {
+      const auto t0 = std::chrono::steady_clock::now();
+      for (;;) {
+        const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (el >= sleep_s) break;
+        if (ctx.stop && ctx.stop->load()) throw std::runtime_error("noop job stopped");
+        ctx.progress("noop", el / sleep_s, fmt::format("{:.2f}/{:.2f} s", el, sleep_s));
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+    }
+    if (ctx.claim.attempt <= fail_attempts)
+      throw std::runtime_error(fmt::format("noop job asked to fail on attempt {} (fail_attempts={})",
+                                           ctx.claim.attempt, fail_attempts));
+    write_file_synced(ctx.output_tmp, json{{"job_id", ctx.claim.job_id}, {"attempt", ctx.claim.attempt}}.dump());
+    RunOutput out;
+    out.metrics["noop_value"] = s.contains("value") ? s["value"] : json(0);
+    out.metrics["sleep_s"] = sleep_s;
+    return out;
+  };
+}
+
+WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
+  WorkerReport rep;
+  db::Database db(o.db_path.string());
+  ensure_schema(db);
+  const CampaignPaths paths(o.db_path);
+  const WorkerIdentity who = make_identity(o.code_version, o.threads);
+  const double hb = o.heartbeat_s > 0 ? o.heartbeat_s : o.lease_s / 4;
+  std::error_code ec;
+  for (const char* d : {"beds", "traces", "noop", "tmp"}) fs::create_directories(paths.root / d, ec);
+  long ran = 0;
+  while (!g_stop.load() && (o.max_jobs < 0 || ran < o.max_jobs)) {
+    Reclaimed lost;
+    std::optional<Claim> c;
+    try {
+      c = claim(db, who, paths, o.lease_s, &lost);
+    } catch (const db::DbError& e) {
+      if (!e.busy()) throw;
+      sleep_interruptible(0.05 + 0.1 * (getpid() % 7) / 7.0);  // busy beyond the timeout: retry with jitter
+      continue;
+    }
+    if (lost.lost > 0) {
+      rep.reclaimed += lost.lost;
+      remove_lost_files(paths, lost);
+      if (o.verbose)
+        std::fprintf(stderr, "worker %d: requeued %d job(s) with expired leases (%d dead)\n", who.pid, lost.lost,
+                     lost.dead);
+    }
+    if (!c) {
+      if (!o.follow && !work_remains(db)) break;
+      sleep_interruptible(o.poll_s);
+      continue;
+    }
+    ++ran;
+    const auto runner = runners.find(c->kind);
+    const std::string ext = c->kind == "noop" ? ".json" : ".h5";
+    const std::string prefix = fmt::format("{}.a{}.", c->job_id, c->attempt);
+    const fs::path tmp = paths.tmp() / (prefix + "out" + ext);
+    JobSignals sig;
+    std::thread beat(heartbeat_loop, std::cref(o), std::cref(*c), std::ref(sig), hb);
+    auto stop_beat = [&] {
+      {
+        std::lock_guard g(sig.m);
+        sig.finished = true;
+      }
+      sig.cv.notify_all();
+      if (beat.joinable()) beat.join();
+    };
+    RunOutput out;
+    std::string error;
+    int exit_code = 0;
+    bool permanent = false;
+    const auto t0 = std::chrono::steady_clock::now();
+    if (o.verbose)
+      std::fprintf(stderr, "worker %d: %s job %s attempt %d\n", who.pid, c->kind.c_str(), c->job_id.c_str(), c->attempt);
+    try {
+      if (runner == runners.end())
+        throw ConfigError(fmt::format("job {}: no runner for kind '{}' in this build", c->job_id, c->kind));
+      RunContext ctx{*c, tmp, c->dep_output_rel.empty() ? fs::path() : paths.abs(c->dep_output_rel), o.threads,
+                     [&sig](const std::string& phase, double f, const std::string& detail) {
+                       std::lock_guard g(sig.m);
+                       sig.phase = phase;
+                       sig.fraction = f;
+                       sig.detail = detail;
+                     },
+                     &sig.stop};
+      out = runner->second(ctx);
+    } catch (const ConfigError& e) {
+      error = e.what();
+      exit_code = 2;
+      permanent = true;
+    } catch (const NumericalFailure& e) {
+      error = fmt::format("numerical failure at step {}, particle {}: {}", e.step(), e.particle(), e.what());
+      exit_code = 3;
+      permanent = true;
+    } catch (const std::exception& e) {
+      error = e.what();
+      exit_code = 1;
+    }
+    stop_beat();
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (sig.lease_lost.load()) {
+      // Someone else holds the job now: discard everything of this attempt.
+      remove_tmp_of(paths.tmp(), prefix);
+      ++rep.fenced_out;
+      continue;
+    }
+    if (g_stop.load() && (!error.empty() || !fs::exists(tmp))) {
+      remove_tmp_of(paths.tmp(), prefix);
+      release(db, *c, "interrupted by SIGINT/SIGTERM; lease released");
+      ++rep.released;
+      rep.interrupted = true;
+      if (o.verbose) std::fprintf(stderr, "worker %d: job %s released (interrupted)\n", who.pid, c->job_id.c_str());
+      break;
+    }
+    if (error.empty() && !fs::exists(tmp)) {
+      error = fmt::format("job {} finished but wrote no output at '{}'", c->job_id, tmp.string());
+      exit_code = 1;
+    }
+    if (!error.empty()) {
+      remove_tmp_of(paths.tmp(), prefix);
+      const std::string state = fail(db, *c, error, exit_code, permanent, o.backoff_base_s);
+      if (state == "dead") ++rep.dead;
+      else if (state == "failed") ++rep.failed;
+      else ++rep.fenced_out;
+      std::fprintf(stderr, "worker %d: job %s attempt %d failed (%s): %s\n", who.pid, c->job_id.c_str(), c->attempt,
+                   state.empty() ? "fenced out" : state.c_str(), error.c_str());
+      continue;
+    }
+    // Output: fsync, rename to its final name, fsync the directory, checksum, record.
+    const fs::path final_path = paths.abs(c->output_rel);
+    fs::create_directories(final_path.parent_path());
+    fsync_path(tmp);
+    fs::rename(tmp, final_path);
+    fsync_path(final_path.parent_path());
+    remove_tmp_of(paths.tmp(), prefix);
+    Completion done;
+    done.output_rel = c->output_rel;
+    done.sha256 = sweep::sha256_file(final_path);
+    done.bytes = static_cast<std::int64_t>(fs::file_size(final_path));
+    done.metrics = out.metrics;
+    done.report = out.report;
+    done.report["wall_s"] = secs;
+    if (complete(db, *c, done)) {
+      ++rep.done;
+      if (o.verbose)
+        std::fprintf(stderr, "worker %d: job %s done in %.2f s\n", who.pid, c->job_id.c_str(), secs);
+    } else {
+      fs::remove(final_path, ec);
+      ++rep.fenced_out;
+      std::fprintf(stderr, "worker %d: job %s finished after its lease was taken over; output discarded\n", who.pid,
+                   c->job_id.c_str());
+    }
+  }
+  if (g_stop.load()) rep.interrupted = true;
+  return rep;
+}
+
+}  // namespace gravsweep::queue

@@ -1,0 +1,72 @@
+// A worker process: claims jobs one at a time and runs them until none is left (or forever with
+// `follow`). While a job runs, a heartbeat thread (its own SQLite connection) renews the lease and
+// records progress; if the lease is lost the job is told to stop and its output is discarded.
+// Outputs are written under tmp/, fsynced, renamed to their final name, checksummed, and recorded
+// in the transaction that marks the job done. SIGINT/SIGTERM stop the current job and give its
+// lease back (the attempt does not count against the retry budget).
+#pragma once
+#include <atomic>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <string>
+
+#include "scheduler/queue/queue.h"
+
+namespace gravsweep::queue {
+
+using ProgressFn = std::function<void(const std::string& phase, double fraction, const std::string& detail)>;
+
+struct RunContext {
+  const Claim& claim;
+  std::filesystem::path output_tmp;  ///< the runner writes its output here (under tmp/)
+  std::filesystem::path bed_path;    ///< drop jobs: the prepared bed (absolute)
+  int threads = 1;
+  ProgressFn progress;
+  const std::atomic<bool>* stop = nullptr;  ///< set when the job must end early
+};
+
+struct RunOutput {
+  nlohmann::json metrics = nlohmann::json::object();
+  nlohmann::json report = nlohmann::json::object();
+};
+
+/// Runs one job; throws on failure (gravsweep::ConfigError and NumericalFailure are permanent:
+/// the job goes dead at once; anything else is retried with backoff).
+using Runner = std::function<RunOutput(const RunContext&)>;
+using RunnerTable = std::map<std::string, Runner>;
+
+/// "noop" jobs, for the scheduler's own benchmark and tests: scenario fields sleep_s (default 0),
+/// fail_attempts (attempts up to this number throw), value (echoed as metric noop_value).
+Runner noop_runner();
+
+struct WorkerOptions {
+  std::filesystem::path db_path;
+  int threads = 1;
+  double lease_s = 60;
+  double heartbeat_s = 0;       ///< 0: lease / 4
+  bool follow = false;          ///< keep waiting for new jobs when none is left
+  double poll_s = 0.5;          ///< idle wait between claims when nothing is runnable
+  long max_jobs = -1;           ///< stop after this many jobs (-1: no limit)
+  double backoff_base_s = 2.0;
+  std::string code_version = "unknown";
+  bool verbose = true;
+};
+
+struct WorkerReport {
+  long done = 0, failed = 0, dead = 0, released = 0, fenced_out = 0, reclaimed = 0;
+  bool interrupted = false;
+};
+
+/// Set by SIGINT/SIGTERM once install_stop_signals() ran.
+std::atomic<bool>& stop_requested();
+void install_stop_signals();
+
+WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners);
+
+/// Writes `text` to `path` and fsyncs it (helper for runners).
+void write_file_synced(const std::filesystem::path& path, const std::string& text);
+/// fsync of a file or directory (best effort on directories).
+void fsync_path(const std::filesystem::path& path);
+
+}  // namespace gravsweep::queue

@@ -1,0 +1,89 @@
+// Sweep specs (schemas/sweep.schema.json): a base scenario plus axes that set scenario fields
+// addressed by JSON pointer, as value lists, ranges or zipped groups, with repeats (seeds or
+// offsets). expand() turns a spec into content-addressed jobs: one `drop` job per point and one
+// `bed` job per distinct bed key, which the drops that share the bed depend on.
+//
+// Validation never stops at the first problem: SpecError lists every problem with the file, the
+// JSON pointer, the value found and what was expected.
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace gravsweep::sweep {
+
+struct SpecProblem {
+  std::string pointer;   ///< JSON pointer into the spec ("" = the document)
+  std::string found;     ///< the value found, as compact JSON (or "missing")
+  std::string expected;  ///< what was expected
+};
+
+class SpecError : public std::runtime_error {
+ public:
+  SpecError(std::string file, std::vector<SpecProblem> problems);
+  [[nodiscard]] const std::vector<SpecProblem>& problems() const { return problems_; }
+  [[nodiscard]] const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+  std::vector<SpecProblem> problems_;
+};
+
+/// One swept scenario field.
+struct Axis {
+  std::string name;      ///< results column name (units in the name, e.g. gravity_m_s2)
+  std::string pointer;   ///< JSON pointer into the scenario
+  std::vector<nlohmann::json> values;  ///< canonical values
+};
+
+/// Axes that vary together (zip) form one dimension of the product; a plain axis is a group of one.
+struct AxisGroup {
+  std::vector<Axis> axes;
+  [[nodiscard]] std::size_t size() const { return axes.empty() ? 0 : axes.front().values.size(); }
+};
+
+struct SweepSpec {
+  std::string name;                 ///< sweep name (unique within a campaign)
+  std::string job_kind = "impact";  ///< "impact" (bed + drop jobs) or "noop" (scheduler benchmark)
+  nlohmann::json base;              ///< canonical base scenario
+  std::vector<AxisGroup> groups;    ///< product over groups, first group slowest; repeats last
+  int max_attempts = 3;
+  int priority = 0;
+  nlohmann::json source;            ///< the spec as read (with the base inlined)
+  [[nodiscard]] std::size_t points() const;
+};
+
+/// Parses and validates a spec document. `file` names it in errors; `base_dir` resolves a base
+/// given as a file name. Throws SpecError.
+SweepSpec parse_spec(const nlohmann::json& doc, const std::string& file,
+                     const std::filesystem::path& base_dir);
+/// Reads the file (JSON parse errors are SpecError with line/column) and parses it.
+SweepSpec load_spec(const std::filesystem::path& path);
+
+struct PlannedJob {
+  std::string job_id;
+  std::string kind;               ///< "bed", "drop" or "noop"
+  nlohmann::json scenario;        ///< canonical scenario the job runs
+  nlohmann::json params;          ///< swept parameter values {column name: value}
+  std::vector<std::string> deps;  ///< job ids this job waits for
+  int priority = 0;
+};
+
+/// bed key of a scenario: drops with equal keys share a bed job.
+using BedKeyFn = std::function<nlohmann::json(const nlohmann::json& scenario)>;
+
+/// Expands the spec. Bed jobs come first (in order of first use), then drops in product order.
+/// `bed_key` is required for impact sweeps. Errors from bed_key (invalid scenario) become
+/// SpecError naming the point.
+std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key);
+
+/// A results column name is [a-z_][a-z0-9_]*; derives one from a pointer ("/drop/speed_m_s"
+/// -> "drop_speed_m_s").
+std::string column_from_pointer(const std::string& pointer);
+bool valid_column_name(const std::string& name);
+
+}  // namespace gravsweep::sweep
