@@ -25,6 +25,12 @@ struct HertzChrono {
     return -2.0 * std::sqrt(5.0 / 6.0) * beta;
   }
 
+  /// Caches the damping factor of the pair (damping_n; Chrono uses the normal COR for both).
+  static void prepare(PairCoefficients& c) {
+    c.damping_n = damping_factor(c.cor_normal);
+    c.damping_t = c.damping_n;
+  }
+
   /// Rayleigh time T_R = pi R sqrt(rho/G) / (0.1631 nu + 0.8766), G = E / (2(1+nu)) (dem-physics 4.3).
   static double rayleigh_time_s(const Material& m, double radius_m) {
     const double G = m.young_modulus_Pa / (2 * (1 + m.poisson_ratio));
@@ -71,7 +77,7 @@ struct HertzChrono {
     const double St = 8.0 * c.G_eff_Pa * sqrt_Rd;
     const double kn = (2.0 / 3.0) * Sn;
     const double kt = St;
-    const double damp_n = damping_factor(c.cor_normal);
+    const double damp_n = c.damping_n;
     const double gn = damp_n * std::sqrt(Sn * g.m_eff_kg);
     const double gt = damp_n * std::sqrt(St * g.m_eff_kg);
     double Fn = kn * delta - gn * v_n;  // unclamped, as in Chrono

@@ -24,6 +24,12 @@ struct HookePkdgrav {
     return 2.0 * std::abs(loge) / std::sqrt(kPi * kPi + loge * loge);
   }
 
+  /// Caches the damping prefactors; C = prefactor * sqrt(k mu). eps_t = 1 gives C_T = 0.
+  static void prepare(PairCoefficients& c) {
+    c.damping_n = damping_prefactor(c.cor_normal);
+    c.damping_t = c.cor_tangential >= 1.0 ? 0.0 : damping_prefactor(c.cor_tangential);
+  }
+
   /// Linear-contact duration t_c = pi sqrt(mu/k) sqrt(1 + ln^2 e / pi^2) (dem-physics.md 2.4).
   static double contact_time_s(double k_N_m, double m_eff_kg, double cor) {
     const double loge = std::log(cor);
@@ -76,10 +82,8 @@ struct HookePkdgrav {
     const double u_n = u.dot(n);
     const Vec3 u_T = u - u_n * n;
 
-    const double cN = damping_prefactor(c.cor_normal) * std::sqrt(c.kn_N_m * g.m_eff_kg);
-    const double cT = c.cor_tangential >= 1.0
-                          ? 0.0
-                          : damping_prefactor(c.cor_tangential) * std::sqrt(c.kt_N_m * g.m_eff_kg);
+    const double cN = c.damping_n * std::sqrt(c.kn_N_m * g.m_eff_kg);
+    const double cT = c.damping_t * std::sqrt(c.kt_N_m * g.m_eff_kg);
     // Force on body 1: F_N = -kN x n + C_N u_N (no tensile clamp).
     const Vec3 FN1 = -c.kn_N_m * g.overlap_m * n + cN * u_n * n;
 

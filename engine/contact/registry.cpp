@@ -73,6 +73,12 @@ ForceFunction select_force_function(std::string_view law, std::string_view rolli
   return f;
 }
 
+void prepare_contact_law(std::string_view law, PairTable& pairs) {
+  std::apply([&](auto... l) {
+    ((law == decltype(l)::name ? (pairs.for_each([](PairCoefficients& c) { decltype(l)::prepare(c); }), 0) : 0), ...);
+  }, ContactLaws{});
+}
+
 void check_contact_law(std::string_view law, const LawSetup& setup) {
   bool found = false;
   std::apply([&](auto... l) {

@@ -1,7 +1,7 @@
 // The registry of contact laws and rolling models: one table each (registry.cpp).
 //
 // To add a contact law: write engine/contact/<name>.h with a struct that has `name`,
-// `description`, `static void check(const LawSetup&)` and `static void evaluate(...)` (see
+// `description`, `static void prepare(PairCoefficients&)`, `static void check(const LawSetup&)` and `static void evaluate(...)` (see
 // hertz_chrono.h), then add the struct to the ContactLaws list in registry.cpp. A rolling model is
 // the same with `apply(...)` (see engine/rolling/) and the RollingModels list.
 #pragma once
@@ -17,6 +17,9 @@ namespace gravsweep {
 /// The force function for a (contact law, rolling model) pair; unknown names are ConfigErrors
 /// that list the valid names.
 ForceFunction select_force_function(std::string_view law, std::string_view rolling);
+
+/// Lets the named law cache its per-pair constants (PairCoefficients::damping_n, damping_t).
+void prepare_contact_law(std::string_view law, PairTable& pairs);
 
 /// Runs the named law's parameter and time-step checks.
 void check_contact_law(std::string_view law, const LawSetup& setup);

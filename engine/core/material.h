@@ -50,6 +50,10 @@ struct PairCoefficients {
   double mu_rolling = 0;
   double mu_twisting = 0;
   double shape_beta = 0;
+  /// Law-specific constants derived once per pair by the law's prepare() (e.g. damping factors
+  /// from the restitution coefficients), so the contact loop does no logarithms.
+  double damping_n = 0;
+  double damping_t = 0;
 };
 
 /// Symmetric table of PairCoefficients indexed by two material ids.
@@ -65,6 +69,11 @@ class PairTable {
     table_[b * n_ + a] = c;
   }
   [[nodiscard]] std::size_t materials() const { return n_; }
+  /// Applies f to every entry (both halves of the symmetric table).
+  template <class F>
+  void for_each(F&& f) {
+    for (auto& c : table_) f(c);
+  }
 
  private:
   std::size_t n_ = 0;

@@ -30,6 +30,35 @@ std::size_t VerletList::bytes() const {
              sizeof(std::uint32_t);
 }
 
+void VerletList::remap(const std::vector<long long>& new_index) {
+  const std::size_t n_old = new_index.size();
+  if (offset.size() != n_old + 1) {
+    clear();
+    return;
+  }
+  std::vector<std::uint32_t> off{0};
+  std::vector<std::uint32_t> nb;
+  std::vector<ContactHistory> hist;
+  std::vector<Vec3> pos;
+  nb.reserve(neighbor_.size());
+  hist.reserve(history.size());
+  for (std::size_t i = 0; i < n_old; ++i) {
+    if (new_index[i] < 0) continue;
+    for (std::uint32_t k = offset[i]; k < offset[i + 1]; ++k) {
+      const long long j = new_index[neighbor_[k]];
+      if (j < 0) continue;
+      nb.push_back(static_cast<std::uint32_t>(j));  // order kept: new indices are monotone
+      hist.push_back(history[k]);
+    }
+    off.push_back(static_cast<std::uint32_t>(nb.size()));
+    pos.push_back(position_at_build_[i]);
+  }
+  offset = std::move(off);
+  neighbor_ = std::move(nb);
+  history = std::move(hist);
+  position_at_build_ = std::move(pos);
+}
+
 bool VerletList::needs_rebuild(const Particles& p) const {
   const std::size_t n = p.size();
   if (position_at_build_.size() != n || offset.size() != n + 1) return true;

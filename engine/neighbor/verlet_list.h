@@ -34,8 +34,12 @@ class VerletList {
   std::vector<std::uint32_t> neighbor_;
   std::vector<ContactHistory> history;
 
-  /// Forget everything (after particles were added or removed: indices changed).
+  /// Forget everything (after particles were added: indices changed).
   void clear();
+
+  /// Drops the removed particles and renumbers the rest (order kept), keeping the histories of
+  /// the surviving pairs. new_index[i] is the new index of particle i, or -1 if removed.
+  void remap(const std::vector<long long>& new_index);
 
  private:
   std::vector<Vec3> position_at_build_;

@@ -26,6 +26,26 @@ void System::invalidate() {
   wall_history_.clear();
 }
 
+void System::remove_particles(const std::vector<bool>& remove) {
+  const std::size_t n = particles.size();
+  std::vector<long long> new_index(n, -1);
+  long long next = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!remove[i]) new_index[i] = next++;
+  nlist_.remap(new_index);
+  const std::size_t nw = walls.size();
+  if (wall_history_.size() == n * nw) {
+    std::vector<ContactHistory> wh;
+    wh.reserve(static_cast<std::size_t>(next) * nw);
+    for (std::size_t i = 0; i < n; ++i)
+      if (!remove[i])
+        for (std::size_t w = 0; w < nw; ++w) wh.push_back(wall_history_[i * nw + w]);
+    wall_history_ = std::move(wh);
+  }
+  particles.remove_if(remove);
+  initialized_ = false;  // thread buffers and checks follow the new size; histories are kept
+}
+
 void System::initialize() {
   const std::size_t nm = config_.materials.size();
   if (nm == 0) throw ConfigError("system: no materials defined");
@@ -72,6 +92,7 @@ void System::initialize() {
                     LawSetup{config_.materials, pairs_, min_r, min_m, is_wall, config_.dt_s,
                              config_.check_time_step});
   force_fn_ = select_force_function(config_.contact_law, config_.rolling_model);
+  prepare_contact_law(config_.contact_law, pairs_);
   integrator_ = make_integrator(config_.integrator);
 
   if (config_.skin_m <= 0) {

@@ -65,8 +65,11 @@ class System {
   /// Validates parameters, builds the pair table and the neighbour list. Called by step() when
   /// needed; call it after changing particles, walls or config (or use invalidate()).
   void initialize();
-  /// Marks particle indices as changed (after adding or removing particles).
+  /// Marks particle indices as changed (after adding particles or changing walls): contact
+  /// histories are dropped.
   void invalidate();
+  /// Removes the flagged particles, keeping the order and the contact histories of the others.
+  void remove_particles(const std::vector<bool>& remove);
 
   void step();
   void advance(long long steps);

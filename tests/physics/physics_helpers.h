@@ -20,6 +20,7 @@ inline SystemConfig two_material_config(const std::string& law, double cor, doub
   c.contact_law = law;
   c.rolling_model = rolling;
   c.gravity_m_s2 = Vec3::Zero();
+  c.threads = 1;
   c.materials.resize(2);
   for (auto& m : c.materials) {
     m.cor_normal = cor;

@@ -1,0 +1,79 @@
+// Numerical failure stops the run with a message naming the particle, the step and the cause.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "engine/core/error.h"
+#include "engine/scenario/paper_params.h"
+#include "engine/system/system.h"
+
+using namespace gravsweep;
+
+namespace {
+SystemConfig no_gravity() {
+  auto c = chrono_table1_config();
+  c.gravity_m_s2 = Vec3::Zero();
+  return c;
+}
+}  // namespace
+
+TEST(Failure, OverlapBeyondHalfRadiusNamesParticlesAndStep) {
+  System s(no_gravity());
+  s.particles.add(Vec3(0, 0, 0), 0.005, 1.3e-3, 0, SizeClass::grain);
+  s.particles.add(Vec3(0, 0, 0.004), 0.005, 1.3e-3, 0, SizeClass::grain);  // 60 % overlap
+  try {
+    s.step();
+    FAIL() << "expected NumericalFailure";
+  } catch (const NumericalFailure& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(e.step(), 0);
+    EXPECT_EQ(e.particle(), 0);
+    EXPECT_NE(msg.find("particle 0 overlaps particle 1"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("step 0"), std::string::npos) << msg;
+  }
+}
+
+TEST(Failure, NaNVelocityIsReported) {
+  System s(no_gravity());
+  s.particles.add(Vec3(0, 0, 0), 0.005, 1.3e-3, 0, SizeClass::grain);
+  s.particles.add(Vec3(0.1, 0, 0), 0.005, 1.3e-3, 0, SizeClass::grain);
+  s.advance(3);
+  s.particles.velocity_m_s[1].x() = std::numeric_limits<double>::quiet_NaN();
+  try {
+    s.step();
+    FAIL() << "expected NumericalFailure";
+  } catch (const NumericalFailure& e) {
+    EXPECT_EQ(e.particle(), 1);
+    EXPECT_EQ(e.step(), 4);
+    EXPECT_NE(std::string(e.what()).find("non-finite"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Failure, GrainLeavingTheContainer) {
+  auto cfg = no_gravity();
+  cfg.domain = Domain{Vec3(-0.1, -0.1, -0.1), Vec3(0.1, 0.1, 0.1)};
+  System s(cfg);
+  s.particles.add(Vec3(0, 0, 0), 0.005, 1.3e-3, 0, SizeClass::grain);
+  s.particles.add(Vec3(0.0995, 0, 0), 0.005, 1.3e-3, 0, SizeClass::grain);
+  s.particles.velocity_m_s[1] = Vec3(1.0, 0, 0);
+  try {
+    s.advance(10000);
+    FAIL() << "expected NumericalFailure";
+  } catch (const NumericalFailure& e) {
+    EXPECT_EQ(e.particle(), 1);
+    EXPECT_NE(std::string(e.what()).find("left the container"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Particles, RemoveKeepsOrderAndHistories) {
+  System s(no_gravity());
+  for (int i = 0; i < 4; ++i) s.particles.add(Vec3(0.0099 * i, 0, 0), 0.005, 1.3e-3, 0, SizeClass::grain);
+  s.step();
+  EXPECT_EQ(s.stats().contacts, 3);
+  s.remove_particles({false, true, false, false});
+  EXPECT_EQ(s.particles.size(), 3u);
+  EXPECT_DOUBLE_EQ(s.particles.position_m[1].x(), 0.0099 * 2);
+  s.step();
+  EXPECT_EQ(s.stats().contacts, 1);  // only the pair (2, 3) still touches
+}
