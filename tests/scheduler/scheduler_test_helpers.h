@@ -1,0 +1,135 @@
+// Helpers of the scheduler tests: temporary folders, running the gravsweep binary, SQL counts.
+#pragma once
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "scheduler/db/sqlite.h"
+
+namespace gravsweep::test {
+
+struct TempDir {
+  std::filesystem::path path;
+  TempDir() {
+    std::random_device rd;
+    path = std::filesystem::temp_directory_path() /
+           ("gravsweep-sched-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
+    std::filesystem::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+};
+
+inline void write_text(const std::filesystem::path& p, const std::string& text) {
+  std::ofstream f(p);
+  f << text;
+}
+
+struct CmdResult {
+  int code = -1;
+  std::string out, err;
+};
+
+/// Runs the gravsweep binary with args; captures stdout and stderr (through files).
+inline CmdResult run_cli(const std::vector<std::string>& args, const std::filesystem::path& workdir) {
+  const auto out_path = workdir / ".cli_out", err_path = workdir / ".cli_err";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int o = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int e = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(o, 1);
+    dup2(e, 2);
+    if (chdir(workdir.c_str()) != 0) _exit(126);
+    std::vector<char*> argv{const_cast<char*>(GRAVSWEEP_BINARY)};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(GRAVSWEEP_BINARY, argv.data());
+    _exit(127);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  CmdResult r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  std::stringstream a, b;
+  a << std::ifstream(out_path).rdbuf();
+  b << std::ifstream(err_path).rdbuf();
+  r.out = a.str();
+  r.err = b.str();
+  return r;
+}
+
+/// Starts the gravsweep binary in the background (output to `log`); returns its pid.
+inline pid_t start_cli(const std::vector<std::string>& args, const std::filesystem::path& log) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const int o = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+    dup2(o, 1);
+    dup2(o, 2);
+    std::vector<char*> argv{const_cast<char*>(GRAVSWEEP_BINARY)};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(GRAVSWEEP_BINARY, argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+/// Waits for a child with a deadline; returns its exit code, or -1 on timeout (child killed).
+inline int wait_child(pid_t pid, double timeout_s) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  int status = 0;
+  for (;;) {
+    const pid_t r = waitpid(pid, &status, WNOHANG);
+    if (r == pid) return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    if (std::chrono::steady_clock::now() > end) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      return -1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
+inline std::int64_t sql_int(db::Database& db, const std::string& sql) {
+  db::Statement st(db, sql);
+  st.step();
+  return st.get_int(0);
+}
+
+inline std::string sql_text(db::Database& db, const std::string& sql) {
+  db::Statement st(db, sql);
+  if (!st.step()) return {};
+  return st.get_text(0);
+}
+
+/// The tiny scenario of the integration tests: an 8 cm cup of 1 cm grains, 4 cm deep (a bed
+/// takes about a second, a drop less).
+inline std::string tiny_base() {
+  return R"({
+    "name": "tiny", "gravity_m_s2": 9.81,
+    "container": {"diameter_m": 0.08, "fill_height_m": 0.04},
+    "dt_s": 1e-5,
+    "bed": {"seed": 7, "dt_s": 1e-5, "settle": {"max_time_s": 0.3, "rms_speed_m_s": 1e-4,
+            "max_speed_m_s": 5e-3}, "relax_time_s": 0.02},
+    "projectile": {"diameter_m": 0.03, "mass_kg": 0.03, "impact_speed_m_s": 0.5,
+                   "lateral_offset_max_grain_diameters": 0.5, "seed": 3},
+    "stop": {"max_time_s": 0.25}
+  })";
+}
+
+}  // namespace gravsweep::test

@@ -1,0 +1,129 @@
+// The verbs as users run them, as real processes on real files: submit (idempotent, extension,
+// malformed spec), work (exit codes, SIGTERM releases the lease), status, resume, results.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "scheduler/db/sqlite.h"
+#include "scheduler_test_helpers.h"
+
+using namespace gravsweep;
+using namespace gravsweep::test;
+using nlohmann::json;
+
+namespace {
+
+std::string noop_spec(const std::vector<double>& gs, double sleep_s = 0.0, int fail_attempts = 0, int max_attempts = 3) {
+  json doc = {{"sweep", "cli"}, {"job", "noop"}, {"max_attempts", max_attempts},
+              {"base", {{"g", 1.5}, {"sleep_s", sleep_s}, {"fail_attempts", fail_attempts}}},
+              {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", gs}}}}};
+  return doc.dump(2);
+}
+
+}  // namespace
+
+TEST(CliQueue, SubmitIsIdempotentAndExtensionAddsOnlyNewJobs) {
+  TempDir d;
+  write_text(d.path / "spec.json", noop_spec({0.5, 1.62, 9.81}));
+  auto r = run_cli({"submit", "spec.json", "--db", "c.db"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("3 new, 0 already present"), std::string::npos) << r.out;
+  r = run_cli({"submit", "spec.json", "--db", "c.db"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("0 new, 3 already present"), std::string::npos) << r.out;
+  write_text(d.path / "spec.json", noop_spec({0.5, 1.62, 9.81, 3.71}));
+  r = run_cli({"submit", "spec.json", "--db", "c.db"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("1 new, 3 already present"), std::string::npos) << r.out;
+  db::Database db((d.path / "c.db").string());
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs"), 4);
+}
+
+TEST(CliQueue, MalformedSpecIsRefusedAndNothingIsWritten) {
+  TempDir d;
+  json doc = json::parse(noop_spec({0.5, 1.62}));
+  doc["axes"][0]["values"][1] = "fast";
+  write_text(d.path / "bad.json", doc.dump(2));
+  auto r = run_cli({"submit", "bad.json", "--db", "c.db"}, d.path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("bad.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("/axes/0/values/1: found \"fast\" (string), expected a number"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(d.path / "c.db")) << "a refused spec must not create the database";
+  // Into an existing campaign: still nothing written.
+  write_text(d.path / "good.json", noop_spec({0.5}));
+  ASSERT_EQ(run_cli({"submit", "good.json", "--db", "c.db"}, d.path).code, 0);
+  r = run_cli({"submit", "good.json", "bad.json", "--db", "c.db"}, d.path);
+  EXPECT_EQ(r.code, 2);
+  db::Database db((d.path / "c.db").string());
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs"), 1);
+  EXPECT_EQ(sql_int(db, "SELECT submits FROM sweeps"), 1);
+}
+
+TEST(CliQueue, WorkersRunEverythingRetryAndReportDeadJobs) {
+  TempDir d;
+  // fail_attempts=1: every job fails once, then succeeds on its retry.
+  write_text(d.path / "spec.json", noop_spec({0.5, 1.62, 9.81, 3.71, 2.0, 4.0}, 0.05, 1));
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
+  auto r = run_cli({"work", "--db", "c.db", "--workers", "2", "--backoff", "0.05", "--poll", "0.02"}, d.path);
+  EXPECT_EQ(r.code, 0) << r.err;
+  db::Database db((d.path / "c.db").string());
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), 6);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='failed'"), 6);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results"), 6);
+  EXPECT_EQ(sql_int(db, "SELECT count(DISTINCT pid) FROM attempts"), 2) << "two worker processes";
+  // Every result's file exists with its recorded checksum size.
+  db::Statement st(db, "SELECT trace_path, trace_bytes FROM results");
+  while (st.step())
+    EXPECT_EQ(std::filesystem::file_size(d.path / st.get_text(0)), static_cast<std::uintmax_t>(st.get_int(1)));
+  // A job that always fails goes dead after max_attempts; work exits 4.
+  write_text(d.path / "dead.json", noop_spec({7.0}, 0.0, 99, 2));
+  ASSERT_EQ(run_cli({"submit", "dead.json", "--db", "c.db"}, d.path).code, 0);
+  r = run_cli({"work", "--db", "c.db", "--backoff", "0.01", "--poll", "0.02"}, d.path);
+  EXPECT_EQ(r.code, 4) << r.err;
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='dead' AND attempts=2"), 1);
+  r = run_cli({"status", "--db", "c.db"}, d.path);
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("asked to fail"), std::string::npos) << r.out;
+  // results: filter, csv, json
+  r = run_cli({"results", "--db", "c.db", "--where", "gravity_m_s2<2", "--format", "csv", "--columns",
+               "gravity_m_s2,noop_value", "--sort", "gravity_m_s2"},
+              d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out, "gravity_m_s2,noop_value\r\n0.5,0\r\n1.62,0\r\n");
+  r = run_cli({"results", "--db", "c.db", "--where", "gravity_m_s2=4", "--format", "json"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json rows = json::parse(r.out);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0]["gravity_m_s2"], 4.0);
+  EXPECT_EQ(rows[0]["trace_sha256"].get<std::string>().size(), 64u);
+  r = run_cli({"results", "--db", "c.db", "--where", "gravity_m_s2<1; DELETE FROM jobs"}, d.path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("expected 'and'"), std::string::npos) << r.err;
+}
+
+TEST(CliQueue, SigtermEndsTheJobAndReleasesItsLease) {
+  TempDir d;
+  write_text(d.path / "spec.json", noop_spec({1.0}, 30.0));
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
+  const pid_t w = start_cli({"work", "--db", (d.path / "c.db").string(), "--lease", "60"}, d.path / "w.log");
+  db::Database db((d.path / "c.db").string());
+  const auto t0 = std::chrono::steady_clock::now();
+  while (sql_int(db, "SELECT count(*) FROM jobs WHERE state='running' AND progress > 0") == 0) {
+    ASSERT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(20)) << "job never started";
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  kill(w, SIGTERM);
+  const auto t1 = std::chrono::steady_clock::now();
+  EXPECT_EQ(wait_child(w, 10), 130);
+  EXPECT_LT(std::chrono::steady_clock::now() - t1, std::chrono::seconds(3));
+  EXPECT_EQ(sql_text(db, "SELECT state FROM jobs"), "queued");
+  EXPECT_EQ(sql_int(db, "SELECT attempts FROM jobs"), 0);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE lease_owner IS NOT NULL"), 0);
+  EXPECT_EQ(sql_text(db, "SELECT outcome FROM attempts"), "released");
+  // Nothing left behind in tmp/.
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(d.path / "c.files" / "tmp")) ++files;
+  EXPECT_EQ(files, 0u);
+}

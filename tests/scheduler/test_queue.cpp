@@ -1,0 +1,259 @@
+// The job queue on real SQLite files: idempotent submit, dependencies, claims, leases, fencing,
+// retries with backoff, the dead state, release, resume and the results table.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "scheduler/queue/queue.h"
+#include "scheduler/sweep/spec.h"
+#include "scheduler_test_helpers.h"
+
+using namespace gravsweep;
+using namespace gravsweep::queue;
+using gravsweep::test::sql_int;
+using gravsweep::test::sql_text;
+using nlohmann::json;
+
+namespace {
+
+sweep::SweepSpec noop_spec(const std::string& name, std::vector<double> gs, int max_attempts = 3,
+                           json base = json::object()) {
+  if (base.empty()) base = {{"g", 1.5}, {"sleep_s", 0.0}};
+  json doc = {{"sweep", name}, {"job", "noop"}, {"base", base}, {"max_attempts", max_attempts},
+              {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", gs}}}}};
+  return sweep::parse_spec(doc, "test", ".");
+}
+
+json bed_key(const json& s) { return {{"g", s["g"]}}; }
+
+/// An impact-shaped sweep (bed + drop jobs) for the dependency logic; no job is run here.
+sweep::SweepSpec impact_spec() {
+  json doc = {{"sweep", "imp"},
+              {"base", {{"g", 9.81}, {"v", 1.0}}},
+              {"axes",
+               {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {9.81, 1.62}}},
+                {{"name", "speed_m_s"}, {"pointer", "/v"}, {"values", {1.0, 2.0, 3.0}}}}}};
+  return sweep::parse_spec(doc, "test", ".");
+}
+
+struct QueueTest : ::testing::Test {
+  test::TempDir dir;
+  std::filesystem::path db_path = dir.path / "c.db";
+  db::Database db{db_path.string()};
+  CampaignPaths paths{db_path};
+  WorkerIdentity me = make_identity("test", 1);
+  void SetUp() override { ensure_schema(db); }
+  SubmitReport submit_spec(const sweep::SweepSpec& s, const sweep::BedKeyFn& key = {}) {
+    return submit(db, s, sweep::expand(s, key));
+  }
+  Completion done_for(const Claim& c, double value = 1.0) {
+    Completion d;
+    d.output_rel = c.output_rel;
+    d.sha256 = std::string(64, 'a');
+    d.bytes = 1;
+    d.metrics = {{"apeak_m_s2", value}, {"rebound", false}, {"note", nullptr}};
+    return d;
+  }
+};
+
+}  // namespace
+
+TEST_F(QueueTest, SubmitTwiceAddsNothingExtensionAddsOnlyNewJobs) {
+  auto r1 = submit_spec(noop_spec("s", {1, 2, 3}));
+  EXPECT_EQ(r1.added, 3u);
+  EXPECT_EQ(r1.present, 0u);
+  EXPECT_TRUE(r1.sweep_new);
+  auto r2 = submit_spec(noop_spec("s", {1, 2, 3}));
+  EXPECT_EQ(r2.added, 0u);
+  EXPECT_EQ(r2.present, 3u);
+  auto r3 = submit_spec(noop_spec("s", {1, 2, 3, 4.5}));
+  EXPECT_EQ(r3.added, 1u);
+  EXPECT_EQ(r3.present, 3u);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs"), 4);
+  EXPECT_EQ(sql_int(db, "SELECT submits FROM sweeps WHERE sweep_id='s'"), 3);
+  // A second sweep sharing points shares the jobs (content addressed) but counts them in both.
+  auto r4 = submit_spec(noop_spec("t", {1, 7}));
+  EXPECT_EQ(r4.added, 1u);
+  EXPECT_EQ(r4.present, 1u);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM sweep_jobs"), 6);
+  // One results column per swept parameter, created at submit.
+  const auto cols = result_columns(db);
+  EXPECT_NE(std::find(cols.begin(), cols.end(), "gravity_m_s2"), cols.end());
+}
+
+TEST_F(QueueTest, DropsWaitForTheirBedAndBedsAreClaimedFirst) {
+  auto r = submit_spec(impact_spec(), bed_key);
+  EXPECT_EQ(r.beds_added, 2u);
+  EXPECT_EQ(r.drops_added, 6u);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='waiting'"), 6);
+  auto bed = claim(db, me, paths, 60);
+  ASSERT_TRUE(bed);
+  EXPECT_EQ(bed->kind, "bed");
+  auto bed2 = claim(db, me, paths, 60);
+  ASSERT_TRUE(bed2);
+  EXPECT_EQ(bed2->kind, "bed");
+  EXPECT_FALSE(claim(db, me, paths, 60)) << "drops must wait for their bed";
+  EXPECT_TRUE(work_remains(db));
+  ASSERT_TRUE(complete(db, *bed, done_for(*bed)));
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='queued' AND kind='drop'"), 3);
+  auto drop = claim(db, me, paths, 60);
+  ASSERT_TRUE(drop);
+  EXPECT_EQ(drop->kind, "drop");
+  EXPECT_EQ(drop->dep_output_rel, bed->output_rel);
+  ASSERT_TRUE(complete(db, *drop, done_for(*drop, 42.0)));
+  EXPECT_EQ(sql_text(db, "SELECT bed_job_id FROM results"), bed->job_id);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results WHERE apeak_m_s2=42.0 AND rebound=0"), 1);
+  // Extending the sweep after the bed finished: the new drops of that bed are queued at once.
+  auto spec = impact_spec();
+  json doc = spec.source;
+  doc["axes"][1]["values"].push_back(4.0);
+  auto r2 = submit_spec(sweep::parse_spec(doc, "test", "."), bed_key);
+  EXPECT_EQ(r2.added, 2u);
+  EXPECT_EQ(r2.present, 8u);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE kind='drop' AND state='queued'"), 3);
+}
+
+TEST_F(QueueTest, ExpiredLeaseIsReclaimedAndTheLateCompletionIsFencedOut) {
+  submit_spec(noop_spec("s", {1}));
+  auto first = claim(db, me, paths, 0.2);
+  ASSERT_TRUE(first);
+  EXPECT_TRUE(heartbeat(db, *first, 0.2, 0.3, "noop", "x"));
+  EXPECT_DOUBLE_EQ(std::stod(sql_text(db, "SELECT progress FROM jobs")), 0.3);
+  // A second worker (its own connection) cannot take a live lease...
+  db::Database other_db(db_path.string());
+  const auto other = make_identity("test", 1);
+  EXPECT_FALSE(claim(other_db, other, paths, 60));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  // ...but takes the expired one; the first attempt is closed as lost.
+  Reclaimed lost;
+  auto second = claim(other_db, other, paths, 60, &lost);
+  ASSERT_TRUE(second);
+  EXPECT_EQ(lost.lost, 1);
+  ASSERT_EQ(lost.output_rels.size(), 1u);
+  EXPECT_EQ(lost.output_rels[0], first->output_rel);
+  EXPECT_EQ(second->job_id, first->job_id);
+  EXPECT_EQ(second->attempt, 2);
+  EXPECT_GT(second->token, first->token);
+  // The stalled first worker wakes up: its heartbeat and completion are refused.
+  EXPECT_FALSE(heartbeat(db, *first, 60, 0.9, "noop", ""));
+  EXPECT_FALSE(complete(db, *first, done_for(*first)));
+  EXPECT_EQ(fail(db, *first, "late", 1, false), "");
+  EXPECT_TRUE(complete(other_db, *second, done_for(*second)));
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results"), 1);
+  EXPECT_EQ(sql_int(db, "SELECT attempt FROM results"), 2);
+  EXPECT_EQ(sql_text(db, "SELECT group_concat(outcome, ',') FROM (SELECT outcome FROM attempts ORDER BY attempt_id)"),
+            "lost,done");
+}
+
+TEST_F(QueueTest, RetriesWithBackoffThenDead) {
+  submit_spec(noop_spec("s", {1}, 3));
+  for (int attempt = 1; attempt <= 3; ++attempt) {
+    auto c = claim(db, me, paths, 60);
+    ASSERT_TRUE(c) << "attempt " << attempt;
+    EXPECT_EQ(c->attempt, attempt);
+    const std::string state = fail(db, *c, "boom", 1, false, /*backoff_base_s=*/0.05 * attempt);
+    EXPECT_EQ(state, attempt < 3 ? "failed" : "dead");
+    if (attempt < 3) {
+      // Not claimable during the backoff (base * 2^(attempt-1), here >= 50 ms)...
+      const double nb = std::stod(sql_text(db, "SELECT not_before FROM jobs"));
+      EXPECT_GE(nb - now_s(), 0.03 * attempt);
+      EXPECT_FALSE(claim(db, me, paths, 60));
+      std::this_thread::sleep_for(std::chrono::duration<double>(nb - now_s() + 0.02));
+    }
+  }
+  EXPECT_FALSE(claim(db, me, paths, 60));
+  EXPECT_FALSE(work_remains(db));
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome IN ('failed','dead') AND error='boom'"), 3);
+  // resume --dead gives it another try.
+  ResumeOptions o;
+  o.retry_dead = true;
+  o.extra_attempts = 1;
+  const auto rep = resume(db, paths, o);
+  EXPECT_EQ(rep.dead_requeued, 1);
+  auto c = claim(db, me, paths, 60);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->attempt, 4);
+  EXPECT_TRUE(complete(db, *c, done_for(*c)));
+}
+
+TEST_F(QueueTest, PermanentErrorGoesDeadAtOnceAndKillsDependents) {
+  submit_spec(impact_spec(), bed_key);
+  auto bed = claim(db, me, paths, 60);
+  ASSERT_TRUE(bed);
+  EXPECT_EQ(fail(db, *bed, "numerical failure", 3, true), "dead");
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='dead' AND kind='drop'"), 3);
+  const auto s = status(db);
+  EXPECT_EQ(s.blocked, 3);
+  ASSERT_FALSE(s.recent_errors.empty());
+  EXPECT_EQ(s.recent_errors[0].second, "numerical failure");
+  // resume --dead revives the bed and puts its drops back to waiting.
+  ResumeOptions o;
+  o.retry_dead = true;
+  resume(db, paths, o);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='waiting'"), 6);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='queued' AND kind='bed'"), 2);  // the revived bed and the one never claimed
+}
+
+TEST_F(QueueTest, ReleaseDoesNotSpendTheBudget) {
+  submit_spec(noop_spec("s", {1}, 1));
+  auto c = claim(db, me, paths, 60);
+  ASSERT_TRUE(c);
+  EXPECT_TRUE(release(db, *c, "SIGTERM"));
+  EXPECT_EQ(sql_text(db, "SELECT state FROM jobs"), "queued");
+  EXPECT_EQ(sql_int(db, "SELECT attempts FROM jobs"), 0);
+  auto again = claim(db, me, paths, 60);
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->attempt, 1);
+  EXPECT_GT(again->token, c->token);
+  EXPECT_FALSE(release(db, *c, "stale")) << "an old token cannot release the new lease";
+}
+
+TEST_F(QueueTest, ResumeRequeuesExpiredAndFailedAndRemovesOrphans) {
+  submit_spec(noop_spec("s", {1, 2, 3}));
+  auto a = claim(db, me, paths, 0.1);
+  auto b = claim(db, me, paths, 60);
+  auto live = claim(db, me, paths, 60);
+  ASSERT_TRUE(a && b && live);
+  fail(db, *b, "transient", 1, false, 100);
+  // Files: one of the lost attempt, one orphan with no owner, one of the live attempt.
+  std::filesystem::create_directories(paths.root / "noop");
+  std::filesystem::create_directories(paths.tmp());
+  test::write_text(paths.abs(a->output_rel), "lost");
+  test::write_text(paths.root / "noop" / "ffffffffffffffffffff.a9.json", "orphan");
+  test::write_text(paths.tmp() / (live->job_id + ".a1.out.json"), "in progress");
+  std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  const auto rep = resume(db, paths, ResumeOptions{});
+  EXPECT_EQ(rep.expired_requeued, 1);
+  EXPECT_EQ(rep.failed_requeued, 1);
+  EXPECT_EQ(rep.orphans.size(), 1u);
+  EXPECT_FALSE(std::filesystem::exists(paths.abs(a->output_rel)));
+  EXPECT_FALSE(std::filesystem::exists(paths.root / "noop" / "ffffffffffffffffffff.a9.json"));
+  EXPECT_TRUE(std::filesystem::exists(paths.tmp() / (live->job_id + ".a1.out.json")));
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='queued'"), 2);
+  EXPECT_EQ(sql_text(db, "PRAGMA integrity_check"), "ok");
+}
+
+TEST_F(QueueTest, StatusCountsRunningAndEta) {
+  submit_spec(noop_spec("s", {1, 2, 3, 4}));
+  auto c = claim(db, me, paths, 60);
+  ASSERT_TRUE(c);
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_TRUE(complete(db, *c, done_for(*c)));
+  auto r = claim(db, me, paths, 60);
+  ASSERT_TRUE(r);
+  heartbeat(db, *r, 60, 0.5, "drop", "t = 0.1 s");
+  const auto s = status(db);
+  ASSERT_EQ(s.per_sweep.size(), 1u);
+  EXPECT_EQ(s.per_sweep[0].done, 1);
+  EXPECT_EQ(s.per_sweep[0].running, 1);
+  EXPECT_EQ(s.per_sweep[0].queued, 2);
+  ASSERT_EQ(s.running.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.running[0].progress, 0.5);
+  EXPECT_EQ(s.running[0].phase, "drop");
+  EXPECT_EQ(s.active_workers, 1);
+  ASSERT_EQ(s.runtimes.size(), 1u);
+  EXPECT_GT(s.runtimes[0].median_s, 0.04);
+  // 2 queued + half of the running one, each at the median runtime, over 1 worker.
+  EXPECT_NEAR(s.eta_s, 2.5 * s.runtimes[0].median_s, 1e-9);
+}
