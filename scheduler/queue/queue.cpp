@@ -74,9 +74,11 @@ CREATE INDEX IF NOT EXISTS job_deps_dep ON job_deps(dep_id);
 CREATE TABLE IF NOT EXISTS sweep_jobs(
   sweep_id TEXT NOT NULL REFERENCES sweeps(sweep_id),
   job_id TEXT NOT NULL REFERENCES jobs(job_id),
+  shared INTEGER NOT NULL DEFAULT 0,  -- 1: the job was created by another sweep (jobs.sweep_id)
   PRIMARY KEY(sweep_id, job_id)
 ) STRICT, WITHOUT ROWID;
 CREATE INDEX IF NOT EXISTS sweep_jobs_job ON sweep_jobs(job_id);
+CREATE INDEX IF NOT EXISTS sweep_jobs_shared ON sweep_jobs(shared) WHERE shared=1;
 CREATE TABLE IF NOT EXISTS attempts(
   attempt_id INTEGER PRIMARY KEY,
   job_id TEXT NOT NULL REFERENCES jobs(job_id),
@@ -272,7 +274,9 @@ SubmitReport submit(Database& db, const sweep::SweepSpec& spec, const std::vecto
                     "jobs j ON j.job_id=d.dep_id WHERE d.job_id=?1 AND j.state='dead') > 0 THEN 'dead' WHEN "
                     "(SELECT count(*) FROM job_deps d JOIN jobs j ON j.job_id=d.dep_id WHERE d.job_id=?1 AND "
                     "j.state!='done') > 0 THEN 'waiting' ELSE 'queued' END WHERE job_id=?1");
-  Statement member(db, "INSERT INTO sweep_jobs(sweep_id, job_id) VALUES(?, ?) ON CONFLICT DO NOTHING");
+  Statement member(db,
+                   "INSERT INTO sweep_jobs(sweep_id, job_id, shared) VALUES(?1, ?2, (SELECT sweep_id != ?1 FROM jobs "
+                   "WHERE job_id=?2)) ON CONFLICT DO NOTHING");
   for (const auto& j : jobs) {
     ins.reset();
     ins.bind(1, j.job_id).bind(2, j.kind).bind(3, spec.name).bind(4, j.deps.empty() ? "queued" : "waiting");
@@ -669,29 +673,38 @@ Status status(Database& db, std::size_t max_running) {
   const double now = now_s();
   // A read transaction gives one consistent snapshot (WAL: does not block writers).
   Transaction tx(db, Transaction::Mode::deferred);
+  std::map<std::string, std::int64_t> remaining;  // per kind, each job once
   {
-    Statement st(db,
-                 "SELECT sj.sweep_id, j.kind, j.state, count(*) FROM sweep_jobs sj JOIN jobs j ON j.job_id=sj.job_id "
-                 "GROUP BY sj.sweep_id, j.kind, j.state ORDER BY sj.sweep_id, j.kind");
+    // Jobs counted under the sweep that created them (covering index jobs_sweep_state), plus the
+    // few memberships of jobs shared with another sweep.
+    Statement own(db, "SELECT sweep_id, kind, state, count(*) FROM jobs GROUP BY sweep_id, kind, state");
+    Statement shared(db,
+                     "SELECT sj.sweep_id, j.kind, j.state, count(*) FROM sweep_jobs sj JOIN jobs j ON "
+                     "j.job_id=sj.job_id WHERE sj.shared=1 GROUP BY sj.sweep_id, j.kind, j.state");
     std::map<std::pair<std::string, std::string>, StateCounts> m;
     std::vector<std::pair<std::string, std::string>> order;
-    while (st.step()) {
-      const auto key = std::make_pair(st.get_text(0), st.get_text(1));
-      if (!m.count(key)) {
-        order.push_back(key);
-        m[key].sweep = key.first;
-        m[key].kind = key.second;
+    for (Statement* q : {&own, &shared}) {
+      Statement& st = *q;
+      while (st.step()) {
+        const auto key = std::make_pair(st.get_text(0), st.get_text(1));
+        if (!m.count(key)) {
+          order.push_back(key);
+          m[key].sweep = key.first;
+          m[key].kind = key.second;
+        }
+        auto& c = m[key];
+        const std::string state = st.get_text(2);
+        const std::int64_t n = st.get_int(3);
+        if (state == "waiting") c.waiting += n;
+        else if (state == "queued") c.queued += n;
+        else if (state == "running") c.running += n;
+        else if (state == "failed") c.failed += n;
+        else if (state == "done") c.done += n;
+        else if (state == "dead") c.dead += n;
+        if (q == &own && (state == "waiting" || state == "queued" || state == "failed")) remaining[key.second] += n;
       }
-      auto& c = m[key];
-      const std::string state = st.get_text(2);
-      const std::int64_t n = st.get_int(3);
-      if (state == "waiting") c.waiting += n;
-      else if (state == "queued") c.queued += n;
-      else if (state == "running") c.running += n;
-      else if (state == "failed") c.failed += n;
-      else if (state == "done") c.done += n;
-      else if (state == "dead") c.dead += n;
     }
+    std::sort(order.begin(), order.end());
     for (const auto& k : order) s.per_sweep.push_back(m[k]);
   }
   {
@@ -710,13 +723,10 @@ Status status(Database& db, std::size_t max_running) {
   }
   {
     // Remaining work per kind, and the median runtime of that kind's finished attempts.
-    Statement rem(db,
-                  "SELECT kind, count(*) FROM jobs WHERE state IN ('waiting','queued','failed') GROUP BY kind");
     std::map<std::string, KindRuntime> kinds;
-    while (rem.step()) {
-      auto& k = kinds[rem.get_text(0)];
-      k.kind = rem.get_text(0);
-      k.remaining = rem.get_int(1);
+    for (const auto& [kind, n] : remaining) {
+      kinds[kind].kind = kind;
+      kinds[kind].remaining = n;
     }
     for (const auto& r : s.running) kinds[r.kind].kind = r.kind;
     Statement cnt(db, "SELECT count(*) FROM attempts WHERE kind=? AND outcome='done'");

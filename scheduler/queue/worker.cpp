@@ -44,8 +44,9 @@ struct JobSignals {
   std::atomic<bool> lease_lost{false};
 };
 
-void heartbeat_loop(const WorkerOptions& o, const Claim& c, JobSignals& sig, double interval_s) {
-  std::unique_ptr<db::Database> db;
+/// `db` is the heartbeat connection of this worker: used only by this thread while the job runs.
+void heartbeat_loop(const WorkerOptions& o, const Claim& c, JobSignals& sig, double interval_s,
+                    std::unique_ptr<db::Database>& db) {
   auto next = std::chrono::steady_clock::now();  // first beat at once: the job has started
   std::unique_lock lock(sig.m);
   while (!sig.finished) {
@@ -138,7 +139,8 @@ Runner noop_runner() {
     if (ctx.claim.attempt <= fail_attempts)
       throw std::runtime_error(fmt::format("noop job asked to fail on attempt {} (fail_attempts={})",
                                            ctx.claim.attempt, fail_attempts));
-    write_file_synced(ctx.output_tmp, json{{"job_id", ctx.claim.job_id}, {"attempt", ctx.claim.attempt}}.dump());
+    std::ofstream(ctx.output_tmp) << json{{"job_id", ctx.claim.job_id}, {"attempt", ctx.claim.attempt}}.dump();
+    // (the worker fsyncs the output before renaming it)
     RunOutput out;
     out.metrics["noop_value"] = s.contains("value") ? s["value"] : json(0);
     out.metrics["sleep_s"] = sleep_s;
@@ -155,6 +157,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
   const double hb = o.heartbeat_s > 0 ? o.heartbeat_s : o.lease_s / 4;
   std::error_code ec;
   for (const char* d : {"beds", "traces", "noop", "tmp"}) fs::create_directories(paths.root / d, ec);
+  std::unique_ptr<db::Database> beat_db;  // the heartbeat thread's own connection, kept across jobs
   long ran = 0;
   while (!g_stop.load() && (o.max_jobs < 0 || ran < o.max_jobs)) {
     Reclaimed lost;
@@ -184,7 +187,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     const std::string prefix = fmt::format("{}.a{}.", c->job_id, c->attempt);
     const fs::path tmp = paths.tmp() / (prefix + "out" + ext);
     JobSignals sig;
-    std::thread beat(heartbeat_loop, std::cref(o), std::cref(*c), std::ref(sig), hb);
+    std::thread beat(heartbeat_loop, std::cref(o), std::cref(*c), std::ref(sig), hb, std::ref(beat_db));
     auto stop_beat = [&] {
       {
         std::lock_guard g(sig.m);

@@ -118,7 +118,7 @@ std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json
   }
   if (a.contains("name")) {
     if (!a["name"].is_string() || !valid_column_name(a["name"].get<std::string>())) {
-      ck.add(join(ptr, "name"), &a["name"], "a column name [a-z_][a-z0-9_]* with units, e.g. \"gravity_m_s2\"");
+      ck.add(join(ptr, "name"), &a["name"], "a column name [a-z_][a-z0-9_]* with units, e.g. \"gravity_m_s2\", not one of the fixed results columns (job_id, sweep, kind, attempt, ...)");
       ok = false;
     } else {
       axis.name = a["name"].get<std::string>();
@@ -294,6 +294,10 @@ std::string column_from_pointer(const std::string& pointer) {
 
 bool valid_column_name(const std::string& name) {
   if (name.empty() || name.size() > 64) return false;
+  static const std::set<std::string> reserved = {"job_id",     "sweep",        "kind",        "bed_job_id",
+                                                 "attempt",    "trace_path",   "trace_sha256", "trace_bytes",
+                                                 "runtime_s",  "finished_at",  "code_version"};
+  if (reserved.count(name)) return false;
   if (!(std::islower(static_cast<unsigned char>(name[0])) || name[0] == '_')) return false;
   for (char c : name)
     if (!(std::islower(static_cast<unsigned char>(c)) || std::isdigit(static_cast<unsigned char>(c)) || c == '_'))
