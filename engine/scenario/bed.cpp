@@ -171,10 +171,10 @@ BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progr
   for (std::size_t i = 0; i < sys.particles.size(); ++i)
     remove[i] = sys.particles.size_class[i] == SizeClass::grain &&
                 sys.particles.position_m[i].z() > spec.fill_height_m;
-  sys.particles.remove_if(remove);
-  sys.invalidate();
+  sys.remove_particles(remove);
   if (progress) progress(BedPhase::flatten, 1.0, fmt::format("{} grains kept", sys.particles.size()));
-  // Relax the new surface.
+  // Relax the new surface (at the drop's gravity when the bed was settled at another).
+  if (spec.relax_gravity_m_s2) sys.mutable_config().gravity_m_s2 = *spec.relax_gravity_m_s2;
   const double t1 = sys.time_s();
   met = settle(sys, spec.settle, spec.relax_time_s, progress, BedPhase::relax, &rep.rms_speed_m_s,
                &rep.max_speed_m_s) && met;

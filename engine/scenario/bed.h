@@ -5,6 +5,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "engine/system/system.h"
@@ -40,6 +41,9 @@ struct BedSpec {
   double relax_time_s = 0.05;      ///< minimum relaxation after flattening
   std::uint8_t grain_material = 0;
   std::uint8_t wall_material = 1;
+  /// When set, gravity switches to this value after flattening, before the relaxation (a bed poured
+  /// and settled at one gravity, relaxed at the drop's; unset: the system's gravity throughout).
+  std::optional<Vec3> relax_gravity_m_s2;
 };
 
 /// Phase of bed preparation, for progress reporting.

@@ -348,7 +348,7 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
     vmin = std::min(vmin, out.velocity_down_m_s[k]);
     zmax = std::max(zmax, out.depth_m[k]);
   }
-  if (vmin < -0.05 * std::max(m.vc_m_s, 0.01)) {
+  if (vmin < -std::max(0.1 * m.vc_m_s, 0.01)) {
     m.rebound = true;
     m.note += (m.note.empty() ? "" : "; ") + fmt::format("moved up at {:.3f} m/s", -vmin);
   }

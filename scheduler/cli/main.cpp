@@ -15,6 +15,10 @@ using SetupFn = void (*)(CLI::App&);
 // The verb table: one row per verb, in the order `gravsweep --help` lists them.
 constexpr SetupFn kVerbs[] = {
     &gravsweep::cli::setup_bench,
+    &gravsweep::cli::setup_measurements,
+    &gravsweep::cli::setup_model,
+    &gravsweep::cli::setup_synth,
+    &gravsweep::cli::setup_report,
     &gravsweep::cli::setup_submit,
     &gravsweep::cli::setup_work,
     &gravsweep::cli::setup_status,

@@ -7,6 +7,10 @@
 namespace gravsweep::cli {
 
 void setup_bench(CLI::App& app);
+void setup_measurements(CLI::App& app);
+void setup_model(CLI::App& app);
+void setup_synth(CLI::App& app);
+void setup_report(CLI::App& app);
 void setup_submit(CLI::App& app);
 void setup_work(CLI::App& app);
 void setup_status(CLI::App& app);

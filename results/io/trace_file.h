@@ -1,0 +1,53 @@
+// trace.h5: the projectile's record during one drop (Sunday et al. 2021 Sect. 2.2-2.3), in the
+// paper's frame: depth z positive down from the mean bed surface, velocity positive down,
+// acceleration positive up (free fall reads -g, rest reads 0). Layout (results/io/README.md):
+//
+//   /                          attrs: format = "gravsweep-trace", format_version, code_version,
+//                                     scenario (JSON), bed_key (JSON), bed_file, metrics (JSON)
+//   /trace                     attrs: sample_rate_hz, dt_s, gravity_m_s2, surface_height_m,
+//                                     release_height_m, release_speed_m_s, projectile_diameter_m,
+//                                     projectile_mass_kg, fill_height_m, grain_diameter_m,
+//                                     stopped (1: stop criterion met, 0: time cap)
+//   /trace/t_s                 (T)    time since release
+//   /trace/depth_m             (T)    depth of the projectile's lowest point below the surface
+//   /trace/velocity_down_m_s   (T)
+//   /trace/accel_up_m_s2       (T)    mean over the preceding sample interval
+//   /trace/omega_rad_s         (T, 3) projectile angular velocity, engine frame
+//   /trace/position_m          (T, 3) projectile centre, engine frame (z up, bottom at z = 0)
+//   /trace/contacts            (T)    int32, grains and walls touching the projectile
+//   /trace/grain_kinetic_energy_J (T)
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "results/processing/trace.h"
+
+namespace gravsweep::results {
+
+struct TraceData {
+  std::vector<double> t_s, depth_m, velocity_down_m_s, accel_up_m_s2;
+  std::vector<double> omega_rad_s;  ///< T x 3
+  std::vector<double> position_m;   ///< T x 3
+  std::vector<std::int32_t> contacts;
+  std::vector<double> grain_kinetic_energy_J;
+  double sample_rate_hz = 0, dt_s = 0, gravity_m_s2 = 0, surface_height_m = 0;
+  double release_height_m = 0, release_speed_m_s = 0;
+  double projectile_diameter_m = 0, projectile_mass_kg = 0, fill_height_m = 0, grain_diameter_m = 0;
+  bool stopped = false;
+  std::string scenario_json, bed_key_json, bed_file, metrics_json, code_version;
+
+  [[nodiscard]] std::size_t size() const { return t_s.size(); }
+  /// The columns compute_metrics() reads.
+  [[nodiscard]] Trace to_trace() const;
+};
+
+inline constexpr const char* kTraceFormat = "gravsweep-trace";
+inline constexpr long long kTraceFormatVersion = 1;
+
+/// Writes under a temporary name, then renames into place.
+void write_trace(const std::filesystem::path& path, const TraceData& trace);
+TraceData read_trace(const std::filesystem::path& path);
+
+}  // namespace gravsweep::results

@@ -1,0 +1,712 @@
+// Collision models, fits, cross-validation, residual analysis and discovery (see model.h).
+#include "results/model/model.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+namespace gravsweep::results {
+
+// ---------------------------------------------------------------------------------------------
+// Specs
+
+std::string ModelSpec::name() const {
+  std::string s;
+  for (const auto& t : terms) {
+    if (!s.empty()) s += "+";
+    s += t.term->name;
+    if (t.per_gravity != t.term->per_gravity) s += t.per_gravity ? ":per_gravity" : ":shared";
+  }
+  return s;
+}
+
+ModelSpec parse_model(const std::string& text) {
+  ModelSpec spec;
+  if (std::filesystem::exists(text) && std::filesystem::is_regular_file(text)) {
+    std::ifstream in(text);
+    nlohmann::json j;
+    try {
+      in >> j;
+    } catch (const std::exception& e) {
+      throw std::invalid_argument(fmt::format("{}: not valid JSON: {}", text, e.what()));
+    }
+    if (!j.is_object() || !j.contains("terms") || !j["terms"].is_array())
+      throw std::invalid_argument(fmt::format("{}: /terms: expected an array of terms", text));
+    for (std::size_t i = 0; i < j["terms"].size(); ++i) {
+      const auto& e = j["terms"][i];
+      const std::string ptr = fmt::format("/terms/{}", i);
+      if (!e.is_object() || !e.contains("name") || !e["name"].is_string())
+        throw std::invalid_argument(fmt::format("{}: {}/name: expected a term name (string)", text, ptr));
+      ModelTerm mt;
+      try {
+        mt.term = &find_term(e["name"].get<std::string>());
+      } catch (const std::invalid_argument& ex) {
+        throw std::invalid_argument(fmt::format("{}: {}/name: {}", text, ptr, ex.what()));
+      }
+      mt.per_gravity = mt.term->per_gravity;
+      if (e.contains("shared")) {
+        if (!e["shared"].is_boolean())
+          throw std::invalid_argument(fmt::format("{}: {}/shared: expected true or false", text, ptr));
+        mt.per_gravity = !e["shared"].get<bool>();
+      }
+      if (e.contains("scale")) {
+        if (!e["scale"].is_number())
+          throw std::invalid_argument(fmt::format("{}: {}/scale: expected a number", text, ptr));
+        mt.scale = e["scale"].get<double>();
+      }
+      spec.terms.push_back(mt);
+    }
+  } else {
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, '+')) {
+      if (item.empty()) continue;
+      ModelTerm mt;
+      std::string name = item;
+      double scale = 1.0;
+      if (auto p = name.find('*'); p != std::string::npos) {
+        scale = std::stod(name.substr(p + 1));
+        name = name.substr(0, p);
+      }
+      std::string mode;
+      if (auto p = name.find(':'); p != std::string::npos) {
+        mode = name.substr(p + 1);
+        name = name.substr(0, p);
+      }
+      mt.term = &find_term(name);
+      mt.per_gravity = mt.term->per_gravity;
+      if (mode == "shared") mt.per_gravity = false;
+      else if (mode == "per_gravity") mt.per_gravity = true;
+      else if (!mode.empty())
+        throw std::invalid_argument(fmt::format("model '{}': '{}' after ':' must be shared or per_gravity", text, mode));
+      mt.scale = scale;
+      spec.terms.push_back(mt);
+    }
+  }
+  if (spec.terms.empty())
+    throw std::invalid_argument(fmt::format("model '{}': no terms (example: base+depth_friction)", text));
+  return spec;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Columns and fits
+
+namespace {
+
+struct Layout {
+  std::vector<int> offset;  ///< first column of each term
+  int cols = 0;
+  int G = 0;
+};
+
+Layout layout(const ModelSpec& s, int G) {
+  Layout L;
+  L.G = G;
+  for (const auto& t : s.terms) {
+    L.offset.push_back(L.cols);
+    L.cols += static_cast<int>(t.term->params.size()) * (t.per_gravity ? G : 1);
+  }
+  return L;
+}
+
+/// Writes the full feature row (zeros for other gravity levels).
+void feature_row(const ModelSpec& s, const Layout& L, int gi, const TermContext& c, double* row) {
+  std::fill(row, row + L.cols, 0.0);
+  double f[8];
+  for (std::size_t i = 0; i < s.terms.size(); ++i) {
+    const auto& t = s.terms[i];
+    t.term->features(c, f);
+    const int np = static_cast<int>(t.term->params.size());
+    for (int j = 0; j < np; ++j) {
+      const int col = L.offset[i] + (t.per_gravity ? j * L.G + gi : j);
+      row[col] = f[j];
+    }
+  }
+}
+
+TermContext context(const Trial& t, std::size_t k) {
+  const auto& p = t.processed;
+  TermContext c;
+  c.z_m = p.depth_m[k];
+  c.v_m_s = p.velocity_down_m_s[k];
+  c.g_m_s2 = t.info.gravity_m_s2;
+  c.t_since_contact_s = p.t_s[k] - p.metrics.t_start_s;
+  c.fill_height_m = t.info.fill_height_m;
+  c.diameter_m = t.info.projectile_diameter_m;
+  c.mass_kg = t.info.projectile_mass_kg;
+  c.vc_m_s = p.metrics.vc_m_s;
+  return c;
+}
+
+TermContext context(const TrialInfo& i) {
+  TermContext c;
+  c.g_m_s2 = i.gravity_m_s2;
+  c.fill_height_m = i.fill_height_m;
+  c.diameter_m = i.projectile_diameter_m;
+  c.mass_kg = i.projectile_mass_kg;
+  c.vc_m_s = i.impact_velocity_m_s;
+  c.v_m_s = i.impact_velocity_m_s;
+  return c;
+}
+
+double binom_tail_half(int k, int n) {
+  // P(X >= k), X ~ Binomial(n, 1/2)
+  double p = 0;
+  for (int i = k; i <= n; ++i)
+    p += std::exp(std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) -
+                  n * std::log(2.0));
+  return std::min(1.0, p);
+}
+
+std::vector<int> fold_of(const Campaign& c, int folds, unsigned seed) {
+  // Stratified by gravity level: shuffle within each level, deal round-robin.
+  std::mt19937 rng(seed);
+  std::vector<int> idx(c.trials.size());
+  std::iota(idx.begin(), idx.end(), 0);
+  std::vector<double> key(idx.size());
+  for (auto& k : key) k = std::uniform_real_distribution<double>(0, 1)(rng);
+  std::sort(idx.begin(), idx.end(), [&](int a, int b) {
+    const double ga = c.trials[a].info.gravity_m_s2, gb = c.trials[b].info.gravity_m_s2;
+    return ga != gb ? ga > gb : key[a] < key[b];
+  });
+  std::vector<int> f(idx.size());
+  for (std::size_t r = 0; r < idx.size(); ++r) f[idx[r]] = static_cast<int>(r % folds);
+  return f;
+}
+
+}  // namespace
+
+int FittedModel::gravity_index(double g) const {
+  for (std::size_t i = 0; i < gravity_levels.size(); ++i)
+    if (std::abs(gravity_levels[i] - g) <= 1e-9 * std::max(1.0, std::abs(g))) return static_cast<int>(i);
+  return -1;
+}
+
+double FittedModel::force(const TermContext& c) const {
+  const int gi = gravity_index(c.g_m_s2);
+  if (gi < 0) throw std::invalid_argument(fmt::format("model has no gravity level {} m/s2", c.g_m_s2));
+  const Layout L = layout(spec, static_cast<int>(gravity_levels.size()));
+  std::vector<double> row(static_cast<std::size_t>(L.cols));
+  feature_row(spec, L, gi, c, row.data());
+  double r = 0;
+  for (int j = 0; j < L.cols; ++j) r += coef(j) * row[static_cast<std::size_t>(j)];
+  return r;
+}
+
+FittedModel fit_model(const ModelSpec& spec, const Campaign& c) {
+  return fit_model(spec, c, std::vector<bool>(c.trials.size(), true));
+}
+
+FittedModel fit_model(const ModelSpec& spec, const Campaign& c, const std::vector<bool>& mask) {
+  FittedModel m;
+  m.spec = spec;
+  m.gravity_levels = c.gravity_levels();
+  const int G = static_cast<int>(m.gravity_levels.size());
+  const Layout L = layout(spec, G);
+  for (std::size_t i = 0; i < spec.terms.size(); ++i) {
+    const auto& t = *spec.terms[i].term;
+    for (std::size_t j = 0; j < t.params.size(); ++j) {
+      if (spec.terms[i].per_gravity)
+        for (int gi = 0; gi < G; ++gi)
+          m.column_names.push_back(fmt::format("{}.{}@g={}", t.name, t.params[j], m.gravity_levels[gi]));
+      else
+        m.column_names.push_back(fmt::format("{}.{}", t.name, t.params[j]));
+    }
+  }
+  std::size_t rows = 0;
+  std::vector<int> used;
+  for (std::size_t ti = 0; ti < c.trials.size(); ++ti)
+    if (mask[ti] && c.trials[ti].fit_end > c.trials[ti].fit_begin) {
+      rows += c.trials[ti].fit_end - c.trials[ti].fit_begin;
+      used.push_back(static_cast<int>(ti));
+    }
+  Eigen::MatrixXd X(static_cast<Eigen::Index>(rows), L.cols);
+  Eigen::VectorXd y(static_cast<Eigen::Index>(rows)), w(static_cast<Eigen::Index>(rows));
+  std::vector<int> cluster(rows);
+  Eigen::Index r = 0;
+  std::vector<double> row(static_cast<std::size_t>(L.cols));
+  for (int ti : used) {
+    const Trial& t = c.trials[static_cast<std::size_t>(ti)];
+    const int gi = m.gravity_index(t.info.gravity_m_s2);
+    const double n_t = static_cast<double>(t.fit_end - t.fit_begin);
+    // Trials weighted equally; gravity levels put on one scale (residuals in units of g).
+    const double wt = 1.0 / (n_t * t.info.gravity_m_s2 * t.info.gravity_m_s2);
+    for (std::size_t k = t.fit_begin; k < t.fit_end; ++k, ++r) {
+      const TermContext ctx = context(t, k);
+      feature_row(spec, L, gi, ctx, row.data());
+      for (int j = 0; j < L.cols; ++j) X(r, j) = row[static_cast<std::size_t>(j)];
+      y(r) = t.info.projectile_mass_kg * (t.processed.accel_up_m_s2[k] + t.info.gravity_m_s2);
+      w(r) = wt;
+      cluster[static_cast<std::size_t>(r)] = ti;
+    }
+  }
+  m.trials_used = static_cast<int>(used.size());
+  m.samples_used = rows;
+  const Eigen::VectorXd sw = w.cwiseSqrt();
+  Eigen::MatrixXd Xw = sw.asDiagonal() * X;
+  const Eigen::VectorXd yw = sw.cwiseProduct(y);
+  Eigen::VectorXd scale(L.cols);
+  for (int j = 0; j < L.cols; ++j) {
+    const double n = Xw.col(j).norm();
+    scale(j) = n > 0 ? n : 1.0;
+    Xw.col(j) /= scale(j);
+  }
+  const Eigen::VectorXd sol = Xw.completeOrthogonalDecomposition().solve(yw);
+  m.coef = sol.cwiseQuotient(scale);
+  // Cluster-robust covariance (trials as clusters): B M B with B = (X'WX)^+.
+  const Eigen::MatrixXd B = (Xw.transpose() * Xw).completeOrthogonalDecomposition().pseudoInverse();
+  const Eigen::VectorXd res = yw - Xw * sol;
+  Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(L.cols, L.cols);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(L.cols);
+  for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(rows); ++i) {
+    u += Xw.row(i).transpose() * res(i);
+    if (i + 1 == static_cast<Eigen::Index>(rows) || cluster[static_cast<std::size_t>(i + 1)] != cluster[static_cast<std::size_t>(i)]) {
+      meat += u * u.transpose();
+      u.setZero();
+    }
+  }
+  const double Gc = std::max(2.0, static_cast<double>(used.size()));
+  const Eigen::MatrixXd covs = B * meat * B * (Gc / (Gc - 1.0));
+  const Eigen::MatrixXd Sinv = scale.cwiseInverse().asDiagonal();
+  m.cov = Sinv * covs * Sinv;
+  return m;
+}
+
+double trial_trace_mse(const FittedModel& m, const Trial& t) {
+  double s = 0;
+  std::size_t n = 0;
+  for (std::size_t k = t.fit_begin; k < t.fit_end; ++k) {
+    const TermContext ctx = context(t, k);
+    const double a_model = m.force(ctx) / t.info.projectile_mass_kg - t.info.gravity_m_s2;
+    const double r = t.processed.accel_up_m_s2[k] - a_model;
+    s += r * r;
+    ++n;
+  }
+  return n ? s / static_cast<double>(n) : NAN;
+}
+
+Prediction predict(const FittedModel& m, const TrialInfo& info) { return predict(m, context(info)); }
+
+Prediction predict(const FittedModel& m, const TermContext& c0, double t_max_s) {
+  // RK4 on (z, v), z down: dv/dt = g - R/m (Eq. 1), from z = 0, v = vc.
+  Prediction p;
+  const double g = c0.g_m_s2, mass = c0.mass_kg;
+  const double dt = std::clamp(2e-5 * std::sqrt(9.81 / g), 1e-5, 2e-4);
+  TermContext c = c0;
+  auto acc = [&](double z, double v, double t) {
+    c.z_m = z;
+    c.v_m_s = v;
+    c.t_since_contact_s = t;
+    return g - m.force(c) / mass;
+  };
+  double z = 0, v = c0.vc_m_s, t = 0;
+  double apeak = -acc(0, v, 0);
+  while (t < t_max_s) {
+    const double k1v = acc(z, v, t), k1z = v;
+    const double k2v = acc(z + 0.5 * dt * k1z, v + 0.5 * dt * k1v, t + 0.5 * dt), k2z = v + 0.5 * dt * k1v;
+    const double k3v = acc(z + 0.5 * dt * k2z, v + 0.5 * dt * k2v, t + 0.5 * dt), k3z = v + 0.5 * dt * k2v;
+    const double k4v = acc(z + dt * k3z, v + dt * k3v, t + dt), k4z = v + dt * k3v;
+    const double vn = v + dt / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+    const double zn = z + dt / 6 * (k1z + 2 * k2z + 2 * k3z + k4z);
+    if (vn <= 0) {
+      const double f = v / (v - vn);
+      p.tstop_s = t + f * dt;
+      p.zstop_m = z + f * (zn - z);
+      p.stopped = true;
+      apeak = std::max(apeak, -acc(p.zstop_m, 0.0, p.tstop_s));
+      p.apeak_m_s2 = apeak;
+      return p;
+    }
+    z = zn;
+    v = vn;
+    t += dt;
+    apeak = std::max(apeak, -acc(z, v, t));
+    if (z > 10.0 * std::max(c0.fill_height_m, c0.diameter_m)) break;
+  }
+  p.apeak_m_s2 = apeak;
+  return p;
+}
+
+HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds, unsigned seed,
+                       bool with_predictions) {
+  HeldOut h;
+  h.trace_mse.assign(c.trials.size(), NAN);
+  h.pred.assign(c.trials.size(), Prediction{});
+  const auto f = fold_of(c, folds, seed);
+  for (int k = 0; k < folds; ++k) {
+    std::vector<bool> mask(c.trials.size());
+    bool any = false;
+    for (std::size_t i = 0; i < mask.size(); ++i) {
+      mask[i] = f[i] != k;
+      any = any || !mask[i];
+    }
+    if (!any) continue;
+    const FittedModel m = fit_model(spec, c, mask);
+    for (std::size_t i = 0; i < mask.size(); ++i) {
+      if (mask[i]) continue;
+      h.trace_mse[i] = trial_trace_mse(m, c.trials[i]);
+      if (with_predictions) h.pred[i] = predict(m, c.trials[i].info);
+    }
+  }
+  return h;
+}
+
+HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds, unsigned seed) {
+  return cross_validate(spec, c, folds, seed, true);
+}
+
+ErrorSummary summarize(const Campaign& c, const HeldOut& h) {
+  ErrorSummary e;
+  double st = 0, str = 0, sz = 0, szr = 0, stt = 0, sttr = 0, sa = 0, sar = 0;
+  int nt = 0, np = 0;
+  for (std::size_t i = 0; i < c.trials.size(); ++i) {
+    const auto& t = c.trials[i];
+    const auto& m = t.processed.metrics;
+    if (std::isfinite(h.trace_mse[i])) {
+      double ref = 0;
+      std::size_t n = 0;
+      for (std::size_t k = t.fit_begin; k < t.fit_end; ++k, ++n)
+        ref += std::pow(t.processed.accel_up_m_s2[k] + t.info.gravity_m_s2, 2);
+      st += h.trace_mse[i];
+      if (n && ref > 0) str += h.trace_mse[i] / (ref / static_cast<double>(n));
+      ++nt;
+    }
+    const auto& p = h.pred[i];
+    if (p.stopped) {
+      sz += std::pow(1e3 * (p.zstop_m - m.zstop_m), 2);
+      szr += std::pow((p.zstop_m - m.zstop_m) / m.zstop_m, 2);
+      stt += std::pow(1e3 * (p.tstop_s - m.tstop_s), 2);
+      sttr += std::pow((p.tstop_s - m.tstop_s) / m.tstop_s, 2);
+      sa += std::pow(p.apeak_m_s2 - m.apeak_m_s2, 2);
+      sar += std::pow((p.apeak_m_s2 - m.apeak_m_s2) / m.apeak_m_s2, 2);
+      ++np;
+    }
+  }
+  e.trials = nt;
+  if (nt) {
+    e.trace_rms_m_s2 = std::sqrt(st / nt);
+    e.trace_rel_pct = 100 * std::sqrt(str / nt);
+  }
+  if (np) {
+    e.zstop_rms_mm = std::sqrt(sz / np);
+    e.zstop_rel_pct = 100 * std::sqrt(szr / np);
+    e.tstop_rms_ms = std::sqrt(stt / np);
+    e.tstop_rel_pct = 100 * std::sqrt(sttr / np);
+    e.apeak_rms_m_s2 = std::sqrt(sa / np);
+    e.apeak_rel_pct = 100 * std::sqrt(sar / np);
+  } else {
+    e.zstop_rms_mm = e.tstop_rms_ms = e.apeak_rms_m_s2 = NAN;
+    e.zstop_rel_pct = e.tstop_rel_pct = e.apeak_rel_pct = NAN;
+  }
+  return e;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The paper's method: Table 3
+
+namespace {
+
+std::vector<Table3Row> table3_of(const Campaign& c, const std::vector<bool>& mask) {
+  std::vector<Table3Row> rows;
+  for (double g : c.gravity_levels()) {
+    std::vector<const Trial*> ts;
+    for (std::size_t i = 0; i < c.trials.size(); ++i)
+      if (mask[i] && c.trials[i].info.gravity_m_s2 == g) ts.push_back(&c.trials[i]);
+    Table3Row r;
+    r.g_m_s2 = g;
+    r.trials = static_cast<int>(ts.size());
+    if (ts.size() < 3) {
+      rows.push_back(r);
+      continue;
+    }
+    const auto n = static_cast<Eigen::Index>(ts.size());
+    Eigen::MatrixXd X(n, 2), Xl(n, 2);
+    Eigen::VectorXd y(n), yl(n);
+    double mass = 0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const auto& m = ts[static_cast<std::size_t>(i)]->processed.metrics;
+      const auto& info = ts[static_cast<std::size_t>(i)]->info;
+      mass += info.projectile_mass_kg / static_cast<double>(n);
+      X(i, 0) = 1.0;
+      X(i, 1) = m.vc_m_s * m.vc_m_s;
+      y(i) = m.apeak_m_s2;  // Eq. 2: apeak = f0/m + vc^2/d1 - g
+      const double drop = info.drop_height_m > 0 ? info.drop_height_m : m.vc_m_s * m.vc_m_s / (2 * g);
+      Xl(i, 0) = 1.0;
+      Xl(i, 1) = std::log(drop + m.zstop_m);  // H = drop height + zstop (Fig. 10)
+      yl(i) = std::log(std::max(m.zstop_m, 1e-9));
+    }
+    auto ols = [](const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::Vector2d& beta,
+                  Eigen::Matrix2d& cov) {
+      beta = A.colPivHouseholderQr().solve(b);
+      const double dof = std::max<double>(1.0, static_cast<double>(A.rows()) - 2.0);
+      const double s2 = (b - A * beta).squaredNorm() / dof;
+      cov = s2 * (A.transpose() * A).inverse();
+    };
+    Eigen::Vector2d b, bl;
+    Eigen::Matrix2d cv, cvl;
+    ols(X, y, b, cv);
+    ols(Xl, yl, bl, cvl);
+    r.f0_N = mass * (b(0) + g);
+    r.f0_se_N = mass * std::sqrt(cv(0, 0));
+    r.inv_d1_1_m = b(1);
+    r.inv_d1_se_1_m = std::sqrt(cv(1, 1));
+    if (r.f0_N > 0 && r.inv_d1_1_m > 0) {
+      // Eq. 5: vt = sqrt(d1 f0 / m); delta method with the covariance of (f0, 1/d1).
+      r.vt_m_s = std::sqrt(r.f0_N / (mass * r.inv_d1_1_m));
+      const double var = 0.25 * r.vt_m_s * r.vt_m_s *
+                         (std::pow(r.f0_se_N / r.f0_N, 2) + std::pow(r.inv_d1_se_1_m / r.inv_d1_1_m, 2) -
+                          2 * mass * cv(0, 1) / (r.f0_N * r.inv_d1_1_m));
+      r.vt_se_m_s = std::sqrt(std::max(0.0, var));
+    }
+    r.alpha = bl(1);
+    r.alpha_se = std::sqrt(cvl(1, 1));
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+}  // namespace
+
+std::vector<Table3Row> table3(const Campaign& c) {
+  return table3_of(c, std::vector<bool>(c.trials.size(), true));
+}
+
+Prediction predict_paper(const Table3Row& row, double m, double vc) {
+  Prediction p;
+  const double g = row.g_m_s2, f0 = row.f0_N, inv_d1 = row.inv_d1_1_m;
+  p.apeak_m_s2 = f0 / m + vc * vc * inv_d1 - g;  // Eq. 2
+  if (!(f0 > m * g) || !(inv_d1 > 0)) return p;
+  const double d1 = 1.0 / inv_d1;
+  p.zstop_m = 0.5 * d1 * std::log(1.0 + m * vc * vc / (d1 * (f0 - m * g)));           // Eq. 3
+  p.tstop_s = std::atan(vc * std::sqrt(m / (d1 * (f0 - m * g)))) /
+              std::sqrt((f0 / m - g) / d1);                                            // Eq. 4
+  p.stopped = true;
+  return p;
+}
+
+HeldOut cross_validate_paper(const Campaign& c, int folds, unsigned seed) {
+  HeldOut h;
+  h.trace_mse.assign(c.trials.size(), NAN);
+  h.pred.assign(c.trials.size(), Prediction{});
+  const auto f = fold_of(c, folds, seed);
+  for (int k = 0; k < folds; ++k) {
+    std::vector<bool> mask(c.trials.size());
+    for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = f[i] != k;
+    const auto rows = table3_of(c, mask);
+    for (std::size_t i = 0; i < mask.size(); ++i) {
+      if (mask[i]) continue;
+      const auto& t = c.trials[i];
+      for (const auto& r : rows)
+        if (r.g_m_s2 == t.info.gravity_m_s2)
+          h.pred[i] = predict_paper(r, t.info.projectile_mass_kg, t.processed.metrics.vc_m_s);
+      // Trace residual of Eq. 1 with the Table 3 f0, d1 (per gravity level).
+      for (const auto& r : rows)
+        if (r.g_m_s2 == t.info.gravity_m_s2) {
+          double s = 0;
+          std::size_t n = 0;
+          for (std::size_t q = t.fit_begin; q < t.fit_end; ++q, ++n) {
+            const double v = t.processed.velocity_down_m_s[q];
+            const double a_model = r.f0_N / t.info.projectile_mass_kg + r.inv_d1_1_m * v * v - r.g_m_s2;
+            s += std::pow(t.processed.accel_up_m_s2[q] - a_model, 2);
+          }
+          if (n) h.trace_mse[i] = s / static_cast<double>(n);
+        }
+    }
+  }
+  return h;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Residuals along axes
+
+std::vector<AxisResidual> residual_axes(const FittedModel& m, const Campaign& c) {
+  struct S {
+    double r, w;
+    double x[6];
+    int trial;
+  };
+  static const char* names[6] = {"depth_m", "speed_m_s", "time_since_contact_s",
+                                 "gravity_m_s2", "impact_velocity_m_s", "fill_height_m"};
+  std::vector<S> s;
+  for (std::size_t ti = 0; ti < c.trials.size(); ++ti) {
+    const auto& t = c.trials[ti];
+    const double n = static_cast<double>(t.fit_end - t.fit_begin);
+    for (std::size_t k = t.fit_begin; k < t.fit_end; ++k) {
+      const TermContext ctx = context(t, k);
+      const double g = t.info.gravity_m_s2;
+      const double a_model = m.force(ctx) / t.info.projectile_mass_kg - g;
+      S q;
+      q.r = (t.processed.accel_up_m_s2[k] - a_model) / g;
+      q.w = 1.0 / n;
+      q.x[0] = ctx.z_m;
+      q.x[1] = ctx.v_m_s;
+      q.x[2] = ctx.t_since_contact_s;
+      q.x[3] = g;
+      q.x[4] = t.info.impact_velocity_m_s;
+      q.x[5] = t.info.fill_height_m;
+      q.trial = static_cast<int>(ti);
+      s.push_back(q);
+    }
+  }
+  std::vector<AxisResidual> out;
+  if (s.empty()) return out;
+  double W = 0, M = 0;
+  for (const auto& q : s) W += q.w, M += q.w * q.r;
+  M /= W;
+  double V = 0;
+  for (const auto& q : s) V += q.w * (q.r - M) * (q.r - M);
+  for (int a = 0; a < 6; ++a) {
+    AxisResidual ar;
+    ar.axis = names[a];
+    std::vector<std::size_t> idx(s.size());
+    std::iota(idx.begin(), idx.end(), 0);
+    std::sort(idx.begin(), idx.end(), [&](std::size_t i, std::size_t j) { return s[i].x[a] < s[j].x[a]; });
+    const int nb = 6;
+    double acc_w = 0;
+    std::size_t pos = 0;
+    double between = 0;
+    for (int b = 0; b < nb && pos < idx.size(); ++b) {
+      const double target = W * (b + 1) / nb;
+      double bw = 0, br = 0, bx = 0;
+      const double x_first = s[idx[pos]].x[a];
+      while (pos < idx.size() && (acc_w < target || b == nb - 1)) {
+        const auto& q = s[idx[pos]];
+        bw += q.w, br += q.w * q.r, bx += q.w * q.x[a];
+        acc_w += q.w;
+        ++pos;
+        // keep equal axis values together (trial-level axes)
+        while (pos < idx.size() && s[idx[pos]].x[a] == s[idx[pos - 1]].x[a] && a >= 3) {
+          const auto& q2 = s[idx[pos]];
+          bw += q2.w, br += q2.w * q2.r, bx += q2.w * q2.x[a];
+          acc_w += q2.w;
+          ++pos;
+        }
+      }
+      (void)x_first;
+      if (bw <= 0) continue;
+      ar.bin_center.push_back(bx / bw);
+      ar.bin_mean_r_over_g.push_back(br / bw);
+      between += bw * std::pow(br / bw - M, 2);
+    }
+    ar.eta2 = V > 0 ? between / V : 0;
+    if (a < 3) {
+      // Within-trial slope of r against the axis; sign test over trials.
+      std::vector<double> sx(c.trials.size()), sy(c.trials.size()), sxx(c.trials.size()),
+          sxy(c.trials.size()), sn(c.trials.size());
+      for (const auto& q : s) {
+        const auto t = static_cast<std::size_t>(q.trial);
+        sx[t] += q.x[a], sy[t] += q.r, sxx[t] += q.x[a] * q.x[a], sxy[t] += q.x[a] * q.r, sn[t] += 1;
+      }
+      for (std::size_t t = 0; t < c.trials.size(); ++t) {
+        if (sn[t] < 3) continue;
+        const double den = sn[t] * sxx[t] - sx[t] * sx[t];
+        if (den <= 0) continue;
+        const double slope = (sn[t] * sxy[t] - sx[t] * sy[t]) / den;
+        (slope > 0 ? ar.trials_positive : ar.trials_negative)++;
+      }
+      const int n = ar.trials_positive + ar.trials_negative;
+      const int k = std::max(ar.trials_positive, ar.trials_negative);
+      ar.slope_sign_trials_p = std::min(1.0, 2.0 * binom_tail_half(k, n));
+    }
+    out.push_back(ar);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Discovery
+
+namespace {
+
+bool structured(const std::vector<AxisResidual>& axes, std::string& where) {
+  const AxisResidual* best = nullptr;
+  for (const auto& a : axes) {
+    if (a.axis == "gravity_m_s2" || a.axis == "impact_velocity_m_s" || a.axis == "fill_height_m") {
+      if (a.eta2 >= 0.25 && (!best || a.eta2 > best->eta2)) best = &a;
+      continue;
+    }
+    if (a.eta2 >= 0.15 && a.slope_sign_trials_p < 1e-4 && (!best || a.eta2 > best->eta2)) best = &a;
+  }
+  if (!best) return false;
+  std::string bins;
+  for (std::size_t i = 0; i < best->bin_center.size(); ++i)
+    bins += fmt::format("{}{:.3g}:{:+.3f}", i ? ", " : "", best->bin_center[i], best->bin_mean_r_over_g[i]);
+  where = fmt::format("residual varies with {} (eta^2 = {:.2f}; mean residual/g by bin: {})",
+                      best->axis, best->eta2, bins);
+  return true;
+}
+
+}  // namespace
+
+Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds, double alpha,
+                   double min_improvement, int max_rounds) {
+  Discovery d;
+  d.baseline = baseline.name();
+  ModelSpec current = baseline;
+  d.residual_before = residual_axes(fit_model(current, c), c);
+  for (int round = 0; round < max_rounds; ++round) {
+    const HeldOut h0 = cross_validate(current, c, folds, 1, false);
+    std::vector<Candidate> cands;
+    for (const auto& term : term_registry()) {
+      bool present = false;
+      for (const auto& t : current.terms) present = present || t.term->name == term.name;
+      if (present) continue;
+      ModelSpec s = current;
+      s.terms.push_back({&term, term.per_gravity, 1.0});
+      const HeldOut h1 = cross_validate(s, c, folds, 1, false);
+      Candidate cd;
+      cd.term = term.name;
+      double sum = 0;
+      for (std::size_t i = 0; i < c.trials.size(); ++i) {
+        if (!std::isfinite(h0.trace_mse[i]) || !std::isfinite(h1.trace_mse[i]) || h0.trace_mse[i] <= 0) continue;
+        const double rel = (h0.trace_mse[i] - h1.trace_mse[i]) / h0.trace_mse[i];
+        sum += rel;
+        ++cd.trials;
+        if (rel > 0) ++cd.trials_better;
+      }
+      cd.mean_rel_improvement = cd.trials ? sum / cd.trials : 0;
+      cd.p_value = binom_tail_half(cd.trials_better, cd.trials);
+      cands.push_back(cd);
+    }
+    const double level = alpha / std::max<std::size_t>(1, cands.size());
+    for (auto& cd : cands) cd.significant = cd.p_value < level && cd.mean_rel_improvement >= min_improvement;
+    std::sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) {
+      if (a.significant != b.significant) return a.significant;
+      return a.mean_rel_improvement > b.mean_rel_improvement;
+    });
+    d.rounds.push_back(cands);
+    if (cands.empty() || !cands.front().significant) break;
+    const TermInfo& win = find_term(cands.front().term);
+    current.terms.push_back({&win, win.per_gravity, 1.0});
+    d.added.push_back(win.name);
+  }
+  d.residual_after = residual_axes(fit_model(current, c), c);
+  std::string where;
+  const bool left = structured(d.residual_after, where);
+  if (d.added.empty()) {
+    d.verdict = left ? "structure left that no candidate explains: " + where
+                     : "no missing effect found: no candidate term improves the held-out trials "
+                       "significantly and the residuals show no structure";
+  } else {
+    const auto& first = d.rounds.front().front();
+    const TermInfo& w = find_term(first.term);
+    d.verdict = fmt::format(
+        "missing effect: {} ({}); held-out trace error down {:.0f} % on average, better on {} of {} "
+        "trials (sign test p = {:.1e}); references: {}",
+        w.name, w.meaning, 100 * first.mean_rel_improvement, first.trials_better, first.trials,
+        first.p_value, w.references);
+    for (std::size_t i = 1; i < d.added.size(); ++i) d.verdict += "; then " + d.added[i];
+    if (left) d.verdict += "; structure left that no candidate explains: " + where;
+  }
+  return d;
+}
+
+}  // namespace gravsweep::results

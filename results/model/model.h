@@ -1,0 +1,127 @@
+// Collision models as sums of registered terms (term.h), their fits to measurement campaigns,
+// held-out errors, residual analysis and the ranking of candidate terms ("which effect is
+// missing"). Formulas: Sunday et al. 2021 Eqs. 1-5, shared/reference/force-laws.md 2.1-2.6.
+#pragma once
+#include <Eigen/Dense>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "results/measurements/campaign.h"
+#include "results/model/term.h"
+
+namespace gravsweep::results {
+
+struct ModelTerm {
+  const TermInfo* term = nullptr;
+  bool per_gravity = true;
+  double scale = 1.0;  ///< for synth: multiplies the term's typical values
+};
+
+struct ModelSpec {
+  std::vector<ModelTerm> terms;
+  [[nodiscard]] std::string name() const;  ///< "base+depth_friction"
+};
+
+/// Parses "base+depth_friction" (":shared" or ":per_gravity" after a name sets the sharing,
+/// "*2.5" a synth scale), or a JSON spec file ({"terms": [{"name": ..., "shared": bool,
+/// "scale": x}]}, schemas/model.schema.json). Errors name the JSON pointer.
+ModelSpec parse_model(const std::string& text_or_path);
+
+/// A model with fitted coefficients for the gravity levels of a campaign.
+struct FittedModel {
+  ModelSpec spec;
+  std::vector<double> gravity_levels;
+  std::vector<std::string> column_names;  ///< "base.f0_N@g=9.81"
+  Eigen::VectorXd coef;
+  Eigen::MatrixXd cov;  ///< cluster-robust (trials as clusters)
+  int trials_used = 0;
+  std::size_t samples_used = 0;
+  /// Resisting force R (N) at a state.
+  [[nodiscard]] double force(const TermContext& c) const;
+  [[nodiscard]] int gravity_index(double g) const;  ///< -1 when unknown
+};
+
+/// Fits the spec to the trials' fit windows (each trial weighted equally), least squares on
+/// m (a_up + g) = R(z, v). `trial_mask` (same length as campaign.trials) selects training trials.
+FittedModel fit_model(const ModelSpec& spec, const Campaign& c, const std::vector<bool>& trial_mask);
+FittedModel fit_model(const ModelSpec& spec, const Campaign& c);
+
+/// Mean squared acceleration residual (m/s2)^2 of a trial's fit window (a_meas - a_model).
+double trial_trace_mse(const FittedModel& m, const Trial& t);
+
+struct Prediction {
+  double zstop_m = NAN, tstop_s = NAN, apeak_m_s2 = NAN;
+  bool stopped = false;
+};
+/// Integrates m dv/dt = m g - R from the trial's impact speed (RK4) to the stop.
+Prediction predict(const FittedModel& m, const TrialInfo& info);
+Prediction predict(const FittedModel& m, const TermContext& trial, double t_max_s = 10.0);
+
+/// Per-trial held-out results of grouped K-fold cross-validation (whole trials held out).
+struct HeldOut {
+  std::vector<double> trace_mse;   ///< per trial
+  std::vector<Prediction> pred;    ///< per trial, from the model fitted without that trial
+};
+HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds = 6, unsigned seed = 1);
+/// The same; without predictions (trace residuals only) when with_predictions is false.
+HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds, unsigned seed,
+                       bool with_predictions);
+
+/// Summary errors against the measured metrics (RMS over trials; relative in %).
+struct ErrorSummary {
+  double trace_rms_m_s2 = 0, trace_rel_pct = 0;
+  double zstop_rms_mm = 0, zstop_rel_pct = 0;
+  double tstop_rms_ms = 0, tstop_rel_pct = 0;
+  double apeak_rms_m_s2 = 0, apeak_rel_pct = 0;
+  int trials = 0;
+};
+ErrorSummary summarize(const Campaign& c, const HeldOut& h);
+
+/// The paper's method (Sect. 4): per gravity level, Eq. 2 fitted to apeak(vc), Eqs. 3-4 predict
+/// zstop and tstop, Eq. 5 gives vt, and zstop ~ H^alpha with H = drop height + zstop.
+struct Table3Row {
+  double g_m_s2 = 0;
+  int trials = 0;
+  double f0_N = 0, f0_se_N = 0, inv_d1_1_m = 0, inv_d1_se_1_m = 0, vt_m_s = 0, vt_se_m_s = 0;
+  double alpha = 0, alpha_se = 0;
+};
+std::vector<Table3Row> table3(const Campaign& c);
+/// Eqs. 3-4 predictions for a trial from its gravity level's row (NaN when f0 <= m g).
+Prediction predict_paper(const Table3Row& row, double mass_kg, double vc_m_s);
+/// Held-out Eqs. 2-4 (Table 3 refitted without each fold).
+HeldOut cross_validate_paper(const Campaign& c, int folds = 6, unsigned seed = 1);
+
+/// Residuals along one axis: bins (quantiles) with the trial-weighted mean residual / g, and the
+/// fraction of the residual variance the binning explains (eta^2).
+struct AxisResidual {
+  std::string axis;  ///< "depth_m", "speed_m_s", "time_since_contact_s", "gravity_m_s2", ...
+  std::vector<double> bin_center, bin_mean_r_over_g;
+  double eta2 = 0;
+  double slope_sign_trials_p = 1;  ///< sign test over trials of the within-trial slope
+  int trials_positive = 0, trials_negative = 0;
+};
+std::vector<AxisResidual> residual_axes(const FittedModel& m, const Campaign& c);
+
+/// One candidate's held-out improvement over the current model.
+struct Candidate {
+  std::string term;
+  double mean_rel_improvement = 0;  ///< mean over trials of (mse0 - mse1) / mse0
+  int trials_better = 0, trials = 0;
+  double p_value = 1;  ///< one-sided sign test over trials (not samples)
+  bool significant = false;
+};
+struct Discovery {
+  std::string baseline;
+  std::vector<std::vector<Candidate>> rounds;  ///< ranking per forward step
+  std::vector<std::string> added;               ///< winners, in order
+  std::string verdict;                          ///< the sentence for users
+  std::vector<AxisResidual> residual_before, residual_after;
+};
+/// Forward selection from `baseline` over all other registered terms by grouped-CV improvement,
+/// adding a term while one is significant (sign test over trials, Bonferroni over candidates, at
+/// level alpha, and at least min_improvement mean relative gain).
+Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds = 6, double alpha = 0.01,
+                   double min_improvement = 0.03, int max_rounds = 2);
+
+}  // namespace gravsweep::results

@@ -1,0 +1,159 @@
+# Figures of `gravsweep report` / `gravsweep model fit --plot`, from the CSV files that
+# results/report/report.cpp writes into the report folder. Usage: plots.py DIR [all|errors]
+# Debian's python3-matplotlib and python3-numpy; no other dependency.
+import csv
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def read(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def num(x):
+    try:
+        v = float(x)
+        return v if math.isfinite(v) else float("nan")
+    except (TypeError, ValueError):
+        return float("nan")
+
+
+D = sys.argv[1]
+WHICH = sys.argv[2] if len(sys.argv) > 2 else "all"
+COLORS = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown"]
+written = []
+
+
+def save(fig, name):
+    p = os.path.join(D, name)
+    fig.tight_layout()
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    written.append(p)
+
+
+def plot_errors():
+    rows = read(os.path.join(D, "errors.csv"))
+    keys = [("trace_rel_pct", "trace RMS (%)"), ("zstop_rel_pct", "zstop (%)"),
+            ("tstop_rel_pct", "tstop (%)"), ("apeak_rel_pct", "apeak (%)")]
+    fig, ax = plt.subplots(figsize=(8, 4))
+    w = 0.8 / max(1, len(rows))
+    for i, r in enumerate(rows):
+        xs = [k + i * w for k in range(len(keys))]
+        ys = [num(r[k]) for k, _ in keys]
+        ax.bar(xs, ys, width=w, label=r["model"], color=COLORS[i % len(COLORS)])
+        for x, y in zip(xs, ys):
+            if math.isfinite(y):
+                ax.text(x, y, f"{y:.0f}", ha="center", va="bottom", fontsize=7)
+    ax.set_xticks([k + 0.4 - w / 2 for k in range(len(keys))])
+    ax.set_xticklabels([l for _, l in keys])
+    ax.set_ylabel("held-out relative RMS error (%)")
+    ax.set_title("Held-out error, whole trials left out (grouped CV)")
+    ax.legend(fontsize=8)
+    save(fig, "error_falls.png")
+
+
+def by_g(rows):
+    gs = sorted({num(r["gravity_m_s2"]) for r in rows}, reverse=True)
+    return gs
+
+
+def plot_fig9():
+    trials = read(os.path.join(D, "trials.csv"))
+    curves = read(os.path.join(D, "model_curves.csv"))
+    gs = by_g(trials)
+    models = []
+    for r in curves:
+        if r["model"] not in models:
+            models.append(r["model"])
+    fig, axs = plt.subplots(3, len(gs), figsize=(4 * len(gs), 9), squeeze=False)
+    for j, g in enumerate(gs):
+        t = [r for r in trials if num(r["gravity_m_s2"]) == g]
+        for i, (key, lab, sc) in enumerate([("apeak_m_s2", "apeak (m/s2)", 1), ("zstop_m", "zstop (cm)", 100),
+                                            ("tstop_s", "tstop (ms)", 1000)]):
+            ax = axs[i][j]
+            ax.plot([num(r["vc_m_s"]) for r in t], [sc * num(r[key]) for r in t], "ko", ms=3, label="measured")
+            for k, m in enumerate(models):
+                c = [r for r in curves if r["model"] == m and num(r["gravity_m_s2"]) == g]
+                ax.plot([num(r["vc_m_s"]) for r in c], [sc * num(r[key]) for r in c], "-",
+                        color=COLORS[k % len(COLORS)], label=m)
+            ax.set_xlabel("collision velocity vc (m/s)")
+            ax.set_ylabel(lab)
+            if i == 0:
+                ax.set_title(f"g = {g:g} m/s2")
+            if i == 0 and j == 0:
+                ax.legend(fontsize=7)
+    save(fig, "fig9_metrics_vs_vc.png")
+
+
+def plot_residuals():
+    rows = read(os.path.join(D, "residuals.csv"))
+    rcols = [k for k in rows[0].keys() if k.startswith("r_")]
+    gs = by_g(rows)
+    fig, axs = plt.subplots(len(rcols), 2, figsize=(10, 3.6 * len(rcols)), squeeze=False)
+    for i, rc in enumerate(rcols):
+        for j, (ax_key, lab, sc) in enumerate([("depth_m", "depth z (cm)", 100), ("speed_m_s", "speed v (m/s)", 1)]):
+            ax = axs[i][j]
+            for k, g in enumerate(gs):
+                s = [r for r in rows if num(r["gravity_m_s2"]) == g]
+                ax.plot([sc * num(r[ax_key]) for r in s], [num(r[rc]) / g for r in s], ".", ms=1.5,
+                        color=COLORS[k % len(COLORS)], label=f"g = {g:g}")
+            ax.axhline(0, color="k", lw=0.8)
+            ax.set_xlabel(lab)
+            ax.set_ylabel("residual a_meas - a_model (g)")
+            ax.set_title(rc[2:].replace("_m_s2", ""))
+            if i == 0 and j == 0:
+                ax.legend(fontsize=7, markerscale=6)
+    save(fig, "residual_vs_depth_speed.png")
+
+
+def plot_fig10():
+    trials = read(os.path.join(D, "trials.csv"))
+    gs = by_g(trials)
+    fig, ax = plt.subplots(figsize=(5.5, 4.5))
+    for k, g in enumerate(gs):
+        t = [r for r in trials if num(r["gravity_m_s2"]) == g]
+        H = [num(r["drop_height_m"]) + num(r["zstop_m"]) for r in t]
+        z = [num(r["zstop_m"]) for r in t]
+        ax.loglog([100 * h for h in H], [100 * x for x in z], "o", ms=3, color=COLORS[k % len(COLORS)],
+                  label=f"g = {g:g} m/s2")
+    ax.set_xlabel("H = drop height + zstop (cm)")
+    ax.set_ylabel("zstop (cm)")
+    ax.set_title("Penetration depth vs total height (Fig. 10)")
+    ax.legend(fontsize=8)
+    save(fig, "fig10_zstop_vs_H.png")
+
+
+def plot_ranking():
+    p = os.path.join(D, "ranking.csv")
+    if not os.path.exists(p):
+        return
+    rows = [r for r in read(p) if r["round"] == "1"]
+    if not rows:
+        return
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    names = [r["term"] for r in rows]
+    vals = [100 * num(r["mean_rel_improvement"]) for r in rows]
+    cols = ["tab:green" if r["significant"] == "1" else "tab:gray" for r in rows]
+    ax.barh(names[::-1], vals[::-1], color=cols[::-1])
+    ax.set_xlabel("mean held-out improvement of trace MSE per trial (%)")
+    ax.set_title("Candidate terms (green: significant, sign test over trials)")
+    save(fig, "ranking.png")
+
+
+if WHICH in ("all", "errors"):
+    plot_errors()
+if WHICH == "all":
+    plot_fig9()
+    plot_residuals()
+    plot_fig10()
+    plot_ranking()
+for p in written:
+    print(p)

@@ -1,0 +1,32 @@
+// Held-out comparisons of collision models (before/after tables), the data files behind the
+// report figures, and the PNG plots (results/report/plots.py, run with Debian's python3).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "results/model/model.h"
+
+namespace gravsweep::results {
+
+struct ComparedModel {
+  std::string name;  ///< "paper Eq. 2-4 (Table 3)", "base", "base+depth_friction"
+  HeldOut held_out;
+  ErrorSummary errors;
+};
+
+/// The paper's method first, then each spec, all by grouped K-fold CV on whole trials.
+std::vector<ComparedModel> compare_models(const Campaign& c, const std::vector<ModelSpec>& specs,
+                                          int folds = 6);
+
+/// Writes the CSV files the plots read into `dir`: trials.csv (metrics and held-out predictions
+/// of every compared model), residuals.csv (fit-window samples with residuals of the first and
+/// last spec), errors.csv, ranking.csv, table3.csv, model_curves.csv (metrics vs vc per g).
+void write_report_data(const std::string& dir, const Campaign& c,
+                       const std::vector<ComparedModel>& compared,
+                       const std::vector<ModelSpec>& specs, const Discovery* discovery);
+
+/// Runs the plotting script on `dir` (writes the PNGs there); returns the script's exit status
+/// and fills `log` with its output.
+int run_plots(const std::string& dir, const std::string& which, std::string& log);
+
+}  // namespace gravsweep::results

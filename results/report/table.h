@@ -1,0 +1,75 @@
+// A small table for CLI output: aligned text, CSV or JSON (`--format table|csv|json`).
+#pragma once
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace gravsweep::results {
+
+class Table {
+ public:
+  explicit Table(std::vector<std::string> columns) : cols_(std::move(columns)) {}
+  void add(std::vector<std::string> row) {
+    row.resize(cols_.size());
+    rows_.push_back(std::move(row));
+  }
+  [[nodiscard]] std::string render(const std::string& format) const {
+    std::string out;
+    if (format == "csv") {
+      for (std::size_t j = 0; j < cols_.size(); ++j) out += (j ? "," : "") + cols_[j];
+      out += "\n";
+      for (const auto& r : rows_) {
+        for (std::size_t j = 0; j < r.size(); ++j) out += (j ? "," : "") + r[j];
+        out += "\n";
+      }
+    } else if (format == "json") {
+      nlohmann::json a = nlohmann::json::array();
+      for (const auto& r : rows_) {
+        nlohmann::json o;
+        for (std::size_t j = 0; j < r.size(); ++j) {
+          double d;
+          char* end = nullptr;
+          d = std::strtod(r[j].c_str(), &end);
+          if (!r[j].empty() && end && *end == '\0' && std::isfinite(d)) o[cols_[j]] = d;
+          else o[cols_[j]] = r[j];
+        }
+        a.push_back(o);
+      }
+      out = a.dump(2) + "\n";
+    } else if (format == "table") {
+      std::vector<std::size_t> w(cols_.size());
+      for (std::size_t j = 0; j < cols_.size(); ++j) w[j] = cols_[j].size();
+      for (const auto& r : rows_)
+        for (std::size_t j = 0; j < r.size(); ++j) w[j] = std::max(w[j], r[j].size());
+      auto line = [&](const std::vector<std::string>& r) {
+        for (std::size_t j = 0; j < r.size(); ++j)
+          out += (j ? "  " : "") + (j == 0 ? fmt::format("{:<{}}", r[j], w[j]) : fmt::format("{:>{}}", r[j], w[j]));
+        out += "\n";
+      };
+      line(cols_);
+      for (const auto& r : rows_) line(r);
+    } else {
+      throw std::invalid_argument(fmt::format("--format '{}': expected table, csv or json", format));
+    }
+    return out;
+  }
+  void print(const std::string& format) const { std::fputs(render(format).c_str(), stdout); }
+
+ private:
+  std::vector<std::string> cols_;
+  std::vector<std::vector<std::string>> rows_;
+};
+
+inline std::string num(double x, int prec = 4) {
+  if (!std::isfinite(x)) return "nan";
+  return fmt::format("{:.{}g}", x, prec);
+}
+
+}  // namespace gravsweep::results

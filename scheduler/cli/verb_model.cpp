@@ -1,0 +1,209 @@
+// `gravsweep model`: collision models as sums of named terms, compared with a measurement
+// campaign. Sub-verbs: terms, table3 (the paper's method), fit (before/after), rank (which
+// effect is missing).
+#include <fmt/format.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "results/model/model.h"
+#include "results/report/report.h"
+#include "results/report/table.h"
+#include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/verbs.h"
+
+namespace gravsweep::cli {
+
+namespace {
+
+using results::num;
+
+struct ModelOptions {
+  std::string dir;
+  std::string model = "base+depth_friction";
+  std::string baseline = "base";
+  std::string format = "table";
+  std::string plot;
+  int folds = 6;
+  double alpha = 0.01;
+  double min_improvement = 0.03;
+};
+
+results::Campaign load(const std::string& dir) {
+  try {
+    auto c = results::load_campaign(dir);
+    for (const auto& is : c.issues) std::fprintf(stderr, "warning: skipped %s/%s\n", dir.c_str(), is.to_string().c_str());
+    if (c.trials.size() < 6)
+      throw UsageError(fmt::format("{}: only {} usable trials; at least 6 are needed", dir, c.trials.size()));
+    return c;
+  } catch (const std::runtime_error& e) {
+    if (dynamic_cast<const UsageError*>(&e)) throw;
+    throw UsageError(e.what());
+  }
+}
+
+results::ModelSpec spec_of(const std::string& s) {
+  try {
+    return results::parse_model(s);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+}
+
+void print_params(const results::FittedModel& m, const std::string& format) {
+  results::Table t({"parameter", "value", "std_error", "unit_note"});
+  for (Eigen::Index j = 0; j < m.coef.size(); ++j)
+    t.add({m.column_names[static_cast<std::size_t>(j)], num(m.coef(j)), num(std::sqrt(std::max(0.0, m.cov(j, j))), 2),
+           "SE cluster-robust over trials"});
+  t.print(format);
+}
+
+results::Table error_table(const std::vector<results::ComparedModel>& cm) {
+  results::Table t({"model", "trace_rms_m_s2", "trace_rel_pct", "zstop_rms_mm", "zstop_rel_pct",
+                    "tstop_rms_ms", "tstop_rel_pct", "apeak_rms_m_s2", "apeak_rel_pct", "trials"});
+  for (const auto& m : cm) {
+    const auto& e = m.errors;
+    t.add({m.name, num(e.trace_rms_m_s2, 3), num(e.trace_rel_pct, 3), num(e.zstop_rms_mm, 3), num(e.zstop_rel_pct, 3),
+           num(e.tstop_rms_ms, 3), num(e.tstop_rel_pct, 3), num(e.apeak_rms_m_s2, 3), num(e.apeak_rel_pct, 3),
+           std::to_string(e.trials)});
+  }
+  return t;
+}
+
+void print_axes(const std::vector<results::AxisResidual>& axes, const std::string& format) {
+  results::Table t({"axis", "eta2", "trials_slope_up", "trials_slope_down", "sign_test_p", "mean_residual_over_g_by_bin"});
+  for (const auto& a : axes) {
+    std::string bins;
+    for (std::size_t i = 0; i < a.bin_center.size(); ++i)
+      bins += fmt::format("{}{:.3g}:{:+.3f}", i ? " " : "", a.bin_center[i], a.bin_mean_r_over_g[i]);
+    const bool trial_level = a.trials_positive + a.trials_negative == 0;
+    t.add({a.axis, num(a.eta2, 3), trial_level ? "-" : std::to_string(a.trials_positive),
+           trial_level ? "-" : std::to_string(a.trials_negative), trial_level ? "-" : num(a.slope_sign_trials_p, 2), bins});
+  }
+  t.print(format);
+}
+
+void print_ranking(const results::Discovery& d, const std::string& format) {
+  results::Table t({"round", "rank", "term", "mean_rel_improvement_pct", "trials_better", "trials", "p_sign_test", "significant"});
+  for (std::size_t r = 0; r < d.rounds.size(); ++r)
+    for (std::size_t i = 0; i < d.rounds[r].size(); ++i) {
+      const auto& c = d.rounds[r][i];
+      t.add({std::to_string(r + 1), std::to_string(i + 1), c.term, num(100 * c.mean_rel_improvement, 3),
+             std::to_string(c.trials_better), std::to_string(c.trials), num(c.p_value, 2), c.significant ? "yes" : "no"});
+    }
+  t.print(format);
+}
+
+}  // namespace
+
+void setup_model(CLI::App& app) {
+  auto* sub = app.add_subcommand(
+      "model",
+      "Collision models m dv/dt = m g - R(z, v, g) as sums of named terms, compared with a\n"
+      "measurement campaign. Run `gravsweep model terms` for the term library.");
+  sub->require_subcommand(1);
+
+  auto* terms = sub->add_subcommand("terms", "List the registered model terms.\n\nExample:\n  gravsweep model terms");
+  auto tf = std::make_shared<std::string>("table");
+  terms->add_option("--format", *tf, "table, csv or json")->capture_default_str();
+  terms->callback([tf]() {
+    results::Table t({"term", "parameters", "default_sharing", "meaning", "references"});
+    for (const auto& r : results::term_registry()) {
+      std::string p;
+      for (const auto& x : r.params) p += (p.empty() ? "" : " ") + x;
+      t.add({r.name, p, r.per_gravity ? "per_gravity" : "shared", r.meaning, r.references});
+    }
+    t.print(*tf);
+  });
+
+  auto o3 = std::make_shared<ModelOptions>();
+  auto* t3 = sub->add_subcommand(
+      "table3",
+      "The paper's method (Sunday et al. 2021 Sect. 4): per gravity level fit Eq. 2 to apeak(vc),\n"
+      "print f0, 1/d1, vt (Eq. 5) and alpha (zstop ~ H^alpha) with standard errors, as Table 3.\n\n"
+      "Example:\n  gravsweep model table3 ../shared/data/measurements/depth-friction-dev");
+  t3->add_option("dir", o3->dir, "campaign folder")->required();
+  t3->add_option("--format", o3->format, "table, csv or json")->capture_default_str();
+  t3->callback([o3]() {
+    const auto c = load(o3->dir);
+    results::Table t({"gravity_m_s2", "trials", "f0_N", "f0_se_N", "inv_d1_1_m", "inv_d1_se_1_m", "vt_m_s",
+                      "vt_se_m_s", "alpha", "alpha_se"});
+    for (const auto& r : results::table3(c))
+      t.add({num(r.g_m_s2), std::to_string(r.trials), num(r.f0_N, 3), num(r.f0_se_N, 2), num(r.inv_d1_1_m, 3),
+             num(r.inv_d1_se_1_m, 2), num(r.vt_m_s, 3), num(r.vt_se_m_s, 2), num(r.alpha, 3), num(r.alpha_se, 2)});
+    t.print(o3->format);
+  });
+
+  auto of = std::make_shared<ModelOptions>();
+  auto* fit = sub->add_subcommand(
+      "fit",
+      "Fit a model to the traces (least squares on m (a + g) = R(z, v) over each collision, clear\n"
+      "of the filter's transient, trials weighted equally, standard errors cluster-robust over\n"
+      "trials), then print the held-out errors (whole trials left out, grouped K-fold) of the\n"
+      "paper's Eq. 2-4, the baseline and the model side by side: trace RMS, zstop, tstop, apeak.\n\n"
+      "Examples:\n"
+      "  gravsweep model fit ../shared/data/measurements/depth-friction-dev --model base+depth_friction\n"
+      "  gravsweep model fit DIR --model spec.json --plot error_falls.png --format csv");
+  fit->add_option("dir", of->dir, "campaign folder")->required();
+  fit->add_option("--model", of->model, "model: 'base+depth_friction' or a JSON spec file")->capture_default_str();
+  fit->add_option("--baseline", of->baseline, "the 'before' model")->capture_default_str();
+  fit->add_option("--folds", of->folds, "cross-validation folds (whole trials)")->check(CLI::Range(2, 100))->capture_default_str();
+  fit->add_option("--plot", of->plot, "write the error-falling figure (PNG) here");
+  fit->add_option("--format", of->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
+  fit->callback([of]() {
+    const auto c = load(of->dir);
+    const auto base = spec_of(of->baseline);
+    const auto spec = spec_of(of->model);
+    const auto fm = results::fit_model(spec, c);
+    if (of->format == "table") fmt::print("Model {} fitted on {} trials ({} samples):\n", spec.name(), fm.trials_used, fm.samples_used);
+    print_params(fm, of->format);
+    const auto cm = results::compare_models(c, {base, spec}, of->folds);
+    if (of->format == "table") fmt::print("\nHeld-out errors ({}-fold grouped CV, whole trials held out), before and after:\n", of->folds);
+    error_table(cm).print(of->format);
+    if (!of->plot.empty()) {
+      namespace fs = std::filesystem;
+      const fs::path png = fs::absolute(of->plot);
+      const fs::path tmp = png.parent_path() / (png.stem().string() + "_data");
+      results::write_report_data(tmp.string(), c, cm, {base, spec}, nullptr);
+      std::string log;
+      if (results::run_plots(tmp.string(), "errors", log) != 0) throw std::runtime_error("plotting failed: " + log);
+      fs::copy_file(tmp / "error_falls.png", png, fs::copy_options::overwrite_existing);
+      std::fprintf(stderr, "wrote %s (data in %s)\n", png.c_str(), tmp.c_str());
+    }
+  });
+
+  auto orank = std::make_shared<ModelOptions>();
+  auto* rank = sub->add_subcommand(
+      "rank",
+      "Which effect is missing: fit the baseline, show where it fails (residuals against depth,\n"
+      "speed, time since contact, gravity, impact speed, fill height), then rank every other\n"
+      "registered term by its held-out improvement with whole trials left out (grouped CV) and\n"
+      "a sign test over trials (not samples), Bonferroni over candidates. Adds the winner and\n"
+      "repeats while a term is significant, then says which effect is missing, 'no missing\n"
+      "effect found', or 'structure left that no candidate explains' with where it lies.\n\n"
+      "Example:\n  gravsweep model rank ../shared/data/measurements/depth-friction-dev");
+  rank->alias("discover");
+  rank->add_option("dir", orank->dir, "campaign folder")->required();
+  rank->add_option("--baseline", orank->baseline, "starting model")->capture_default_str();
+  rank->add_option("--folds", orank->folds, "cross-validation folds")->check(CLI::Range(2, 100))->capture_default_str();
+  rank->add_option("--alpha", orank->alpha, "family-wise significance level")->capture_default_str();
+  rank->add_option("--min-improvement", orank->min_improvement, "minimum mean relative improvement")->capture_default_str();
+  rank->add_option("--format", orank->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
+  rank->callback([orank]() {
+    const auto c = load(orank->dir);
+    const auto base = spec_of(orank->baseline);
+    const auto d = results::discover(c, base, orank->folds, orank->alpha, orank->min_improvement);
+    if (orank->format == "table") fmt::print("Where {} fails (residual a_meas - a_model in units of g):\n", d.baseline);
+    print_axes(d.residual_before, orank->format);
+    if (orank->format == "table") fmt::print("\nCandidate terms by held-out improvement:\n");
+    print_ranking(d, orank->format);
+    if (orank->format == "table") fmt::print("\nVerdict: {}\n", d.verdict);
+    else std::fprintf(stderr, "verdict: %s\n", d.verdict.c_str());
+  });
+}
+
+}  // namespace gravsweep::cli

@@ -1,0 +1,122 @@
+// `gravsweep report DIR --out REPORT`: the figures and the summary page of a model-vs-measurement
+// comparison: Fig. 9 with model lines, residuals against depth and speed coloured by gravity,
+// zstop against H (Fig. 10), the candidate ranking and the error falling.
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include "results/model/model.h"
+#include "results/report/report.h"
+#include "results/report/table.h"
+#include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/verbs.h"
+
+namespace gravsweep::cli {
+
+namespace {
+struct ReportOptions {
+  std::string dir, out = "report", baseline = "base", model;
+  int folds = 6;
+};
+}  // namespace
+
+void setup_report(CLI::App& app) {
+  auto o = std::make_shared<ReportOptions>();
+  auto* sub = app.add_subcommand(
+      "report",
+      "Compare collision models with a measurement campaign and write PNG figures and a summary\n"
+      "page (summary.md) into --out: fig9_metrics_vs_vc.png (apeak, zstop, tstop vs vc with the\n"
+      "model lines), residual_vs_depth_speed.png (coloured by gravity), fig10_zstop_vs_H.png,\n"
+      "ranking.png and error_falls.png, plus the CSV files behind them. Without --model the\n"
+      "missing effect is searched for (as `gravsweep model rank`) and the winner is added.\n\n"
+      "Example:\n"
+      "  gravsweep report ../shared/data/measurements/depth-friction-dev --out report-dev");
+  sub->add_option("dir", o->dir, "campaign folder")->required();
+  sub->add_option("--out", o->out, "report folder")->capture_default_str();
+  sub->add_option("--baseline", o->baseline, "the 'before' model")->capture_default_str();
+  sub->add_option("--model", o->model, "the 'after' model (default: baseline + discovered terms)");
+  sub->add_option("--folds", o->folds, "cross-validation folds")->check(CLI::Range(2, 100))->capture_default_str();
+  sub->callback([o]() {
+    results::Campaign c;
+    try {
+      c = results::load_campaign(o->dir);
+    } catch (const std::runtime_error& e) {
+      throw UsageError(e.what());
+    }
+    for (const auto& is : c.issues) std::fprintf(stderr, "warning: skipped %s/%s\n", o->dir.c_str(), is.to_string().c_str());
+    if (c.trials.size() < 6) throw UsageError(fmt::format("{}: only {} usable trials", o->dir, c.trials.size()));
+    results::ModelSpec base, after;
+    try {
+      base = results::parse_model(o->baseline);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
+    const auto d = results::discover(c, base, o->folds);
+    if (!o->model.empty()) {
+      try {
+        after = results::parse_model(o->model);
+      } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
+      }
+    } else {
+      after = base;
+      for (const auto& n : d.added) {
+        const auto& t = results::find_term(n);
+        after.terms.push_back({&t, t.per_gravity, 1.0});
+      }
+    }
+    std::vector<results::ModelSpec> specs{base};
+    if (after.name() != base.name()) specs.push_back(after);
+    const auto cm = results::compare_models(c, specs, o->folds);
+    results::write_report_data(o->out, c, cm, specs, &d);
+    std::string log;
+    const int rc = results::run_plots(o->out, "all", log);
+    if (rc != 0) throw std::runtime_error("plotting failed (python3 with matplotlib needed): " + log);
+    // Summary page.
+    namespace fs = std::filesystem;
+    std::ofstream md(fs::path(o->out) / "summary.md");
+    md << fmt::format("# Model vs measurements: {}\n\n", o->dir);
+    md << fmt::format("{} trials, gravity levels:", c.trials.size());
+    for (double g : c.gravity_levels()) md << fmt::format(" {} m/s2", g);
+    md << fmt::format(". {} rejected.\n\n## Verdict\n\n{}\n\n", c.issues.size(), d.verdict);
+    md << "## Table 3 (paper's method: Eq. 2 fitted to apeak per gravity level)\n\n```\n";
+    {
+      results::Table t({"gravity_m_s2", "trials", "f0_N", "f0_se_N", "inv_d1_1_m", "inv_d1_se_1_m", "vt_m_s", "alpha", "alpha_se"});
+      for (const auto& r : results::table3(c))
+        t.add({results::num(r.g_m_s2), std::to_string(r.trials), results::num(r.f0_N, 3), results::num(r.f0_se_N, 2),
+               results::num(r.inv_d1_1_m, 3), results::num(r.inv_d1_se_1_m, 2), results::num(r.vt_m_s, 3),
+               results::num(r.alpha, 3), results::num(r.alpha_se, 2)});
+      md << t.render("table");
+    }
+    md << "```\n\n## Held-out errors (grouped CV, whole trials held out)\n\n```\n";
+    {
+      results::Table t({"model", "trace_rel_pct", "zstop_rms_mm", "zstop_rel_pct", "tstop_rms_ms", "tstop_rel_pct", "apeak_rel_pct"});
+      for (const auto& m : cm)
+        t.add({m.name, results::num(m.errors.trace_rel_pct, 3), results::num(m.errors.zstop_rms_mm, 3),
+               results::num(m.errors.zstop_rel_pct, 3), results::num(m.errors.tstop_rms_ms, 3),
+               results::num(m.errors.tstop_rel_pct, 3), results::num(m.errors.apeak_rel_pct, 3)});
+      md << t.render("table");
+    }
+    md << "```\n\n## Candidate ranking\n\n```\n";
+    {
+      results::Table t({"round", "term", "mean_rel_improvement_pct", "trials_better", "trials", "p_sign_test", "significant"});
+      for (std::size_t r = 0; r < d.rounds.size(); ++r)
+        for (const auto& cd : d.rounds[r])
+          t.add({std::to_string(r + 1), cd.term, results::num(100 * cd.mean_rel_improvement, 3),
+                 std::to_string(cd.trials_better), std::to_string(cd.trials), results::num(cd.p_value, 2),
+                 cd.significant ? "yes" : "no"});
+      md << t.render("table");
+    }
+    md << "```\n\n## Figures\n\n";
+    for (const char* png : {"fig9_metrics_vs_vc.png", "residual_vs_depth_speed.png", "fig10_zstop_vs_H.png",
+                            "ranking.png", "error_falls.png"})
+      md << fmt::format("![{}]({})\n\n", png, png);
+    fmt::print("{}", log);
+    fmt::print("{}\nverdict: {}\n", (fs::path(o->out) / "summary.md").string(), d.verdict);
+  });
+}
+
+}  // namespace gravsweep::cli

@@ -1,0 +1,236 @@
+#include "scheduler/pipeline/impact_job.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "engine/core/error.h"
+#include "engine/scenario/bed.h"
+#include "engine/scenario/impact.h"
+#include "engine/scenario/paper_params.h"
+#include "results/io/bed_file.h"
+#include "results/io/trace_file.h"
+#include "results/processing/trace.h"
+#include "scheduler/pipeline/scenario_spec.h"
+
+#ifndef GRAVSWEEP_VERSION
+#define GRAVSWEEP_VERSION "unknown"
+#endif
+
+namespace gravsweep::pipeline {
+
+using nlohmann::json;
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void check_stop(const std::atomic<bool>* stop, const char* what) {
+  if (stop && stop->load(std::memory_order_relaxed)) throw Interrupted(fmt::format("{} interrupted", what));
+}
+
+json bed_key_of_validated(const json& s) {
+  json k;
+  k["bed_format_version"] = results::kBedFormatVersion;
+  k["container"] = s.at("container");
+  k["grains"] = s.at("grains");
+  k["gravity_m_s2"] = s.at("gravity_m_s2");
+  k["materials"] = s.at("materials");
+  k["contact"] = s.at("contact");
+  k["integrator"] = s.at("integrator");
+  k["bed"] = s.at("bed");
+  return k;
+}
+
+/// JSON pointer of the first difference between two keys, for messages.
+std::string first_difference(const json& a, const json& b) {
+  const json patch = json::diff(a, b);
+  return patch.empty() ? std::string() : patch[0].value("path", std::string("/"));
+}
+
+}  // namespace
+
+json bed_key(const json& scenario) { return bed_key_of_validated(validate_scenario(scenario)); }
+
+BedJobResult run_bed_job(const json& scenario, const std::filesystem::path& bed_out, int threads,
+                         const Progress& progress, const std::atomic<bool>* stop) {
+  const json s = validate_scenario(scenario);
+  ScenarioParams p = scenario_params(s);
+  check_stop(stop, "bed preparation");
+  if (threads > 0) p.bed_config.threads = threads;
+  const auto t0 = std::chrono::steady_clock::now();
+  System sys(p.bed_config);
+  // Sect. 2.2: mix and settle, flatten, relax; the relaxation is reported as part of "flatten".
+  const BedReport rep = prepare_bed(sys, p.bed, [&](BedPhase ph, double f, const std::string& d) {
+    check_stop(stop, "bed preparation");
+    if (!progress) return;
+    if (ph == BedPhase::relax) progress("flatten", f, "relaxing the surface: " + d);
+    else progress(to_string(ph), f, d);
+  });
+  const double wall_s = seconds_since(t0);
+
+  results::BedData b;
+  const auto& pt = sys.particles;
+  for (std::size_t i = 0; i < pt.size(); ++i) {
+    if (pt.size_class[i] != SizeClass::grain) continue;
+    for (int k = 0; k < 3; ++k) {
+      b.position_m.push_back(pt.position_m[i][k]);
+      b.velocity_m_s.push_back(pt.velocity_m_s[i][k]);
+      b.omega_rad_s.push_back(pt.omega_rad_s[i][k]);
+    }
+    b.radius_m.push_back(pt.radius_m[i]);
+    b.mass_kg.push_back(pt.mass_kg[i]);
+    b.material.push_back(pt.material[i]);
+  }
+  double wall_h = 0;
+  for (const auto& w : sys.walls)
+    if (w.kind == WallKind::cylinder) wall_h = w.height_m;
+  b.container_diameter_m = p.bed.container.diameter_m;
+  b.wall_height_m = wall_h;
+  b.fill_height_m = p.bed.fill_height_m;
+  b.surface_height_m = rep.surface_height_m;
+  b.gravity_m_s2 = p.gravity_m_s2;
+  b.time_s = sys.time_s();
+  b.code_version = GRAVSWEEP_VERSION;
+  b.bed_key_json = bed_key_of_validated(s).dump();
+  b.scenario_json = s.dump();
+  json report{{"grains_placed", rep.grains_placed},
+              {"grains_kept", rep.grains_kept},
+              {"settled", rep.settled},
+              {"settle_time_s", rep.settle_time_s},
+              {"relax_time_s", rep.relax_time_s},
+              {"rms_speed_m_s", rep.rms_speed_m_s},
+              {"max_speed_m_s", rep.max_speed_m_s},
+              {"surface_height_m", rep.surface_height_m},
+              {"bulk_density_kg_m3", rep.bulk_density_kg_m3},
+              {"steps", sys.step_count()},
+              {"dt_s", sys.config().dt_s},
+              {"threads", sys.threads()},
+              {"wall_time_s", wall_s}};
+  b.report_json = report.dump();
+  check_stop(stop, "bed preparation");
+  results::write_bed(bed_out, b);
+  return BedJobResult{bed_out, report};
+}
+
+DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& bed_in,
+                           const std::filesystem::path& trace_out, int threads, const Progress& progress,
+                           const std::atomic<bool>* stop) {
+  const json s = validate_scenario(scenario);
+  ScenarioParams p = scenario_params(s);
+  if (threads > 0) p.drop_config.threads = threads;
+  const results::BedData bed = results::read_bed(bed_in);
+  const json want = bed_key_of_validated(s);
+  json have;
+  try {
+    have = json::parse(bed.bed_key_json);
+  } catch (const json::exception&) {
+    throw ConfigError(fmt::format("bed {}: the bed_key attribute is not valid JSON", bed_in.string()));
+  }
+  if (have != want)
+    throw ConfigError(fmt::format(
+        "bed {} was prepared for another scenario: its bed key differs at {} (found {}, the scenario "
+        "needs {}); prepare a bed for this scenario (omit --bed)",
+        bed_in.string(), first_difference(have, want),
+        have.contains(json::json_pointer(first_difference(have, want)))
+            ? have[json::json_pointer(first_difference(have, want))].dump()
+            : "nothing",
+        want.contains(json::json_pointer(first_difference(have, want)))
+            ? want[json::json_pointer(first_difference(have, want))].dump()
+            : "nothing"));
+  check_stop(stop, "drop");
+  const auto t0 = std::chrono::steady_clock::now();
+
+  // Rebuild the bed in a fresh system: bit-exact state, no contact history (as after any restart).
+  System sys(p.drop_config);
+  for (std::size_t i = 0; i < bed.size(); ++i) {
+    const Vec3 x(bed.position_m[3 * i], bed.position_m[3 * i + 1], bed.position_m[3 * i + 2]);
+    const ParticleIndex k = sys.particles.add(x, bed.radius_m[i], bed.mass_kg[i], bed.material[i], SizeClass::grain);
+    sys.particles.velocity_m_s[k] = Vec3(bed.velocity_m_s[3 * i], bed.velocity_m_s[3 * i + 1], bed.velocity_m_s[3 * i + 2]);
+    sys.particles.omega_rad_s[k] = Vec3(bed.omega_rad_s[3 * i], bed.omega_rad_s[3 * i + 1], bed.omega_rad_s[3 * i + 2]);
+    sys.particles.eval_velocity_m_s[k] = sys.particles.velocity_m_s[k];
+    sys.particles.eval_omega_rad_s[k] = sys.particles.omega_rad_s[k];
+  }
+  ContainerSpec cs;
+  cs.diameter_m = bed.container_diameter_m;
+  add_container_walls(sys, cs, bed.wall_height_m, kWallMaterial);
+
+  const DropResult dr = drop_projectile(sys, bed.surface_height_m, p.projectile, p.stop, p.sample_rate_hz,
+                                        [&](double f, const std::string& d) {
+                                          check_stop(stop, "drop");
+                                          if (progress) progress("drop", f, d);
+                                        });
+  const double wall_s = seconds_since(t0);
+
+  results::TraceData td;
+  for (const auto& smp : dr.samples) {
+    td.t_s.push_back(smp.t_s);
+    td.depth_m.push_back(smp.depth_m);
+    td.velocity_down_m_s.push_back(smp.velocity_down_m_s);
+    td.accel_up_m_s2.push_back(smp.accel_up_m_s2);
+    for (int k = 0; k < 3; ++k) {
+      td.omega_rad_s.push_back(smp.omega_rad_s[k]);
+      td.position_m.push_back(smp.position_m[k]);
+    }
+    td.contacts.push_back(smp.contacts);
+    td.grain_kinetic_energy_J.push_back(smp.grain_kinetic_energy_J);
+  }
+  const double sample_dt = dr.samples.size() > 1 ? dr.samples[1].t_s - dr.samples[0].t_s : 1.0 / p.sample_rate_hz;
+  td.sample_rate_hz = 1.0 / sample_dt;
+  td.dt_s = p.drop_config.dt_s;
+  td.gravity_m_s2 = p.gravity_m_s2;
+  td.surface_height_m = bed.surface_height_m;
+  td.release_height_m = dr.release_height_m;
+  td.release_speed_m_s = dr.release_speed_m_s;
+  td.projectile_diameter_m = p.projectile.diameter_m;
+  td.projectile_mass_kg = p.projectile.mass_kg;
+  td.fill_height_m = bed.surface_height_m;
+  td.grain_diameter_m = p.bed.grains.diameter_m;
+  td.stopped = dr.stopped;
+  td.scenario_json = s.dump();
+  td.bed_key_json = want.dump();
+  td.bed_file = std::filesystem::absolute(bed_in).string();
+  td.code_version = GRAVSWEEP_VERSION;
+
+  // Sect. 2.3: Butterworth 500 Hz, start = end of free fall, end = a below 0.1 g.
+  results::MetricOptions mo = p.metric_options;
+  mo.fill_height_m = bed.surface_height_m;  // the floor lies this far below the mean surface
+  json m;
+  try {
+    const results::Metrics r = results::compute_metrics(td.to_trace(), mo);
+    m = json{{"vc_m_s", r.vc_m_s},     {"apeak_m_s2", r.apeak_m_s2}, {"zstop_m", r.zstop_m},
+             {"tstop_s", r.tstop_s},   {"t_start_s", r.t_start_s},   {"t_end_s", r.t_end_s},
+             {"rebound", r.rebound},   {"note", r.note}};
+  } catch (const std::exception& e) {
+    m = json{{"vc_m_s", nullptr},  {"apeak_m_s2", nullptr}, {"zstop_m", nullptr}, {"tstop_s", nullptr},
+             {"t_start_s", nullptr}, {"t_end_s", nullptr}, {"rebound", nullptr},
+             {"metrics_error", e.what()}};
+  }
+  double max_depth = -1e300;
+  for (double z : td.depth_m) max_depth = std::max(max_depth, z);
+  m["max_depth_m"] = max_depth;
+  m["final_depth_m"] = td.depth_m.empty() ? 0.0 : td.depth_m.back();
+  m["first_contact_s"] = dr.first_contact_s ? json(*dr.first_contact_s) : json(nullptr);
+  m["stopped"] = dr.stopped;
+  m["simulated_time_s"] = td.t_s.empty() ? 0.0 : td.t_s.back();
+  m["steps"] = dr.steps;
+  m["dt_s"] = td.dt_s;
+  m["sample_rate_hz"] = td.sample_rate_hz;
+  m["gravity_m_s2"] = p.gravity_m_s2;
+  m["grains"] = bed.size();
+  m["surface_height_m"] = bed.surface_height_m;
+  m["release_speed_m_s"] = dr.release_speed_m_s;
+  m["release_height_above_surface_m"] = dr.release_height_m - bed.surface_height_m;
+  m["lateral_offset_m"] = std::hypot(p.projectile.lateral_offset_x_m, p.projectile.lateral_offset_y_m);
+  m["threads"] = sys.threads();
+  m["wall_time_s"] = wall_s;
+  td.metrics_json = m.dump();
+  check_stop(stop, "drop");
+  results::write_trace(trace_out, td);
+  return DropJobResult{trace_out, m};
+}
+
+}  // namespace gravsweep::pipeline

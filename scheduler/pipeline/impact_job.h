@@ -1,0 +1,54 @@
+// Job-level API of one impact (Sunday et al. 2021 Sect. 2.2-2.3): prepare a bed and save it
+// (bed.h5), drop the projectile into a saved bed, record the trace (trace.h5) and compute the
+// paper's metrics. Used by `gravsweep run` and by the queue's worker processes. Beds are shared
+// between drops whose bed_key() is equal (the paper's repeats: same bed, other speeds/offsets).
+#pragma once
+#include <atomic>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+
+#include "scheduler/pipeline/json_schema.h"
+
+namespace gravsweep::pipeline {
+
+/// progress(phase, fraction of the phase in [0, 1], detail); phases: fill, settle, flatten, drop.
+using Progress = std::function<void(const std::string& phase, double fraction, const std::string& detail)>;
+
+/// The `stop` flag was raised; the job left no output file behind.
+class Interrupted : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct BedJobResult {
+  std::filesystem::path bed_path;
+  nlohmann::json report;  ///< grains_placed, grains_kept, settled, surface_height_m, bulk_density_kg_m3, wall_time_s, ...
+};
+
+struct DropJobResult {
+  std::filesystem::path trace_path;
+  nlohmann::json metrics;  ///< vc_m_s, apeak_m_s2, zstop_m, tstop_s, rebound, wall_time_s, ...
+};
+
+/// Validates `scenario` (throws SpecError, a ConfigError, with the JSON pointer on bad input),
+/// prepares the bed and writes it to bed_out (HDF5), written under a temporary name then renamed.
+/// threads <= 0: the scenario's "threads", else OpenMP's default.
+BedJobResult run_bed_job(const nlohmann::json& scenario, const std::filesystem::path& bed_out, int threads,
+                         const Progress& progress, const std::atomic<bool>* stop);
+
+/// Loads the bed (its bed_key must equal bed_key(scenario)), drops the projectile, writes the trace
+/// (HDF5, temporary name then rename) and returns the metrics: the paper's vc, apeak, zstop, tstop,
+/// rebound, plus wall time. A collision the metrics cannot resolve (e.g. no contact before the time
+/// cap) is not an error: the metrics carry "metrics_error" with the reason, and null values.
+DropJobResult run_drop_job(const nlohmann::json& scenario, const std::filesystem::path& bed_in,
+                           const std::filesystem::path& trace_out, int threads, const Progress& progress,
+                           const std::atomic<bool>* stop);
+
+/// Canonical key of the bed a scenario needs (container, grains, fill, gravity, materials, contact
+/// law, preparation settings and seed): drops with equal keys share a bed. Validates the scenario.
+nlohmann::json bed_key(const nlohmann::json& scenario);
+
+}  // namespace gravsweep::pipeline

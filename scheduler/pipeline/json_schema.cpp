@@ -1,0 +1,150 @@
+#include "scheduler/pipeline/json_schema.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <vector>
+
+namespace gravsweep::pipeline {
+
+using nlohmann::json;
+
+namespace {
+
+std::string shown(const json& v) {
+  std::string s = v.dump();
+  if (s.size() > 80) s = s.substr(0, 77) + "...";
+  return s;
+}
+
+std::string number(double v) { return fmt::format("{:g}", v); }
+
+}  // namespace
+
+SpecError::SpecError(std::string source, std::string pointer, std::string found, std::string expected)
+    : ConfigError(fmt::format("{}: {} = {} is invalid: expected {}", source,
+                              pointer.empty() ? std::string("(document root)") : pointer, found, expected)),
+      source_(std::move(source)),
+      pointer_(std::move(pointer)),
+      found_(std::move(found)),
+      expected_(std::move(expected)) {}
+
+std::string pointer_token(const std::string& key) {
+  std::string out;
+  for (char c : key) {
+    if (c == '~') out += "~0";
+    else if (c == '/') out += "~1";
+    else out += c;
+  }
+  return out;
+}
+
+SchemaValidator::SchemaValidator(json schema) : schema_(std::move(schema)) {}
+
+json SchemaValidator::resolve(const json& s) const {
+  if (!s.is_object() || !s.contains("$ref")) return s;
+  const std::string ref = s.at("$ref").get<std::string>();
+  const std::string prefix = "#/$defs/";
+  if (ref.rfind(prefix, 0) != 0 || !schema_.contains("$defs") || !schema_["$defs"].contains(ref.substr(prefix.size())))
+    throw std::logic_error(fmt::format("schema: unsupported or dangling $ref '{}'", ref));
+  json merged = resolve(schema_["$defs"][ref.substr(prefix.size())]);
+  for (auto it = s.begin(); it != s.end(); ++it)
+    if (it.key() != "$ref") merged[it.key()] = it.value();
+  return merged;
+}
+
+void SchemaValidator::validate(json& instance, const std::string& source) const {
+  check(instance, schema_, "", source);
+}
+
+void SchemaValidator::check(json& node, const json& schema_in, const std::string& ptr,
+                            const std::string& source) const {
+  const json s = resolve(schema_in);
+  auto fail = [&](const std::string& found, const std::string& expected) {
+    throw SpecError(source, ptr, found, expected);
+  };
+  const std::string desc = s.contains("description") ? s["description"].get<std::string>() : "";
+  auto expect = [&](const std::string& what) {
+    return desc.empty() ? what : fmt::format("{} ({})", what, desc);
+  };
+  if (s.contains("type")) {
+    const std::string type = s["type"].get<std::string>();
+    bool ok = false;
+    if (type == "object") ok = node.is_object();
+    else if (type == "number") ok = node.is_number();
+    else if (type == "integer")
+      ok = node.is_number_integer() ||
+           (node.is_number_float() && std::isfinite(node.get<double>()) &&
+            std::floor(node.get<double>()) == node.get<double>());
+    else if (type == "string") ok = node.is_string();
+    else if (type == "boolean") ok = node.is_boolean();
+    else if (type == "array") ok = node.is_array();
+    if (!ok) fail(shown(node), expect(fmt::format("a JSON {}", type)));
+    if (type == "integer" && node.is_number_float()) node = static_cast<long long>(node.get<double>());
+  }
+  if (s.contains("enum")) {
+    bool ok = false;
+    for (const auto& e : s["enum"]) ok = ok || e == node;
+    if (!ok) fail(shown(node), fmt::format("one of {}", s["enum"].dump()));
+  }
+  if (node.is_number()) {
+    const double v = node.get<double>();
+    if (!std::isfinite(v)) fail(shown(node), "a finite number");
+    std::vector<std::string> bounds;
+    bool ok = true;
+    if (s.contains("minimum")) {
+      ok = ok && v >= s["minimum"].get<double>();
+      bounds.push_back(">= " + number(s["minimum"].get<double>()));
+    }
+    if (s.contains("exclusiveMinimum")) {
+      ok = ok && v > s["exclusiveMinimum"].get<double>();
+      bounds.push_back("> " + number(s["exclusiveMinimum"].get<double>()));
+    }
+    if (s.contains("maximum")) {
+      ok = ok && v <= s["maximum"].get<double>();
+      bounds.push_back("<= " + number(s["maximum"].get<double>()));
+    }
+    if (s.contains("exclusiveMaximum")) {
+      ok = ok && v < s["exclusiveMaximum"].get<double>();
+      bounds.push_back("< " + number(s["exclusiveMaximum"].get<double>()));
+    }
+    if (!ok) {
+      std::string b;
+      for (std::size_t i = 0; i < bounds.size(); ++i) b += (i ? " and " : "") + bounds[i];
+      fail(shown(node), expect(fmt::format("a number {}", b)));
+    }
+  }
+  if (node.is_object() && s.contains("properties")) {
+    const json& props = s["properties"];
+    if (s.contains("additionalProperties") && s["additionalProperties"].is_boolean() &&
+        !s["additionalProperties"].get<bool>()) {
+      for (auto it = node.begin(); it != node.end(); ++it) {
+        if (props.contains(it.key())) continue;
+        std::string known;
+        for (auto p = props.begin(); p != props.end(); ++p) known += (known.empty() ? "" : ", ") + p.key();
+        throw SpecError(source, ptr + "/" + pointer_token(it.key()), shown(it.value()) + " (unknown field)",
+                        fmt::format("one of the fields {}", known));
+      }
+    }
+    if (s.contains("required"))
+      for (const auto& r : s["required"]) {
+        const std::string key = r.get<std::string>();
+        if (!node.contains(key))
+          throw SpecError(source, ptr + "/" + pointer_token(key), "nothing (missing)", "a value: the field is required");
+      }
+    for (auto p = props.begin(); p != props.end(); ++p) {
+      const std::string child_ptr = ptr + "/" + pointer_token(p.key());
+      if (node.contains(p.key())) {
+        check(node[p.key()], p.value(), child_ptr, source);
+      } else {
+        const json ps = resolve(p.value());
+        if (ps.contains("default")) {
+          node[p.key()] = ps["default"];
+          check(node[p.key()], p.value(), child_ptr, source);
+        }
+      }
+    }
+  }
+}
+
+}  // namespace gravsweep::pipeline

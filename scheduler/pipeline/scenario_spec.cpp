@@ -1,0 +1,285 @@
+#include "scheduler/pipeline/scenario_spec.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "engine/integrate/integrators.h"
+#include "engine/scenario/paper_params.h"
+
+namespace gravsweep::pipeline {
+
+using nlohmann::json;
+
+extern const char* const kScenarioSchemaJson;  // generated from schemas/scenario.schema.json
+
+namespace {
+
+const SchemaValidator& validator() {
+  static const SchemaValidator v(json::parse(scenario_schema_text()));
+  return v;
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+Material material_from(const json& j, const std::string& name) {
+  Material m{name};
+  m.young_modulus_Pa = j.at("young_modulus_Pa");
+  m.poisson_ratio = j.at("poisson_ratio");
+  m.cor_normal = j.at("cor_normal");
+  m.cor_tangential = j.at("cor_tangential");
+  m.mu_static = j.at("mu_static");
+  m.mu_rolling = j.at("mu_rolling");
+  m.mu_twisting = j.at("mu_twisting");
+  m.kn_N_m = j.at("kn_N_m");
+  m.kt_N_m = j.at("kt_N_m");
+  m.shape_beta = j.at("shape_beta");
+  return m;
+}
+
+PairOverride pair_from(const json& j) {
+  PairOverride o;
+  auto opt = [&](const char* k, std::optional<double>& f) {
+    if (j.contains(k)) f = j.at(k).get<double>();
+  };
+  opt("cor_normal", o.cor_normal);
+  opt("cor_tangential", o.cor_tangential);
+  opt("mu_static", o.mu_static);
+  opt("mu_rolling", o.mu_rolling);
+  opt("mu_twisting", o.mu_twisting);
+  opt("kn_N_m", o.kn_N_m);
+  opt("kt_N_m", o.kt_N_m);
+  opt("shape_beta", o.shape_beta);
+  return o;
+}
+
+/// The system configuration common to preparation and drop (dt and gravity set by the caller).
+SystemConfig base_config(const json& s) {
+  SystemConfig c;
+  const json& ct = s.at("contact");
+  c.contact_law = ct.at("law");
+  c.rolling_model = ct.at("rolling_model");
+  c.integrator = s.at("integrator");
+  c.composition = ct.at("composition") == "chrono_min" ? Composition::chrono_min : Composition::explicit_pair;
+  c.options.clamp_normal = ct.at("clamp_normal");
+  const json& m = s.at("materials");
+  c.materials.assign(3, Material{});
+  c.materials[kGrainMaterial] = material_from(m.at("grain"), "grain");
+  c.materials[kWallMaterial] = material_from(m.at("wall"), "wall");
+  c.materials[kProjectileMaterial] = material_from(m.at("projectile"), "projectile");
+  const std::pair<const char*, std::pair<int, int>> pairs[] = {
+      {"grain-grain", {kGrainMaterial, kGrainMaterial}},
+      {"grain-wall", {kGrainMaterial, kWallMaterial}},
+      {"grain-projectile", {kGrainMaterial, kProjectileMaterial}},
+      {"projectile-wall", {kWallMaterial, kProjectileMaterial}}};
+  for (const auto& [name, key] : pairs)
+    if (ct.at("pairs").contains(name) && !ct.at("pairs").at(name).empty())
+      c.pair_overrides[key] = pair_from(ct.at("pairs").at(name));
+  c.threads = s.at("threads");
+  return c;
+}
+
+/// Runs the engine's own parameter and time-step checks on a two-body system built from the
+/// scenario (smallest grain, projectile, container walls), so errors surface before any work.
+void engine_checks(const json& s, const SystemConfig& cfg, const std::string& dt_pointer,
+                   const std::string& source) {
+  const double d = s["/grains/diameter_m"_json_pointer];
+  const double spread = s["/grains/diameter_spread_m"_json_pointer];
+  const double rho = s["/grains/density_kg_m3"_json_pointer];
+  const double r_min = 0.5 * (d - spread);
+  auto build = [&](double dt) {
+    SystemConfig c = cfg;
+    c.dt_s = dt;
+    System sys(c);
+    sys.particles.add(Vec3(0, 0, 1), r_min, rho * kPi / 6 * std::pow(2 * r_min, 3), kGrainMaterial, SizeClass::grain);
+    const double Rp = 0.5 * s["/projectile/diameter_m"_json_pointer].get<double>();
+    sys.particles.add(Vec3(0, 0, 3 + Rp), Rp, s["/projectile/mass_kg"_json_pointer], kProjectileMaterial,
+                      SizeClass::projectile);
+    ContainerSpec cs;
+    cs.diameter_m = s["/container/diameter_m"_json_pointer];
+    add_container_walls(sys, cs, 5.0, kWallMaterial);
+    sys.initialize();
+  };
+  try {
+    build(1e-12);
+  } catch (const ConfigError& e) {
+    throw SpecError(source, "/materials", fmt::format("parameters the engine rejects ({})", e.what()),
+                    "materials and contact.pairs valid for the contact law");
+  }
+  try {
+    build(cfg.dt_s);
+  } catch (const ConfigError& e) {
+    throw SpecError(source, dt_pointer, fmt::format("{:g}", cfg.dt_s),
+                    fmt::format("a time step the contact law accepts ({})", e.what()));
+  }
+}
+
+}  // namespace
+
+const std::string& scenario_schema_text() {
+  static const std::string text(kScenarioSchemaJson);
+  return text;
+}
+
+json validate_scenario(const json& scenario, const std::string& source) {
+  json s = scenario;
+  validator().validate(s, source);
+  auto num = [&](const char* p) { return s[json::json_pointer(p)].get<double>(); };
+  auto bad = [&](const char* p, const std::string& expected) {
+    const json::json_pointer jp(p);
+    throw SpecError(source, p, s.contains(jp) ? s[jp].dump() : "nothing (missing)", expected);
+  };
+  // Names resolved by the engine's registries.
+  const auto laws = contact_law_names();
+  if (std::find(laws.begin(), laws.end(), s["/contact/law"_json_pointer].get<std::string>()) == laws.end())
+    bad("/contact/law", "one of the contact laws " + join(laws));
+  const auto rolls = rolling_model_names();
+  if (std::find(rolls.begin(), rolls.end(), s["/contact/rolling_model"_json_pointer].get<std::string>()) == rolls.end())
+    bad("/contact/rolling_model", "one of the rolling models " + join(rolls));
+  std::vector<std::string> integrators;
+  for (const auto& e : integrator_table()) integrators.emplace_back(e.name);
+  if (std::find(integrators.begin(), integrators.end(), s["/integrator"_json_pointer].get<std::string>()) ==
+      integrators.end())
+    bad("/integrator", "one of the integrators " + join(integrators));
+  // Geometry.
+  const double d = num("/grains/diameter_m");
+  if (!(num("/grains/diameter_spread_m") < 0.5 * d))
+    bad("/grains/diameter_spread_m", fmt::format("a spread below half the grain diameter ({:g} m)", 0.5 * d));
+  const double Dc = num("/container/diameter_m");
+  if (!(Dc > 4 * d)) bad("/container/diameter_m", fmt::format("more than 4 grain diameters ({:g} m)", 4 * d));
+  if (!(num("/container/fill_height_m") >= 2 * d))
+    bad("/container/fill_height_m", fmt::format("at least 2 grain diameters ({:g} m)", 2 * d));
+  const json& p = s["projectile"];
+  const double Dp = num("/projectile/diameter_m");
+  if (!(Dp + 2 * d < Dc))
+    bad("/projectile/diameter_m", fmt::format("a projectile narrower than the container minus two grains ({:g} m)", Dc - 2 * d));
+  const double lateral = num("/projectile/lateral_offset_max_grain_diameters") * d;
+  if (!(lateral + 0.5 * Dp + d < 0.5 * Dc))
+    bad("/projectile/lateral_offset_max_grain_diameters",
+        fmt::format("an offset that keeps the projectile one grain from the side wall (at most {:g})",
+                    (0.5 * Dc - 0.5 * Dp - d) / d));
+  const bool has_speed = p.contains("impact_speed_m_s"), has_height = p.contains("drop_height_m");
+  if (has_speed && has_height)
+    bad("/projectile/drop_height_m", "no drop height when impact_speed_m_s is given (give exactly one)");
+  if (!has_speed && !has_height)
+    bad("/projectile/impact_speed_m_s", "an impact speed or a drop_height_m (give exactly one)");
+  const double g = num("/gravity_m_s2");
+  if (has_speed) {
+    const double v = num("/projectile/impact_speed_m_s");
+    const double gap = num("/projectile/start_gap_m");
+    const double vert = num("/projectile/vertical_offset_max_grain_diameters") * d;
+    if (!(v * v > 2 * g * gap))
+      bad("/projectile/start_gap_m",
+          fmt::format("a gap below {:g} m: free fall over a larger gap already exceeds {} m/s", v * v / (2 * g), v));
+    if (!(v * v > 2 * g * (gap + vert)))
+      bad("/projectile/vertical_offset_max_grain_diameters",
+          fmt::format("at most {:g}: free fall over a larger start height already exceeds {} m/s",
+                      (v * v / (2 * g) - gap) / d, v));
+  }
+  const double dt = num("/dt_s");
+  if (!(num("/output/sample_rate_hz") * dt <= 1.0))
+    bad("/output/sample_rate_hz", fmt::format("at most 1/dt_s = {:g} Hz", 1.0 / dt));
+  if (!(num("/output/filter_cutoff_hz") < 0.5 * num("/output/sample_rate_hz")))
+    bad("/output/filter_cutoff_hz", fmt::format("below the Nyquist frequency {:g} Hz", 0.5 * num("/output/sample_rate_hz")));
+  // The engine's own checks (materials, pair values, stability bound of dt).
+  SystemConfig c = base_config(s);
+  c.dt_s = num("/bed/dt_s");
+  engine_checks(s, c, "/bed/dt_s", source);
+  c.dt_s = dt;
+  engine_checks(s, c, "/dt_s", source);
+  return s;
+}
+
+json load_scenario(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError(fmt::format("{}: cannot open the scenario file", path.string()));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  json j;
+  try {
+    j = json::parse(ss.str());
+  } catch (const json::parse_error& e) {
+    // nlohmann reports the byte offset; translate it to line and column.
+    const std::string text = ss.str();
+    std::size_t line = 1, col = 1;
+    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
+      if (text[i] == '\n') { ++line; col = 1; } else { ++col; }
+    }
+    throw ConfigError(fmt::format("{}:{}:{}: not valid JSON: {}", path.string(), line, col, e.what()));
+  }
+  return validate_scenario(j, path.string());
+}
+
+ScenarioParams scenario_params(const json& s) {
+  ScenarioParams out;
+  out.gravity_m_s2 = s.at("gravity_m_s2");
+  const double settle_g = s["/bed/settle_gravity_m_s2"_json_pointer].get<double>() > 0
+                              ? s["/bed/settle_gravity_m_s2"_json_pointer].get<double>()
+                              : out.gravity_m_s2;
+  out.bed_config = base_config(s);
+  out.bed_config.dt_s = s["/bed/dt_s"_json_pointer];
+  out.bed_config.gravity_m_s2 = Vec3(0, 0, -settle_g);
+  out.drop_config = base_config(s);
+  out.drop_config.dt_s = s.at("dt_s");
+  out.drop_config.gravity_m_s2 = Vec3(0, 0, -out.gravity_m_s2);
+
+  BedSpec& b = out.bed;
+  b.container.diameter_m = s["/container/diameter_m"_json_pointer];
+  b.grains.diameter_m = s["/grains/diameter_m"_json_pointer];
+  b.grains.diameter_spread_m = s["/grains/diameter_spread_m"_json_pointer];
+  b.grains.density_kg_m3 = s["/grains/density_kg_m3"_json_pointer];
+  b.fill_height_m = s["/container/fill_height_m"_json_pointer];
+  const json& bj = s.at("bed");
+  b.overfill_factor = bj.at("overfill_factor");
+  b.packing_fraction = bj.at("packing_fraction");
+  b.seed = bj.at("seed").get<std::uint64_t>();
+  b.settle.rms_speed_m_s = bj["/settle/rms_speed_m_s"_json_pointer];
+  b.settle.max_speed_m_s = bj["/settle/max_speed_m_s"_json_pointer];
+  b.settle.max_time_s = bj["/settle/max_time_s"_json_pointer];
+  b.settle.check_interval_s = bj["/settle/check_interval_s"_json_pointer];
+  b.relax_time_s = bj.at("relax_time_s");
+  b.grain_material = kGrainMaterial;
+  b.wall_material = kWallMaterial;
+  if (settle_g != out.gravity_m_s2) b.relax_gravity_m_s2 = Vec3(0, 0, -out.gravity_m_s2);
+
+  const json& pj = s.at("projectile");
+  ProjectileSpec& ps = out.projectile;
+  ps.diameter_m = pj.at("diameter_m");
+  ps.mass_kg = pj.at("mass_kg");
+  ps.material = kProjectileMaterial;
+  if (pj.contains("impact_speed_m_s")) ps.impact_speed_m_s = pj.at("impact_speed_m_s").get<double>();
+  if (pj.contains("drop_height_m")) ps.drop_height_m = pj.at("drop_height_m").get<double>();
+  ps.start_gap_m = pj.at("start_gap_m");
+  // Random start (paper, Chrono repeats: radial and vertical start within two grain diameters).
+  std::mt19937_64 rng(pj.at("seed").get<std::uint64_t>());
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double lat = pj.at("lateral_offset_max_grain_diameters").get<double>() * b.grains.diameter_m;
+  const double r = lat * std::sqrt(u(rng));
+  const double phi = 2 * kPi * u(rng);
+  ps.lateral_offset_x_m = r * std::cos(phi);
+  ps.lateral_offset_y_m = r * std::sin(phi);
+  ps.vertical_offset_m = pj.at("vertical_offset_max_grain_diameters").get<double>() * b.grains.diameter_m * u(rng);
+
+  out.stop.speed_m_s = s["/stop/speed_m_s"_json_pointer];
+  out.stop.hold_time_s = s["/stop/hold_time_s"_json_pointer];
+  out.stop.max_time_s = s["/stop/max_time_s"_json_pointer];
+  out.sample_rate_hz = s["/output/sample_rate_hz"_json_pointer];
+
+  results::MetricOptions& mo = out.metric_options;
+  mo.gravity_m_s2 = out.gravity_m_s2;
+  mo.cutoff_hz = s["/output/filter_cutoff_hz"_json_pointer];
+  mo.end_threshold_g = s["/output/end_threshold_g"_json_pointer];
+  mo.fill_height_m = b.fill_height_m;
+  mo.grain_diameter_m = b.grains.diameter_m;
+  mo.projectile_diameter_m = ps.diameter_m;
+  return out;
+}
+
+}  // namespace gravsweep::pipeline

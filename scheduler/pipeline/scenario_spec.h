@@ -1,0 +1,43 @@
+// The impact scenario spec (schemas/scenario.schema.json, compiled in): validation with defaults,
+// cross-field checks, and its translation into engine parameters.
+#pragma once
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "engine/scenario/bed.h"
+#include "engine/scenario/impact.h"
+#include "engine/system/system.h"
+#include "results/processing/trace.h"
+#include "scheduler/pipeline/json_schema.h"
+
+namespace gravsweep::pipeline {
+
+/// The text of schemas/scenario.schema.json as compiled into the binary.
+const std::string& scenario_schema_text();
+
+/// Validates a scenario against the schema and the cross-field rules (exactly one of
+/// impact_speed_m_s / drop_height_m, grains fit the container, the projectile and its offsets fit,
+/// dt within the contact law's stability bound, sample rate <= 1/dt, ...) and returns it with
+/// every default filled in. Throws SpecError (a ConfigError) naming `source`, the JSON pointer of
+/// the field, the value found and what was expected.
+nlohmann::json validate_scenario(const nlohmann::json& scenario, const std::string& source = "scenario");
+
+/// Reads a scenario file (JSON) and validates it; parse errors name the file, line and column.
+nlohmann::json load_scenario(const std::filesystem::path& path);
+
+/// Everything the engine needs, from a validated scenario.
+struct ScenarioParams {
+  SystemConfig bed_config;    ///< preparation: bed.dt_s, settle gravity
+  SystemConfig drop_config;   ///< drop: dt_s, gravity_m_s2
+  BedSpec bed;
+  ProjectileSpec projectile;  ///< with its random offsets drawn from projectile.seed
+  DropStop stop;
+  double gravity_m_s2 = 9.81;
+  double sample_rate_hz = 1e4;
+  results::MetricOptions metric_options;  ///< fill height and grain diameter set from the bed
+};
+
+ScenarioParams scenario_params(const nlohmann::json& validated);
+
+}  // namespace gravsweep::pipeline

@@ -1,0 +1,182 @@
+// The scenario spec: defaults from the paper, and bad specs refused before any work with the JSON
+// pointer of the bad field, the value found and what was expected.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "engine/scenario/paper_params.h"
+#include "scenario_helpers.h"
+#include "scheduler/pipeline/scenario_spec.h"
+
+namespace gravsweep {
+namespace {
+
+using nlohmann::json;
+using pipeline::SpecError;
+using pipeline::validate_scenario;
+
+/// Expects validation to fail at `pointer`; returns the message.
+std::string refused_at(const json& spec, const std::string& pointer) {
+  try {
+    validate_scenario(spec, "spec.json");
+  } catch (const SpecError& e) {
+    EXPECT_EQ(e.pointer(), pointer) << e.what();
+    EXPECT_NE(std::string(e.what()).find("spec.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(pointer), std::string::npos) << e.what();
+    EXPECT_FALSE(e.expected().empty());
+    return e.what();
+  }
+  ADD_FAILURE() << "accepted a spec that should fail at " << pointer;
+  return {};
+}
+
+json minimal() { return json{{"projectile", {{"impact_speed_m_s", 1.0}}}}; }
+
+TEST(ScenarioSpec, DefaultsAreThePapersChronoSetup) {
+  const json s = validate_scenario(minimal());
+  EXPECT_DOUBLE_EQ(s["gravity_m_s2"].get<double>(), 9.81);
+  EXPECT_DOUBLE_EQ(s["/container/diameter_m"_json_pointer].get<double>(), 0.315);
+  EXPECT_DOUBLE_EQ(s["/container/fill_height_m"_json_pointer].get<double>(), 0.10);
+  EXPECT_DOUBLE_EQ(s["/grains/diameter_spread_m"_json_pointer].get<double>(), 5e-4);
+  EXPECT_DOUBLE_EQ(s["/materials/grain/young_modulus_Pa"_json_pointer].get<double>(), 7e8);
+  EXPECT_DOUBLE_EQ(s["/materials/grain/mu_rolling"_json_pointer].get<double>(), 0.09);
+  EXPECT_DOUBLE_EQ(s["/materials/wall/cor_normal"_json_pointer].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(s["/contact/pairs/grain-wall/mu_static"_json_pointer].get<double>(), 0.45);
+  EXPECT_DOUBLE_EQ(s["dt_s"].get<double>(), 1e-6);
+  EXPECT_DOUBLE_EQ(s["/output/sample_rate_hz"_json_pointer].get<double>(), 1e4);
+  EXPECT_DOUBLE_EQ(s["/stop/speed_m_s"_json_pointer].get<double>(), 1e-3);
+  EXPECT_DOUBLE_EQ(s["/bed/settle/rms_speed_m_s"_json_pointer].get<double>(), 1e-5);
+  // The engine parameters equal Table 1's Chrono set of engine/scenario/paper_params.h.
+  const auto p = pipeline::scenario_params(s);
+  const SystemConfig ref = chrono_table1_config();
+  ASSERT_EQ(p.drop_config.materials.size(), ref.materials.size());
+  for (std::size_t i = 0; i < ref.materials.size(); ++i) {
+    EXPECT_EQ(p.drop_config.materials[i].cor_normal, ref.materials[i].cor_normal) << i;
+    EXPECT_EQ(p.drop_config.materials[i].mu_static, ref.materials[i].mu_static) << i;
+    EXPECT_EQ(p.drop_config.materials[i].mu_rolling, ref.materials[i].mu_rolling) << i;
+    EXPECT_EQ(p.drop_config.materials[i].young_modulus_Pa, ref.materials[i].young_modulus_Pa) << i;
+  }
+  EXPECT_EQ(p.drop_config.pair_overrides.size(), ref.pair_overrides.size());
+  EXPECT_EQ(p.drop_config.contact_law, "hertz");
+  EXPECT_EQ(p.drop_config.rolling_model, "sunday");
+}
+
+TEST(ScenarioSpec, OffsetsAreDrawnWithinTheirBoundsFromTheSeed) {
+  json s = minimal();
+  s["projectile"]["lateral_offset_max_grain_diameters"] = 2;
+  s["projectile"]["vertical_offset_max_grain_diameters"] = 2;
+  const auto a = pipeline::scenario_params(validate_scenario(s));
+  const auto b = pipeline::scenario_params(validate_scenario(s));
+  EXPECT_EQ(a.projectile.lateral_offset_x_m, b.projectile.lateral_offset_x_m);
+  EXPECT_LE(std::hypot(a.projectile.lateral_offset_x_m, a.projectile.lateral_offset_y_m), 0.02);
+  EXPECT_GE(a.projectile.vertical_offset_m, 0.0);
+  EXPECT_LE(a.projectile.vertical_offset_m, 0.02);
+  s["projectile"]["seed"] = 2;
+  const auto c = pipeline::scenario_params(validate_scenario(s));
+  EXPECT_NE(a.projectile.lateral_offset_x_m, c.projectile.lateral_offset_x_m);
+}
+
+TEST(ScenarioSpec, UnknownFieldsAreRefusedWithTheirPointer) {
+  json s = minimal();
+  s["projectile"]["speed_m_s"] = 1.0;
+  const std::string msg = refused_at(s, "/projectile/speed_m_s");
+  EXPECT_NE(msg.find("impact_speed_m_s"), std::string::npos) << msg;  // lists the known fields
+  json t = minimal();
+  t["contact"]["pairs"]["grain/wall"] = json::object();
+  refused_at(t, "/contact/pairs/grain~1wall");  // RFC 6901 escaping
+}
+
+TEST(ScenarioSpec, WrongTypesAndRangesAreRefused) {
+  json s = minimal();
+  s["gravity_m_s2"] = "9.81";
+  const std::string msg = refused_at(s, "/gravity_m_s2");
+  EXPECT_NE(msg.find("\"9.81\""), std::string::npos) << msg;
+  EXPECT_NE(msg.find("number"), std::string::npos) << msg;
+  s = minimal();
+  s["materials"]["grain"]["cor_normal"] = 1.5;
+  EXPECT_NE(refused_at(s, "/materials/grain/cor_normal").find("<= 1"), std::string::npos);
+  s = minimal();
+  s["dt_s"] = -1e-6;
+  refused_at(s, "/dt_s");
+  s = minimal();
+  s["bed"]["seed"] = 1.5;
+  refused_at(s, "/bed/seed");
+  s = minimal();
+  s["contact"]["composition"] = "average";
+  refused_at(s, "/contact/composition");
+  s = minimal();
+  s["contact"]["law"] = "hertzian";
+  EXPECT_NE(refused_at(s, "/contact/law").find("hooke"), std::string::npos);
+  s = minimal();
+  s["integrator"] = "rk4";
+  refused_at(s, "/integrator");
+}
+
+TEST(ScenarioSpec, CrossFieldRulesAreRefusedAtTheRightField) {
+  json s = minimal();
+  s["projectile"]["drop_height_m"] = 0.05;
+  refused_at(s, "/projectile/drop_height_m");  // both speed and height
+  s = json{{"projectile", json::object()}};
+  refused_at(s, "/projectile/impact_speed_m_s");  // neither
+  s = minimal();
+  s["grains"]["diameter_spread_m"] = 0.006;
+  refused_at(s, "/grains/diameter_spread_m");
+  s = minimal();
+  s["projectile"]["impact_speed_m_s"] = 0.2;  // 5 mm of free fall at 1 g already gives 0.31 m/s
+  refused_at(s, "/projectile/start_gap_m");
+  s = minimal();
+  s["projectile"]["vertical_offset_max_grain_diameters"] = 10;
+  refused_at(s, "/projectile/vertical_offset_max_grain_diameters");
+  s = minimal();
+  s["projectile"]["lateral_offset_max_grain_diameters"] = 20;
+  refused_at(s, "/projectile/lateral_offset_max_grain_diameters");
+  s = minimal();
+  s["output"]["sample_rate_hz"] = 2e6;  // above 1/dt
+  refused_at(s, "/output/sample_rate_hz");
+  s = minimal();
+  s["container"]["diameter_m"] = 0.03;
+  refused_at(s, "/container/diameter_m");
+}
+
+TEST(ScenarioSpec, TimeStepsAboveTheStabilityBoundAreRefused) {
+  json s = minimal();
+  s["dt_s"] = 5e-5;  // Hertz bound: 0.3 x Rayleigh time ~ 15 us for 1 cm glass beads at 700 MPa
+  EXPECT_NE(refused_at(s, "/dt_s").find("stability"), std::string::npos);
+  s = minimal();
+  s["bed"]["dt_s"] = 5e-5;
+  refused_at(s, "/bed/dt_s");
+}
+
+TEST(ScenarioSpec, TheCompiledSchemaIsTheRepositorysSchema) {
+  std::ifstream in(std::string(GRAVSWEEP_SOURCE_DIR) + "/schemas/scenario.schema.json");
+  ASSERT_TRUE(in.good());
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_EQ(json::parse(ss.str()), json::parse(pipeline::scenario_schema_text()));
+}
+
+TEST(ScenarioSpec, ExamplesAreValid) {
+  int n = 0;
+  for (const auto& e : std::filesystem::directory_iterator(std::string(GRAVSWEEP_SOURCE_DIR) + "/examples")) {
+    if (e.path().extension() != ".json") continue;
+    EXPECT_NO_THROW(pipeline::load_scenario(e.path())) << e.path();
+    ++n;
+  }
+  EXPECT_GE(n, 2);
+}
+
+TEST(ScenarioSpec, JsonSyntaxErrorsNameFileLineAndColumn) {
+  test::TempDir dir;
+  const auto path = dir.path / "broken.json";
+  std::ofstream(path) << "{\n  \"gravity_m_s2\": 9.81,\n  \"dt_s\": ,\n}\n";
+  try {
+    pipeline::load_scenario(path);
+    FAIL() << "broken JSON accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("broken.json:3:"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace gravsweep
