@@ -22,23 +22,17 @@ using namespace gravsweep::test;
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-TEST(CrashCampaign, SigkilledWorkerLosesNothingAndDuplicatesNothing) {
-  if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
+namespace {
+
+/// Runs the campaign of `doc` with 3 workers, SIGKILLs worker 0 mid-job up to max_kills times
+/// (restarting it each time), then checks the campaign end to end.
+void crash_campaign(const json& doc, std::int64_t total, std::int64_t with_results,
+                    const std::vector<std::string>& param_columns, int min_kills, int max_kills) {
   TempDir d;
-  json doc = {{"sweep", "crash"},
-              {"max_attempts", 6},
-              {"base", json::parse(tiny_base())},
-              {"axes",
-               {{{"name", "gravity_m_s2"}, {"pointer", "/gravity_m_s2"}, {"values", {9.81, 3.71}}},
-                {{"name", "bed_seed"}, {"pointer", "/bed/seed"}, {"values", {7, 8}}},
-                {{"name", "impact_speed_m_s"},
-                 {"pointer", "/projectile/impact_speed_m_s"},
-                 {"range", {{"start", 0.3}, {"stop", 0.9}, {"step", 0.1}}}}}},
-              {"repeats", {{"name", "projectile_seed"}, {"pointer", "/projectile/seed"}, {"count", 2}, {"start", 1}}}};
   write_text(d.path / "spec.json", doc.dump(2));
   auto r = run_cli({"submit", "spec.json", "--db", "c.db"}, d.path);
   ASSERT_EQ(r.code, 0) << r.err;
-  ASSERT_NE(r.out.find("60 jobs planned (4 bed, 56 drop): 60 new"), std::string::npos) << r.out;
+  ASSERT_NE(r.out.find(fmt::format("{} new, 0 already present", total)), std::string::npos) << r.out;
 
   const std::string db_path = (d.path / "c.db").string();
   const std::vector<std::string> work_args = {"work",   "--db",        db_path, "--threads", "1",
@@ -50,7 +44,7 @@ TEST(CrashCampaign, SigkilledWorkerLosesNothingAndDuplicatesNothing) {
   db::Database db(db_path);
   int kills = 0;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(150);
-  while (kills < 4 && std::chrono::steady_clock::now() < deadline) {
+  while (kills < max_kills && std::chrono::steady_clock::now() < deadline) {
     // Wait until the victim (worker 0) is in the middle of a job: it holds a lease and has reported progress.
     const std::string q = fmt::format(
         "SELECT count(*) FROM attempts a JOIN jobs j ON j.job_id=a.job_id WHERE a.pid={} AND a.outcome='running' "
@@ -66,13 +60,13 @@ TEST(CrashCampaign, SigkilledWorkerLosesNothingAndDuplicatesNothing) {
     ++kills;
     workers[0] = start_cli(work_args, d.path / "w0.log");
   }
-  EXPECT_GE(kills, 3) << "the victim was never caught mid-job often enough";
+  EXPECT_GE(kills, min_kills) << "the victim was never caught mid-job often enough";
   for (pid_t w : workers) EXPECT_EQ(wait_child(w, 200), 0);
 
   // Every job done exactly once.
-  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs"), 60);
-  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), 60);
-  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='done'"), 60);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs"), total);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), total);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='done'"), total);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM (SELECT job_id FROM attempts WHERE outcome='done' GROUP BY job_id "
                         "HAVING count(*) > 1)"),
             0);
@@ -80,11 +74,10 @@ TEST(CrashCampaign, SigkilledWorkerLosesNothingAndDuplicatesNothing) {
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='lost'"), kills);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='running'"), 0);
   // Results: one row per drop, none duplicated, with the swept parameters and the metrics.
-  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results"), 56);
-  EXPECT_EQ(sql_int(db, "SELECT count(DISTINCT job_id) FROM results"), 56);
-  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results WHERE gravity_m_s2 IS NULL OR impact_speed_m_s IS NULL "
-                        "OR projectile_seed IS NULL OR bed_job_id IS NULL"),
-            0);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results"), with_results);
+  EXPECT_EQ(sql_int(db, "SELECT count(DISTINCT job_id) FROM results"), with_results);
+  for (const auto& col : param_columns)
+    EXPECT_EQ(sql_int(db, fmt::format("SELECT count(*) FROM results WHERE \"{}\" IS NULL", col)), 0) << col;
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results WHERE trace_path NOT IN (SELECT output_path FROM jobs)"), 0);
   // Every output exists with its recorded size and checksum; nothing else is on disk.
   std::set<std::string> referenced;
@@ -107,7 +100,35 @@ TEST(CrashCampaign, SigkilledWorkerLosesNothingAndDuplicatesNothing) {
   // status after the storm: all done, no stale lease; resume finds nothing to repair.
   r = run_cli({"status", "--db", "c.db"}, d.path);
   EXPECT_EQ(r.code, 0);
-  EXPECT_NE(r.out.find("60 done, 0 dead, 0 running, 0 to run"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(fmt::format("{} done, 0 dead, 0 running, 0 to run", total)), std::string::npos) << r.out;
   r = run_cli({"resume", "--db", "c.db", "--dry-run"}, d.path);
   EXPECT_NE(r.out.find("orphaned files found: 0"), std::string::npos) << r.out;
+}
+
+}  // namespace
+
+TEST(CrashCampaign, SigkilledWorkerLosesNothingAndDuplicatesNothing) {
+  if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
+  json doc = {{"sweep", "crash"},
+              {"max_attempts", 6},
+              {"base", json::parse(tiny_base())},
+              {"axes",
+               {{{"name", "gravity_m_s2"}, {"pointer", "/gravity_m_s2"}, {"values", {9.81, 3.71}}},
+                {{"name", "bed_seed"}, {"pointer", "/bed/seed"}, {"values", {7, 8}}},
+                {{"name", "impact_speed_m_s"},
+                 {"pointer", "/projectile/impact_speed_m_s"},
+                 {"range", {{"start", 0.3}, {"stop", 0.9}, {"step", 0.1}}}}}},
+              {"repeats", {{"name", "projectile_seed"}, {"pointer", "/projectile/seed"}, {"count", 2}, {"start", 1}}}};
+  // 4 beds (gravity x bed seed) and 56 drops (7 speeds x 2 projectile seeds per bed).
+  crash_campaign(doc, 60, 56, {"gravity_m_s2", "bed_seed", "impact_speed_m_s", "projectile_seed", "bed_job_id"}, 3, 4);
+}
+
+TEST(CrashCampaign, NoopJobsSurviveSigkillToo) {
+  // The queue alone (no engine): 30 half-second jobs.
+  json doc = {{"sweep", "crash_noop"},
+              {"job", "noop"},
+              {"max_attempts", 6},
+              {"base", {{"g", 1.5}, {"sleep_s", 0.5}}},
+              {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 0.1}, {"stop", 3.0}, {"step", 0.1}}}}}}};
+  crash_campaign(doc, 30, 30, {"gravity_m_s2", "noop_value"}, 3, 3);
 }
