@@ -75,7 +75,7 @@ void setup_submit(CLI::App& app) {
       "depend on one bed-preparation job. A malformed spec is refused (exit 2) with the JSON pointer,\n"
       "the value found and the type expected, and nothing is written.\n\n"
       "Examples:\n"
-      "  gravsweep submit examples/sweep_gravity.json --db campaign.db\n"
+      "  gravsweep submit examples/sweep_tiny.json --db campaign.db\n"
       "  gravsweep submit a.json b.json --db campaign.db      # a campaign may hold several sweeps\n"
       "  gravsweep submit spec.json --dry-run                 # validate and count, write nothing");
   sub->add_option("specs", opt->specs, "sweep spec files (JSON)")->required()->check(CLI::ExistingFile);
