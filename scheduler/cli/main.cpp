@@ -14,6 +14,7 @@ namespace {
 using SetupFn = void (*)(CLI::App&);
 // The verb table: one row per verb, in the order `gravsweep --help` lists them.
 constexpr SetupFn kVerbs[] = {
+    &gravsweep::cli::setup_run,
     &gravsweep::cli::setup_bench,
     &gravsweep::cli::setup_measurements,
     &gravsweep::cli::setup_model,

@@ -11,6 +11,7 @@ void setup_measurements(CLI::App& app);
 void setup_model(CLI::App& app);
 void setup_synth(CLI::App& app);
 void setup_report(CLI::App& app);
+void setup_run(CLI::App& app);
 void setup_submit(CLI::App& app);
 void setup_work(CLI::App& app);
 void setup_status(CLI::App& app);
