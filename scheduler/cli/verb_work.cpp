@@ -156,8 +156,8 @@ void setup_work(CLI::App& app) {
   sub->add_option("--workers", opt->workers, "worker processes")->check(CLI::Range(1, 256))->capture_default_str();
   sub->add_option("--threads", opt->threads, "engine threads per worker (0: cores / workers)")->check(CLI::Range(0, 1024))->capture_default_str();
   sub->add_flag("--follow", opt->follow, "keep waiting for new jobs when none is left");
-  sub->add_option("--lease", opt->lease_s, "lease length, s (renewed every lease/4)")->check(CLI::Range(0.5, 86400.0))->capture_default_str();
-  sub->add_option("--heartbeat", opt->heartbeat_s, "heartbeat interval, s (0: lease/4)")->check(CLI::Range(0.0, 3600.0))->capture_default_str();
+  sub->add_option("--lease", opt->lease_s, "lease length, s: a worker silent this long is presumed dead")->check(CLI::Range(0.5, 86400.0))->capture_default_str();
+  sub->add_option("--heartbeat", opt->heartbeat_s, "heartbeat (lease renewal + progress) interval, s (0: min(lease/4, 2 s))")->check(CLI::Range(0.0, 3600.0))->capture_default_str();
   sub->add_option("--poll", opt->poll_s, "wait between claims when nothing is runnable, s")->check(CLI::Range(0.01, 60.0))->capture_default_str();
   sub->add_option("--backoff", opt->backoff_s, "retry backoff base, s (base * 2^(attempt-1), capped at 300 s)")->check(CLI::Range(0.0, 3600.0))->capture_default_str();
   sub->add_option("--max-jobs", opt->max_jobs, "stop after this many jobs per worker (-1: no limit)")->capture_default_str();

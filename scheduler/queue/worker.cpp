@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <csignal>
@@ -154,7 +155,8 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
   ensure_schema(db);
   const CampaignPaths paths(o.db_path);
   const WorkerIdentity who = make_identity(o.code_version, o.threads);
-  const double hb = o.heartbeat_s > 0 ? o.heartbeat_s : o.lease_s / 4;
+  // Renew at least 4 times per lease, and report progress at least every 2 s.
+  const double hb = o.heartbeat_s > 0 ? o.heartbeat_s : std::min(o.lease_s / 4, 2.0);
   std::error_code ec;
   for (const char* d : {"beds", "traces", "noop", "tmp"}) fs::create_directories(paths.root / d, ec);
   std::unique_ptr<db::Database> beat_db;  // the heartbeat thread's own connection, kept across jobs

@@ -44,7 +44,7 @@ struct WorkerOptions {
   std::filesystem::path db_path;
   int threads = 1;
   double lease_s = 60;
-  double heartbeat_s = 0;       ///< 0: lease / 4
+  double heartbeat_s = 0;       ///< 0: min(lease / 4, 2 s)
   bool follow = false;          ///< keep waiting for new jobs when none is left
   double poll_s = 0.5;          ///< idle wait between claims when nothing is runnable
   long max_jobs = -1;           ///< stop after this many jobs (-1: no limit)
