@@ -106,7 +106,7 @@ std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json
     try {
       const json::json_pointer jp(axis.pointer);
       if (!base.contains(jp)) {
-        ck.add(join(ptr, "pointer"), &a["pointer"], "a pointer to a field present in the base scenario");
+        ck.add(join(ptr, "pointer"), &a["pointer"], "a pointer to a field present in the base scenario (to sweep a default, write the field into the base)");
         ok = false;
       } else {
         base_value = &base.at(jp);

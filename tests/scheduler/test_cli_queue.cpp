@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "scheduler/db/sqlite.h"
+#include "scheduler/queue/impact.h"
 #include "scheduler_test_helpers.h"
 
 using namespace gravsweep;
@@ -126,4 +127,35 @@ TEST(CliQueue, SigtermEndsTheJobAndReleasesItsLease) {
   std::size_t files = 0;
   for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(d.path / "c.files" / "tmp")) ++files;
   EXPECT_EQ(files, 0u);
+}
+
+TEST(CliQueue, ImpactSweepSharesBedsAndExtendsIdempotently) {
+  if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
+  TempDir d;
+  const std::string example = std::string(GRAVSWEEP_SOURCE_DIR) + "/examples/sweep_tiny.json";
+  auto r = run_cli({"submit", example, "--db", "c.db"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("14 jobs planned (2 bed, 12 drop): 14 new, 0 already present"), std::string::npos) << r.out;
+  r = run_cli({"submit", example, "--db", "c.db"}, d.path);
+  EXPECT_NE(r.out.find("0 new, 14 already present"), std::string::npos) << r.out;
+  // One more impact speed: 4 new drops (2 gravities x 2 seeds) on the 2 existing beds.
+  json doc = json::parse(std::ifstream(example));
+  doc["axes"][1]["range"]["stop"] = 2.0;
+  write_text(d.path / "more.json", doc.dump());
+  r = run_cli({"submit", "more.json", "--db", "c.db"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("18 jobs planned (2 bed, 16 drop): 4 new, 14 already present"), std::string::npos) << r.out;
+  db::Database db((d.path / "c.db").string());
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM job_deps"), 16);
+  EXPECT_EQ(sql_int(db, "SELECT count(DISTINCT dep_id) FROM job_deps"), 2);
+  // A field the scenario does not have is refused with its pointer; nothing is written.
+  doc["axes"][1]["pointer"] = "/projectile/speed_m_s";
+  write_text(d.path / "typo.json", doc.dump());
+  r = run_cli({"submit", "typo.json", "--db", "c.db"}, d.path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("/axes/1/pointer: found \"/projectile/speed_m_s\" (string), expected a pointer to a field "
+                       "present in the base scenario"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs"), 18);
 }
