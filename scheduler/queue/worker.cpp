@@ -72,7 +72,7 @@ void heartbeat_loop(const WorkerOptions& o, const Claim& c, JobSignals& sig, dou
                                                     std::chrono::duration<double>(interval_s));
       if (sig.lease_lost.load()) return;
     }
-    sig.cv.wait_for(lock, std::chrono::milliseconds(50));
+    sig.cv.wait_for(lock, std::chrono::milliseconds(50), [&sig] { return sig.finished; });
   }
 }
 
