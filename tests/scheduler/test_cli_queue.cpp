@@ -159,3 +159,30 @@ TEST(CliQueue, ImpactSweepSharesBedsAndExtendsIdempotently) {
       << r.err;
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs"), 18);
 }
+
+TEST(CliQueue, FollowingWorkersPickUpLateSubmissionsAndTheSupervisorForwardsSigterm) {
+  TempDir d;
+  write_text(d.path / "a.json", noop_spec({1.0}, 0.05));
+  ASSERT_EQ(run_cli({"submit", "a.json", "--db", "c.db"}, d.path).code, 0);
+  const pid_t sup = start_cli({"work", "--db", (d.path / "c.db").string(), "--workers", "2", "--follow", "--poll",
+                               "0.05", "--quiet"},
+                              d.path / "w.log");
+  db::Database db((d.path / "c.db").string());
+  auto wait_done = [&](std::int64_t n) {
+    const auto t0 = std::chrono::steady_clock::now();
+    while (sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'") < n) {
+      if (std::chrono::steady_clock::now() - t0 > std::chrono::seconds(20)) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return true;
+  };
+  ASSERT_TRUE(wait_done(1));
+  // The workers are idle but still there; new jobs are picked up.
+  write_text(d.path / "b.json", noop_spec({1.0, 2.0, 3.0}, 0.05));
+  ASSERT_EQ(run_cli({"submit", "b.json", "--db", "c.db"}, d.path).code, 0);
+  ASSERT_TRUE(wait_done(3));
+  EXPECT_EQ(waitpid(sup, nullptr, WNOHANG), 0) << "--follow workers must not exit when the queue is empty";
+  kill(sup, SIGTERM);
+  EXPECT_EQ(wait_child(sup, 10), 130);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='running'"), 0);
+}
