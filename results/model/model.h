@@ -108,7 +108,7 @@ struct Candidate {
   std::string term;
   double mean_rel_improvement = 0;  ///< mean over trials of (mse0 - mse1) / mse0
   int trials_better = 0, trials = 0;
-  double p_value = 1;  ///< one-sided sign test over trials (not samples)
+  double p_value = 1;  ///< one-sided Wilcoxon signed-rank test over trials (not samples)
   bool significant = false;
 };
 struct Discovery {
@@ -119,7 +119,7 @@ struct Discovery {
   std::vector<AxisResidual> residual_before, residual_after;
 };
 /// Forward selection from `baseline` over all other registered terms by grouped-CV improvement,
-/// adding a term while one is significant (sign test over trials, Bonferroni over candidates, at
+/// adding a term while one is significant (signed-rank test over trials, Bonferroni over candidates, at
 /// level alpha, and at least min_improvement mean relative gain).
 Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds = 6, double alpha = 0.01,
                    double min_improvement = 0.03, int max_rounds = 2);

@@ -144,7 +144,7 @@ def plot_ranking():
     cols = ["tab:green" if r["significant"] == "1" else "tab:gray" for r in rows]
     ax.barh(names[::-1], vals[::-1], color=cols[::-1])
     ax.set_xlabel("mean held-out improvement of trace MSE per trial (%)")
-    ax.set_title("Candidate terms (green: significant, sign test over trials)")
+    ax.set_title("Candidate terms (green: significant, signed-rank test over trials)")
     save(fig, "ranking.png")
 
 

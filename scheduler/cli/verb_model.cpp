@@ -88,7 +88,7 @@ void print_axes(const std::vector<results::AxisResidual>& axes, const std::strin
 }
 
 void print_ranking(const results::Discovery& d, const std::string& format) {
-  results::Table t({"round", "rank", "term", "mean_rel_improvement_pct", "trials_better", "trials", "p_sign_test", "significant"});
+  results::Table t({"round", "rank", "term", "mean_rel_improvement_pct", "trials_better", "trials", "p_signed_rank", "significant"});
   for (std::size_t r = 0; r < d.rounds.size(); ++r)
     for (std::size_t i = 0; i < d.rounds[r].size(); ++i) {
       const auto& c = d.rounds[r][i];
@@ -182,7 +182,7 @@ void setup_model(CLI::App& app) {
       "Which effect is missing: fit the baseline, show where it fails (residuals against depth,\n"
       "speed, time since contact, gravity, impact speed, fill height), then rank every other\n"
       "registered term by its held-out improvement with whole trials left out (grouped CV) and\n"
-      "a sign test over trials (not samples), Bonferroni over candidates. Adds the winner and\n"
+      "a Wilcoxon signed-rank test over trials (not samples), Bonferroni over candidates. Adds the winner and\n"
       "repeats while a term is significant, then says which effect is missing, 'no missing\n"
       "effect found', or 'structure left that no candidate explains' with where it lies.\n\n"
       "Example:\n  gravsweep model rank ../shared/data/measurements/depth-friction-dev");

@@ -102,7 +102,7 @@ void setup_report(CLI::App& app) {
     }
     md << "```\n\n## Candidate ranking\n\n```\n";
     {
-      results::Table t({"round", "term", "mean_rel_improvement_pct", "trials_better", "trials", "p_sign_test", "significant"});
+      results::Table t({"round", "term", "mean_rel_improvement_pct", "trials_better", "trials", "p_signed_rank", "significant"});
       for (std::size_t r = 0; r < d.rounds.size(); ++r)
         for (const auto& cd : d.rounds[r])
           t.add({std::to_string(r + 1), cd.term, results::num(100 * cd.mean_rel_improvement, 3),

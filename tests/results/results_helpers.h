@@ -1,0 +1,34 @@
+// Helpers for the results/ tests: temporary folders and the shared dev campaign.
+#pragma once
+#include <filesystem>
+#include <random>
+#include <string>
+
+namespace gravsweep::testing {
+
+/// A fresh temporary folder, removed when the object goes out of scope.
+struct TempDir {
+  std::filesystem::path path;
+  TempDir() {
+    std::random_device rd;
+    path = std::filesystem::temp_directory_path() / ("gravsweep_results_" + std::to_string(rd()) + std::to_string(rd()));
+    std::filesystem::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  [[nodiscard]] std::string str() const { return path.string(); }
+};
+
+/// ../shared/data/measurements/depth-friction-dev relative to the source tree.
+inline std::string dev_campaign() {
+  return (std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / ".." / "shared" / "data" / "measurements" /
+          "depth-friction-dev")
+      .lexically_normal()
+      .string();
+}
+
+}  // namespace gravsweep::testing

@@ -1,0 +1,135 @@
+// Measurement import: the laboratory format, bad rows and traces reported by file, line and
+// column without stopping the others, and storage in a real SQLite file.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "results/measurements/campaign.h"
+#include "results/model/synth.h"
+#include "results_helpers.h"
+#include "scheduler/db/sqlite.h"
+
+using namespace gravsweep;
+using namespace gravsweep::results;
+using gravsweep::testing::TempDir;
+
+namespace {
+
+SynthOptions small() {
+  SynthOptions o;
+  o.gravity_m_s2 = {9.81, 1.2};
+  o.impact_velocity_m_s = {0.3, 0.8};
+  o.repeats = 2;
+  o.seed = 5;
+  return o;
+}
+
+std::string read_all(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+}  // namespace
+
+TEST(Campaign, ReadsSyntheticCampaignAndRecoversImpactSpeed) {
+  TempDir d;
+  const int n = write_synthetic_campaign(d.str(), parse_model("base"), small());
+  ASSERT_EQ(n, 8);
+  const Campaign c = load_campaign(d.str());
+  EXPECT_TRUE(c.issues.empty()) << c.issues.front().to_string();
+  ASSERT_EQ(c.trials.size(), 8u);
+  EXPECT_EQ(c.gravity_levels(), (std::vector<double>{9.81, 1.2}));
+  for (const auto& t : c.trials) {
+    EXPECT_GT(t.processed.metrics.zstop_m, 0.0);
+    EXPECT_GT(t.processed.metrics.tstop_s, 0.0);
+    EXPECT_GT(t.fit_end, t.fit_begin);
+  }
+}
+
+TEST(Campaign, BadRowsAndTracesAreReportedByFileLineColumnAndDoNotStopOthers) {
+  TempDir d;
+  write_synthetic_campaign(d.str(), parse_model("base"), small());
+  const auto csv = d.path / "trials.csv";
+  std::string text = read_all(csv);
+  // Line 3 (second trial): an unparseable gravity (column 3).
+  auto line_start = [&](int line) {
+    std::size_t p = 0;
+    for (int i = 1; i < line; ++i) p = text.find('\n', p) + 1;
+    return p;
+  };
+  {
+    const std::size_t p = line_start(3);
+    const std::size_t c1 = text.find(',', p), c2 = text.find(',', c1 + 1), c3 = text.find(',', c2 + 1);
+    text.replace(c2 + 1, c3 - c2 - 1, "nine");
+  }
+  std::ofstream(csv) << text;
+  // Trace of the fourth trial: a non-increasing time on its line 5.
+  {
+    const auto tp = d.path / "traces" / "S004.csv";
+    std::string tr = read_all(tp);
+    std::size_t p = 0;
+    for (int i = 1; i < 5; ++i) p = tr.find('\n', p) + 1;
+    tr.replace(p, tr.find(',', p) - p, "0.000000");
+    std::ofstream(tp) << tr;
+  }
+  // Trace of the sixth trial: cut during the collision.
+  {
+    const auto tp = d.path / "traces" / "S006.csv";
+    std::string tr = read_all(tp);
+    std::size_t p = 0;
+    for (int i = 0; i < 50; ++i) p = tr.find('\n', p) + 1;
+    std::ofstream(tp) << tr.substr(0, p);
+  }
+  const Campaign c = load_campaign(d.str());
+  EXPECT_EQ(c.trials.size(), 5u);
+  ASSERT_EQ(c.issues.size(), 3u);
+  EXPECT_EQ(c.issues[0].file, "trials.csv");
+  EXPECT_EQ(c.issues[0].line, 3);
+  EXPECT_EQ(c.issues[0].column, 3);
+  EXPECT_NE(c.issues[0].message.find("gravity_m_s2"), std::string::npos);
+  EXPECT_NE(c.issues[0].message.find("expected a finite number"), std::string::npos);
+  EXPECT_EQ(c.issues[1].file, "traces/S004.csv");
+  EXPECT_EQ(c.issues[1].line, 5);
+  EXPECT_EQ(c.issues[1].column, 1);
+  EXPECT_NE(c.issues[1].message.find("time must increase"), std::string::npos);
+  EXPECT_EQ(c.issues[2].file, "traces/S006.csv");
+  EXPECT_NE(c.issues[2].message.find("shorter than the collision"), std::string::npos) << c.issues[2].message;
+}
+
+TEST(Campaign, MissingRequiredColumnIsAnErrorNamingIt) {
+  TempDir d;
+  std::ofstream(d.path / "trials.csv") << "trial_id,trace_file,gravity_m_s2\nA,traces/A.csv,9.81\n";
+  try {
+    load_campaign(d.str());
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("impact_velocity_m_s"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("trials.csv:1"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Campaign, StoresTrialsSamplesAndMetricsInSqlite) {
+  TempDir d;
+  write_synthetic_campaign((d.path / "c").string(), parse_model("base"), small());
+  const Campaign c = load_campaign((d.path / "c").string());
+  const std::string dbfile = (d.path / "lab.db").string();
+  {
+    db::Database db(dbfile);
+    EXPECT_EQ(store_campaign(db, c), 8);
+    EXPECT_EQ(store_campaign(db, c), 8);  // re-import replaces, no duplicates
+  }
+  db::Database db(dbfile);
+  db::Statement q(db, "SELECT COUNT(*), SUM(zstop_m > 0) FROM trial_metrics");
+  ASSERT_TRUE(q.step());
+  EXPECT_EQ(q.get_int(0), 8);
+  EXPECT_EQ(q.get_int(1), 8);
+  std::size_t samples = 0;
+  for (const auto& t : c.trials) samples += t.processed.t_s.size();
+  db::Statement s(db, "SELECT COUNT(*) FROM trial_samples");
+  ASSERT_TRUE(s.step());
+  EXPECT_EQ(static_cast<std::size_t>(s.get_int(0)), samples);
+  db::Statement g(db, "SELECT gravity_m_s2 FROM trials WHERE trial_id = 'S001'");
+  ASSERT_TRUE(g.step());
+  EXPECT_DOUBLE_EQ(g.get_double(0), 9.81);
+}

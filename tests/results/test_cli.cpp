@@ -1,0 +1,102 @@
+// The real `gravsweep` binary on real files: measurements import, model fit/rank/table3, synth,
+// report (PNGs and summary page), output formats and exit codes.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <sys/wait.h>
+
+#include "results_helpers.h"
+
+using gravsweep::testing::TempDir;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+  int code;
+  std::string out;
+};
+
+Run run(const std::string& args, bool merge_stderr = false) {
+  const std::string cmd = std::string("'") + GRAVSWEEP_BINARY + "' " + args + (merge_stderr ? " 2>&1" : " 2>/dev/null");
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf{};
+  while (p && fgets(buf.data(), buf.size(), p)) out += buf.data();
+  const int st = p ? pclose(p) : -1;
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+
+}  // namespace
+
+TEST(Cli, ImportsTheDevCampaignIntoSqlite) {
+  TempDir d;
+  const auto r = run("measurements import '" + gravsweep::testing::dev_campaign() + "' --db '" + d.str() + "/lab.db'");
+  EXPECT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("T072"), std::string::npos);
+  EXPECT_GT(fs::file_size(d.path / "lab.db"), 100000u);
+}
+
+TEST(Cli, ImportReportsBadTraceAndExitsIncomplete) {
+  TempDir d;
+  const std::string c = d.str() + "/c";
+  ASSERT_EQ(run("synth --out '" + c + "' --gravity 9.81 --speeds 0.5,1.0 --repeats 1").code, 0);
+  std::ofstream(c + "/traces/S002.csv") << "t_s,accel_m_s2\n0,-9.81\n0.001,abc\n";
+  const auto r = run("measurements import '" + c + "' --db '" + d.str() + "/x.db'", true);
+  EXPECT_EQ(r.code, 4) << r.out;
+  EXPECT_NE(r.out.find("traces/S002.csv:3:2"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("S001"), std::string::npos) << r.out;  // the other trial went through
+}
+
+TEST(Cli, ModelFitPrintsBeforeAndAfterAsCsvAndJson) {
+  const std::string dev = gravsweep::testing::dev_campaign();
+  const auto csv = run("model fit '" + dev + "' --model base+depth_friction --format csv");
+  ASSERT_EQ(csv.code, 0);
+  EXPECT_NE(csv.out.find("model,trace_rms_m_s2,trace_rel_pct,zstop_rms_mm"), std::string::npos) << csv.out;
+  EXPECT_NE(csv.out.find("base+depth_friction,"), std::string::npos);
+  const auto t3 = run("model table3 '" + dev + "' --format json");
+  ASSERT_EQ(t3.code, 0);
+  const auto j = nlohmann::json::parse(t3.out);
+  ASSERT_EQ(j.size(), 3u);
+  EXPECT_GT(j[0]["f0_N"].get<double>(), 0);
+}
+
+TEST(Cli, BadModelNameIsAUsageError) {
+  const auto r = run("model fit '" + gravsweep::testing::dev_campaign() + "' --model base+warp", true);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.out.find("unknown model term 'warp'"), std::string::npos) << r.out;
+}
+
+TEST(Cli, HelpTeachesWithExamples) {
+  for (const char* v : {"synth", "report", "model fit", "model rank", "measurements import"}) {
+    const auto r = run(std::string(v) + " --help");
+    EXPECT_EQ(r.code, 0) << v;
+    EXPECT_NE(r.out.find("Example"), std::string::npos) << v;
+  }
+}
+
+TEST(Cli, ReportWritesFiguresAndSummary) {
+  TempDir d;
+  const std::string c = d.str() + "/c", out = d.str() + "/report";
+  ASSERT_EQ(run("synth --out '" + c + "' --model base+immersion_drag --speeds 0.2,0.5,0.8,1.1 --repeats 2 --seed 4").code, 0);
+  const auto r = run("report '" + c + "' --out '" + out + "'", true);
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* f : {"fig9_metrics_vs_vc.png", "residual_vs_depth_speed.png", "fig10_zstop_vs_H.png",
+                        "ranking.png", "error_falls.png", "summary.md", "errors.csv", "ranking.csv"}) {
+    ASSERT_TRUE(fs::exists(fs::path(out) / f)) << f;
+    EXPECT_GT(fs::file_size(fs::path(out) / f), std::string(f).ends_with(".png") ? 10000u : 200u) << f;
+  }
+  std::ifstream png(fs::path(out) / "error_falls.png", std::ios::binary);
+  char sig[8];
+  png.read(sig, 8);
+  EXPECT_EQ(std::string(sig + 1, 3), "PNG");
+  std::ifstream md(fs::path(out) / "summary.md");
+  const std::string s{std::istreambuf_iterator<char>(md), std::istreambuf_iterator<char>()};
+  EXPECT_NE(s.find("immersion_drag"), std::string::npos);
+  EXPECT_NE(s.find("Table 3"), std::string::npos);
+}

@@ -1,0 +1,207 @@
+// Collision models on measurements: the term registry, fits, held-out errors, the paper's
+// Table 3, and finding the missing effect on the dev campaign and on synthetic campaigns.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "results/model/model.h"
+#include "results/model/synth.h"
+#include "results_helpers.h"
+
+using namespace gravsweep::results;
+using gravsweep::testing::TempDir;
+
+namespace {
+
+const Campaign& dev() {
+  static const Campaign c = load_campaign(gravsweep::testing::dev_campaign());
+  return c;
+}
+
+const AxisResidual& axis(const std::vector<AxisResidual>& a, const std::string& name) {
+  for (const auto& x : a)
+    if (x.axis == name) return x;
+  throw std::runtime_error("no axis " + name);
+}
+
+bool is_depth_friction(const std::string& t) { return t == "depth_friction" || t == "gravity_depth_friction"; }
+
+/// A small campaign: 3 gravity levels x 6 speeds x 2 repeats = 36 trials.
+SynthOptions small_synth(unsigned seed) {
+  SynthOptions o;
+  o.impact_velocity_m_s = {0.15, 0.35, 0.55, 0.75, 0.95, 1.15};
+  o.repeats = 2;
+  o.seed = seed;
+  return o;
+}
+
+}  // namespace
+
+TEST(Terms, RegistryHasTheLibraryAndRejectsUnknownNames) {
+  for (const char* n : {"base", "depth_friction", "gravity_depth_friction", "viscous_drag", "immersion_drag",
+                        "bottom_stiffening", "cohesion"})
+    EXPECT_EQ(find_term(n).name, n);
+  EXPECT_THROW(find_term("warp_drive"), std::invalid_argument);
+  const auto s = parse_model("base+depth_friction:shared");
+  ASSERT_EQ(s.terms.size(), 2u);
+  EXPECT_FALSE(s.terms[1].per_gravity);
+  EXPECT_EQ(s.name(), "base+depth_friction:shared");
+}
+
+TEST(Terms, ModelSpecFileErrorsNameTheJsonPointer) {
+  TempDir d;
+  const auto f = (d.path / "spec.json").string();
+  std::ofstream(f) << R"({"terms": [{"name": "base"}, {"name": "depth_friction", "shared": "yes"}]})";
+  try {
+    parse_model(f);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("/terms/1/shared"), std::string::npos) << e.what();
+  }
+  std::ofstream(f) << R"({"terms": [{"name": "base"}, {"name": "depth_friction", "shared": true}]})";
+  EXPECT_EQ(parse_model(f).name(), "base+depth_friction:shared");
+}
+
+TEST(Terms, ANewTermIsAFeatureFunctionAndFitsLikeTheOthers) {
+  // What a term file provides (ARCHITECTURE.md, "Collision-model terms"): a TermInfo with named
+  // parameters and a feature function. Here a quadratic depth friction k2 z^2, built in the test.
+  TermInfo q;
+  q.name = "depth_friction_sq";
+  q.params = {"k2_N_m2"};
+  q.per_gravity = true;
+  q.features = [](const TermContext& c, double* out) { out[0] = c.z_m * c.z_m; };
+  q.typical = [](double g, double m, double) { return std::vector<double>{2.0e3 * m * g}; };
+  ModelSpec truth = parse_model("base");
+  truth.terms.push_back({&q, true, 1.0});
+  TempDir d;
+  SynthOptions o = small_synth(3);
+  o.gravity_m_s2 = {9.81, 1.2};
+  write_synthetic_campaign(d.str(), truth, o);
+  const Campaign c = load_campaign(d.str());
+  ASSERT_GE(c.trials.size(), 20u);
+  const FittedModel with = fit_model(truth, c);
+  // k2 recovered at 1 g within 25 % (bed spread, fluctuations and the contact ramp remain).
+  EXPECT_EQ(with.column_names[4], "depth_friction_sq.k2_N_m2@g=9.81");
+  EXPECT_NEAR(with.coef(4), 2.0e3 * 9.81, 0.25 * 2.0e3 * 9.81);
+  const auto h0 = summarize(c, cross_validate(parse_model("base"), c, 4, 1));
+  const auto h1 = summarize(c, cross_validate(truth, c, 4, 1));
+  EXPECT_LT(h1.zstop_rel_pct, h0.zstop_rel_pct);
+}
+
+TEST(Table3, PaperMethodGivesParametersWithUncertainties) {
+  const auto rows = table3(dev());
+  ASSERT_EQ(rows.size(), 3u);
+  for (const auto& r : rows) {
+    EXPECT_EQ(r.trials, 24);
+    EXPECT_GT(r.f0_se_N, 0);
+    EXPECT_GT(r.inv_d1_se_1_m, 0);
+    EXPECT_GT(r.alpha_se, 0);
+  }
+  // 1 g: f0 near the truth's 1.6 m g = 15.7 N and 1/d1 near 25 1/m, within 3 standard errors.
+  EXPECT_NEAR(rows[0].f0_N, 15.7, 3 * rows[0].f0_se_N + 2);
+  EXPECT_NEAR(rows[0].inv_d1_1_m, 25, 3 * rows[0].inv_d1_se_1_m);
+  // Eqs. 3-4 at the Table 3 row of the paper's experiment: f0 = 25 N, 1/d1 = 25 1/m, 1 kg, 1 m/s.
+  Table3Row paper;
+  paper.g_m_s2 = 9.81;
+  paper.f0_N = 25;
+  paper.inv_d1_1_m = 25;
+  const Prediction p = predict_paper(paper, 1.0, 1.0);
+  EXPECT_NEAR(p.zstop_m, 0.02 * std::log(1 + 1.0 / (0.04 * 15.19)), 1e-9);
+  EXPECT_NEAR(p.apeak_m_s2, 25 + 25 - 9.81, 1e-12);
+}
+
+TEST(Fit, TraceFitRecoversTheHiddenDepthFrictionOnTheDevCampaign) {
+  const FittedModel m = fit_model(parse_model("base+depth_friction"), dev());
+  // Truth (ANSWER.md): k = f0/lambda = 1.6 m g / 3 cm per gravity level.
+  for (int gi = 0; gi < 3; ++gi) {
+    const double g = m.gravity_levels[static_cast<std::size_t>(gi)];
+    const double k = m.coef(6 + gi), se = std::sqrt(m.cov(6 + gi, 6 + gi));
+    EXPECT_NEAR(k, 1.6 * g / 0.03, std::max(4 * se, 0.2 * 1.6 * g / 0.03)) << "g = " << g;
+    EXPECT_GT(se, 0);
+  }
+}
+
+TEST(Discovery, DevCampaignBaselineFailsWithDepthAndDepthFrictionWins) {
+  const Discovery d = discover(dev(), parse_model("base"));
+  // Where it fails: of the state axes the residual varies most with depth, growing with it (the
+  // model misses a resistance that grows with depth), consistently across trials.
+  const auto& z = axis(d.residual_before, "depth_m");
+  for (const char* other : {"speed_m_s", "time_since_contact_s"}) EXPECT_GT(z.eta2, axis(d.residual_before, other).eta2);
+  EXPECT_GT(z.bin_mean_r_over_g.back(), z.bin_mean_r_over_g.front() + 0.5);
+  EXPECT_GT(z.trials_positive, 2 * z.trials_negative);
+  EXPECT_LT(z.slope_sign_trials_p, 1e-4);
+  // Which effect: depth friction first and significant, counted over 72 trials.
+  ASSERT_FALSE(d.rounds.empty());
+  const Candidate& first = d.rounds.front().front();
+  EXPECT_TRUE(is_depth_friction(first.term)) << first.term;
+  EXPECT_TRUE(first.significant);
+  EXPECT_EQ(first.trials, 72);
+  EXPECT_LT(first.p_value, 1e-6);
+  ASSERT_FALSE(d.added.empty());
+  EXPECT_TRUE(is_depth_friction(d.added.front()));
+  EXPECT_NE(d.verdict.find("missing effect"), std::string::npos) << d.verdict;
+  EXPECT_EQ(d.verdict.find("structure left"), std::string::npos) << d.verdict;
+}
+
+TEST(Discovery, AddingDepthFrictionCutsHeldOutZstopAndTstopErrors) {
+  const auto base = summarize(dev(), cross_validate(parse_model("base"), dev(), 6, 1));
+  const auto after = summarize(dev(), cross_validate(parse_model("base+depth_friction"), dev(), 6, 1));
+  const auto paper = summarize(dev(), cross_validate_paper(dev(), 6, 1));
+  EXPECT_LT(after.zstop_rms_mm, 0.7 * base.zstop_rms_mm);
+  EXPECT_LT(after.tstop_rms_ms, 0.7 * base.tstop_rms_ms);
+  EXPECT_LT(after.trace_rms_m_s2, base.trace_rms_m_s2);
+  EXPECT_LT(after.zstop_rms_mm, paper.zstop_rms_mm);
+  EXPECT_LT(after.tstop_rms_ms, paper.tstop_rms_ms);
+}
+
+class HiddenTerm : public ::testing::TestWithParam<std::tuple<std::string, unsigned>> {};
+
+TEST_P(HiddenTerm, IsRankedFirstOnASyntheticCampaign) {
+  const auto& [term, seed] = GetParam();
+  TempDir d;
+  SynthOptions o = small_synth(seed);
+  if (term == "bottom_stiffening") o.fill_height_m = {0.05, 0.07, 0.1, 0.21};
+  write_synthetic_campaign(d.str(), parse_model("base+" + term), o);
+  const Campaign c = load_campaign(d.str());
+  ASSERT_GE(c.trials.size(), 30u);
+  const Discovery disc = discover(c, parse_model("base"), 6, 0.01, 0.03, 1);
+  const Candidate& first = disc.rounds.front().front();
+  if (term == "depth_friction") {
+    EXPECT_TRUE(is_depth_friction(first.term)) << first.term;
+  } else {
+    EXPECT_EQ(first.term, term) << disc.verdict;
+  }
+  // The strong effects are also significant at this size (36 trials); the viscous drag, nearly
+  // a mix of the baseline's constant and v^2 over a trajectory, only ranks first.
+  if (term != "viscous_drag") {
+    EXPECT_TRUE(first.significant) << "p = " << first.p_value;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(FourHiddenTermsThreeSeeds, HiddenTerm,
+                         ::testing::Combine(::testing::Values("depth_friction", "immersion_drag",
+                                                              "bottom_stiffening", "viscous_drag"),
+                                            ::testing::Values(11u, 12u, 13u)),
+                         [](const auto& info) {
+                           return std::get<0>(info.param) + "_seed" + std::to_string(std::get<1>(info.param));
+                         });
+
+TEST(Discovery, NothingHiddenNothingReportedIn19Of20Seeds) {
+  int reported = 0;
+  std::string log;
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    TempDir d;
+    SynthOptions o;  // full size: 72 trials, as the dev campaign
+    o.seed = 100 + seed;
+    write_synthetic_campaign(d.str(), parse_model("base"), o);
+    const Campaign c = load_campaign(d.str());
+    const Discovery disc = discover(c, parse_model("base"), 6, 0.01, 0.03, 1);
+    if (!disc.added.empty()) {
+      ++reported;
+      log += "seed " + std::to_string(o.seed) + ": " + disc.verdict + "\n";
+    }
+  }
+  EXPECT_LE(reported, 1) << log;
+}
