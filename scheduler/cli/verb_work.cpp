@@ -114,6 +114,10 @@ int supervise(const WorkOptions& o, int threads) {
 
 int run_work(const WorkOptions& o) {
   if (!std::filesystem::exists(o.db)) throw UsageError(fmt::format("--db: no campaign database at '{}' (run `gravsweep submit` first)", o.db));
+  if (o.heartbeat_s > 0 && o.heartbeat_s * 2 > o.lease_s)
+    throw UsageError(fmt::format("--heartbeat: found {} s, expected at most half of --lease ({} s), or the lease "
+                                 "lapses between heartbeats",
+                                 o.heartbeat_s, o.lease_s));
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int threads = o.threads > 0 ? o.threads : std::max(1, cores / std::max(1, o.workers));
   if (o.workers > 1) return supervise(o, threads);
