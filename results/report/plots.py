@@ -101,16 +101,34 @@ def plot_residuals():
     for i, rc in enumerate(rcols):
         for j, (ax_key, lab, sc) in enumerate([("depth_m", "depth z (cm)", 100), ("speed_m_s", "speed v (m/s)", 1)]):
             ax = axs[i][j]
+            allr = []
             for k, g in enumerate(gs):
                 s = [r for r in rows if num(r["gravity_m_s2"]) == g]
-                ax.plot([sc * num(r[ax_key]) for r in s], [num(r[rc]) / g for r in s], ".", ms=1.5,
-                        color=COLORS[k % len(COLORS)], label=f"g = {g:g}")
+                xs = [sc * num(r[ax_key]) for r in s]
+                ys = [num(r[rc]) / g for r in s]
+                allr += ys
+                ax.plot(xs, ys, ".", ms=1, alpha=0.25, color=COLORS[k % len(COLORS)])
+                # binned means (10 quantile bins): the structure the scatter hides
+                pairs = sorted(zip(xs, ys))
+                nb = 10
+                bx, by = [], []
+                for b in range(nb):
+                    chunk = pairs[b * len(pairs) // nb:(b + 1) * len(pairs) // nb]
+                    if chunk:
+                        bx.append(sum(p[0] for p in chunk) / len(chunk))
+                        by.append(sum(p[1] for p in chunk) / len(chunk))
+                ax.plot(bx, by, "o-", ms=4, lw=1.5, color=COLORS[k % len(COLORS)], label=f"g = {g:g} m/s2 (bin means)")
             ax.axhline(0, color="k", lw=0.8)
+            srt = sorted(allr)
+            if srt:
+                lo, hi = srt[int(0.02 * len(srt))], srt[int(0.98 * len(srt)) - 1]
+                pad = 0.1 * (hi - lo)
+                ax.set_ylim(lo - pad, hi + pad)
             ax.set_xlabel(lab)
             ax.set_ylabel("residual a_meas - a_model (g)")
             ax.set_title(rc[2:].replace("_m_s2", ""))
             if i == 0 and j == 0:
-                ax.legend(fontsize=7, markerscale=6)
+                ax.legend(fontsize=7)
     save(fig, "residual_vs_depth_speed.png")
 
 

@@ -176,6 +176,38 @@ void setup_model(CLI::App& app) {
     }
   });
 
+  auto ores = std::make_shared<ModelOptions>();
+  ores->model = "base";
+  auto* res = sub->add_subcommand(
+      "residuals",
+      "Where a model fails: fit it on all trials, then print per trial the residuals of the\n"
+      "metrics (model - measured zstop, tstop, apeak; RMS of a_meas - a_model over the trace)\n"
+      "with gravity, impact speed and fill height, and per sample the mean residual (in g) in\n"
+      "quantile bins of depth, speed, time since contact, gravity, impact speed and fill height,\n"
+      "with eta^2 (share of residual variance the binning explains) and a sign test over trials\n"
+      "of the within-trial slope.\n\n"
+      "Example:\n  gravsweep model residuals ../shared/data/measurements/depth-friction-dev --model base");
+  res->add_option("dir", ores->dir, "campaign folder")->required();
+  res->add_option("--model", ores->model, "model: 'base' or a JSON spec file")->capture_default_str();
+  res->add_option("--format", ores->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
+  res->callback([ores]() {
+    const auto c = load(ores->dir);
+    const auto fm = results::fit_model(spec_of(ores->model), c);
+    results::Table t({"trial_id", "gravity_m_s2", "vc_m_s", "fill_height_m", "trace_rms_m_s2", "dzstop_mm",
+                      "dtstop_ms", "dapeak_m_s2"});
+    for (const auto& tr : c.trials) {
+      const auto p = results::predict(fm, tr.info);
+      const auto& m = tr.processed.metrics;
+      t.add({tr.info.trial_id, num(tr.info.gravity_m_s2), num(m.vc_m_s), num(tr.info.fill_height_m),
+             num(std::sqrt(results::trial_trace_mse(fm, tr)), 3), p.stopped ? num(1e3 * (p.zstop_m - m.zstop_m), 3) : "nan",
+             p.stopped ? num(1e3 * (p.tstop_s - m.tstop_s), 3) : "nan", num(p.apeak_m_s2 - m.apeak_m_s2, 3)});
+    }
+    if (ores->format == "table") fmt::print("Per trial ({} fitted on all trials; model - measured):\n", fm.spec.name());
+    t.print(ores->format);
+    if (ores->format == "table") fmt::print("\nPer sample, residual a_meas - a_model in units of g, by axis:\n");
+    print_axes(results::residual_axes(fm, c), ores->format);
+  });
+
   auto orank = std::make_shared<ModelOptions>();
   auto* rank = sub->add_subcommand(
       "rank",

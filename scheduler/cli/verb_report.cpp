@@ -82,6 +82,21 @@ void setup_report(CLI::App& app) {
     md << fmt::format("{} trials, gravity levels:", c.trials.size());
     for (double g : c.gravity_levels()) md << fmt::format(" {} m/s2", g);
     md << fmt::format(". {} rejected.\n\n## Verdict\n\n{}\n\n", c.issues.size(), d.verdict);
+    md << fmt::format("## Where {} fails\n\nResidual a_meas - a_model (in g) by quantile bins of each axis; eta2 is the share "
+                      "of the residual variance the bins explain, the sign test counts trials whose within-trial slope "
+                      "is up or down.\n\n```\n", d.baseline);
+    for (const auto* axes : {&d.residual_before, &d.residual_after}) {
+      results::Table t({"axis", "eta2", "trials_up", "trials_down", "mean_residual_over_g_by_bin"});
+      for (const auto& a : *axes) {
+        std::string bins;
+        for (std::size_t i = 0; i < a.bin_center.size(); ++i)
+          bins += fmt::format("{}{:.3g}:{:+.3f}", i ? " " : "", a.bin_center[i], a.bin_mean_r_over_g[i]);
+        t.add({a.axis, results::num(a.eta2, 3), std::to_string(a.trials_positive), std::to_string(a.trials_negative), bins});
+      }
+      md << (axes == &d.residual_before ? "before (" + d.baseline + "):\n" : "\nafter (with the added terms):\n");
+      md << t.render("table");
+    }
+    md << "```\n\n";
     md << "## Table 3 (paper's method: Eq. 2 fitted to apeak per gravity level)\n\n```\n";
     {
       results::Table t({"gravity_m_s2", "trials", "f0_N", "f0_se_N", "inv_d1_1_m", "inv_d1_se_1_m", "vt_m_s", "alpha", "alpha_se"});
