@@ -78,7 +78,9 @@ TEST(SweepSpec, ProductOfListsRangesZipsAndRepeats) {
   EXPECT_EQ(ids.size(), jobs.size()) << "job ids must be distinct";
   // zip: fill 0.21 always comes with dt 2e-5
   for (const auto& j : jobs)
-    if (j.kind == "drop") EXPECT_EQ(j.scenario["fill_m"] == 0.21, j.scenario["dt_s"] == 2e-5);
+    if (j.kind == "drop") {
+      EXPECT_EQ(j.scenario["fill_m"] == 0.21, j.scenario["dt_s"] == 2e-5);
+    }
 }
 
 TEST(SweepSpec, ExpansionIsDeterministicAndExtensionKeepsIds) {
