@@ -186,3 +186,39 @@ TEST(CliQueue, FollowingWorkersPickUpLateSubmissionsAndTheSupervisorForwardsSigt
   EXPECT_EQ(wait_child(sup, 10), 130);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='running'"), 0);
 }
+
+TEST(CliQueue, ResumeAfterEveryWorkerWasKilled) {
+  TempDir d;
+  write_text(d.path / "spec.json", noop_spec({1.0, 2.0}, 1.0));
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
+  const std::string db_path = (d.path / "c.db").string();
+  const pid_t w = start_cli({"work", "--db", db_path, "--lease", "1", "--heartbeat", "0.2"}, d.path / "w.log");
+  db::Database db(db_path);
+  const auto t0 = std::chrono::steady_clock::now();
+  while (sql_int(db, "SELECT count(*) FROM jobs WHERE state='running' AND progress > 0.1") == 0) {
+    ASSERT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(20));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  kill(w, SIGKILL);
+  EXPECT_EQ(wait_child(w, 5), 128 + SIGKILL);
+  // A file the dead worker left behind, as if it died between its rename and its commit.
+  const std::string planned = sql_text(db, "SELECT output_path FROM attempts WHERE outcome='running'");
+  ASSERT_FALSE(planned.empty());
+  write_text(d.path / planned, "half");
+  auto r = run_cli({"status", "--db", "c.db"}, d.path);
+  EXPECT_NE(r.out.find("running jobs (1 active, 0 stale leases)"), std::string::npos) << r.out;
+  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  r = run_cli({"status", "--db", "c.db"}, d.path);
+  EXPECT_NE(r.out.find("1 stale lease(s)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("STALE"), std::string::npos) << r.out;
+  r = run_cli({"resume", "--db", "c.db"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("expired leases: 1 requeued"), std::string::npos) << r.out;
+  EXPECT_FALSE(std::filesystem::exists(d.path / planned)) << "the lost attempt's file must go";
+  EXPECT_EQ(sql_text(db, "SELECT outcome FROM attempts WHERE output_path='" + planned + "'"), "lost");
+  r = run_cli({"work", "--db", "c.db", "--quiet"}, d.path);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), 2);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results"), 2);
+  EXPECT_EQ(sql_text(db, "PRAGMA integrity_check"), "ok");
+}
