@@ -1,0 +1,103 @@
+// The drop itself (engine/scenario/impact.h) in an empty container: release height and speed,
+// free fall at -g in the paper's frame, the stop criterion after contact (Sect. 2.2).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "engine/core/error.h"
+#include "engine/scenario/bed.h"
+#include "engine/scenario/impact.h"
+#include "engine/scenario/paper_params.h"
+
+namespace gravsweep {
+namespace {
+
+struct EmptyContainer {
+  System sys;
+  explicit EmptyContainer(double g) : sys(make_config(g)) {
+    ContainerSpec c;
+    c.diameter_m = 0.2;
+    add_container_walls(sys, c, 0.3, kWallMaterial);
+  }
+  static SystemConfig make_config(double g) {
+    SystemConfig c = chrono_table1_config();
+    c.dt_s = 1e-5;
+    c.gravity_m_s2 = Vec3(0, 0, -g);
+    return c;
+  }
+};
+
+/// Velocity (down) when the trace's depth crosses zero, by linear interpolation.
+double speed_at_surface(const DropResult& r) {
+  for (std::size_t i = 1; i < r.samples.size(); ++i) {
+    const auto& a = r.samples[i - 1];
+    const auto& b = r.samples[i];
+    if (a.depth_m < 0 && b.depth_m >= 0) {
+      const double f = -a.depth_m / (b.depth_m - a.depth_m);
+      return a.velocity_down_m_s + f * (b.velocity_down_m_s - a.velocity_down_m_s);
+    }
+  }
+  return NAN;
+}
+
+TEST(Drop, ImpactSpeedModeReachesTheSurfaceAtThatSpeed) {
+  EmptyContainer c(9.81);
+  ProjectileSpec p;
+  p.diameter_m = 0.1;
+  p.mass_kg = 1.0;
+  p.impact_speed_m_s = 0.7;
+  p.start_gap_m = 0.01;
+  DropStop stop;
+  stop.max_time_s = 1.0;
+  const DropResult r = drop_projectile(c.sys, 0.05, p, stop, 1e4);
+  ASSERT_GT(r.samples.size(), 10u);
+  EXPECT_NEAR(r.samples.front().depth_m, -0.01, 1e-12);
+  EXPECT_NEAR(r.release_speed_m_s, std::sqrt(0.49 - 2 * 9.81 * 0.01), 1e-12);
+  EXPECT_NEAR(speed_at_surface(r), 0.7, 2e-3);  // semi-implicit Euler, 10 kHz sampling
+  // Paper frame: free fall reads -g, velocity positive down, depth grows.
+  EXPECT_NEAR(r.samples[5].accel_up_m_s2, -9.81, 1e-9);
+  EXPECT_GT(r.samples[5].velocity_down_m_s, 0.0);
+  EXPECT_EQ(r.samples[5].contacts, 0);
+  // The floor is 5 cm below the "surface": the projectile lands there and comes to rest.
+  ASSERT_TRUE(r.first_contact_s.has_value());
+  EXPECT_NEAR(*r.first_contact_s, 0.07, 0.01);  // 6 cm at about 0.7-1.0 m/s
+  EXPECT_TRUE(r.stopped);
+  EXPECT_NEAR(r.samples.back().depth_m, 0.05, 1e-3);
+  EXPECT_EQ(r.samples.back().contacts, 1);
+  EXPECT_LT(std::abs(r.samples.back().velocity_down_m_s), 1e-3);
+  EXPECT_LT(r.samples.back().t_s, 1.0);
+}
+
+TEST(Drop, DropHeightModeFallsFromRestWithTheOffsets) {
+  EmptyContainer c(1.62);
+  ProjectileSpec p;
+  p.drop_height_m = 0.03;
+  p.vertical_offset_m = 0.01;
+  p.lateral_offset_x_m = 0.02;
+  DropStop stop;
+  stop.max_time_s = 0.5;
+  const DropResult r = drop_projectile(c.sys, 0.05, p, stop, 1e4);
+  EXPECT_EQ(r.release_speed_m_s, 0.0);
+  EXPECT_NEAR(r.samples.front().depth_m, -0.04, 1e-12);
+  EXPECT_NEAR(r.samples.front().position_m.x(), 0.02, 1e-12);
+  EXPECT_NEAR(speed_at_surface(r), std::sqrt(2 * 1.62 * 0.04), 2e-3);
+  EXPECT_NEAR(r.samples[3].accel_up_m_s2, -1.62, 1e-9);
+  // Time cap: at 1.62 m/s2 the bounces on the floor outlast 0.5 s, and the run ends at the cap.
+  EXPECT_FALSE(r.stopped);
+  EXPECT_NEAR(r.samples.back().t_s, 0.5, 1e-3);
+}
+
+TEST(Drop, RefusesAmbiguousOrUnreachableStarts) {
+  EmptyContainer c(9.81);
+  ProjectileSpec p;
+  p.impact_speed_m_s = 1.0;
+  p.drop_height_m = 0.02;
+  EXPECT_THROW(drop_projectile(c.sys, 0.05, p, DropStop{}, 1e4), ConfigError);
+  ProjectileSpec q;
+  q.impact_speed_m_s = 0.1;
+  q.start_gap_m = 0.01;  // free fall over 1 cm already gives 0.44 m/s
+  EXPECT_THROW(drop_projectile(c.sys, 0.05, q, DropStop{}, 1e4), ConfigError);
+}
+
+}  // namespace
+}  // namespace gravsweep
