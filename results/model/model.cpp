@@ -597,9 +597,12 @@ std::vector<AxisResidual> residual_axes(const FittedModel& m, const Campaign& c)
     double acc_w = 0;
     std::size_t pos = 0;
     double between = 0;
+    std::vector<double> half_even, half_odd;  // bin means over even- and odd-numbered trials
     for (int b = 0; b < nb && pos < idx.size(); ++b) {
       const double target = W * (b + 1) / nb;
       double bw = 0, br = 0, bx = 0;
+      double hw[2] = {0, 0}, hr[2] = {0, 0};
+      const std::size_t pos0 = pos;
       const double x_first = s[idx[pos]].x[a];
       while (pos < idx.size() && (acc_w < target || b == nb - 1)) {
         const auto& q = s[idx[pos]];
@@ -616,11 +619,33 @@ std::vector<AxisResidual> residual_axes(const FittedModel& m, const Campaign& c)
       }
       (void)x_first;
       if (bw <= 0) continue;
+      for (std::size_t k = pos0; k < pos; ++k) {
+        const auto& q = s[idx[k]];
+        hw[q.trial % 2] += q.w, hr[q.trial % 2] += q.w * q.r;
+      }
+      if (hw[0] > 0 && hw[1] > 0) {
+        half_even.push_back(hr[0] / hw[0]);
+        half_odd.push_back(hr[1] / hw[1]);
+      }
       ar.bin_center.push_back(bx / bw);
       ar.bin_mean_r_over_g.push_back(br / bw);
       between += bw * std::pow(br / bw - M, 2);
     }
     ar.eta2 = V > 0 ? between / V : 0;
+    // Split-half reproducibility: the bin profile of the even-numbered trials against that of the
+    // odd-numbered ones (disjoint sets of trials), Pearson r over the bins.
+    if (half_even.size() >= 3) {
+      const double n = static_cast<double>(half_even.size());
+      double me = 0, mo = 0;
+      for (std::size_t i = 0; i < half_even.size(); ++i) me += half_even[i] / n, mo += half_odd[i] / n;
+      double see = 0, soo = 0, seo = 0;
+      for (std::size_t i = 0; i < half_even.size(); ++i) {
+        see += (half_even[i] - me) * (half_even[i] - me);
+        soo += (half_odd[i] - mo) * (half_odd[i] - mo);
+        seo += (half_even[i] - me) * (half_odd[i] - mo);
+      }
+      ar.split_half_r = see > 0 && soo > 0 ? seo / std::sqrt(see * soo) : 0;
+    }
     if (a < 3) {
       // Within-trial slope of r against the axis; sign test over trials.
       std::vector<double> sx(c.trials.size()), sy(c.trials.size()), sxx(c.trials.size()),
@@ -657,14 +682,16 @@ bool structured(const std::vector<AxisResidual>& axes, std::string& where) {
       if (a.eta2 >= 0.25 && (!best || a.eta2 > best->eta2)) best = &a;
       continue;
     }
-    if (a.eta2 >= 0.15 && a.slope_sign_trials_p < 1e-4 && (!best || a.eta2 > best->eta2)) best = &a;
+    const bool monotone = a.eta2 >= 0.15 && a.slope_sign_trials_p < 1e-4;
+    const bool reproducible = a.eta2 >= 0.05 && a.split_half_r >= 0.9;
+    if ((monotone || reproducible) && (!best || a.eta2 > best->eta2)) best = &a;
   }
   if (!best) return false;
   std::string bins;
   for (std::size_t i = 0; i < best->bin_center.size(); ++i)
     bins += fmt::format("{}{:.3g}:{:+.3f}", i ? ", " : "", best->bin_center[i], best->bin_mean_r_over_g[i]);
-  where = fmt::format("residual varies with {} (eta^2 = {:.2f}; mean residual/g by bin: {})",
-                      best->axis, best->eta2, bins);
+  where = fmt::format("residual varies with {} (eta^2 = {:.2f}, split-half r = {:.2f}; mean residual/g by bin: {})",
+                      best->axis, best->eta2, best->split_half_r, bins);
   return true;
 }
 
@@ -717,6 +744,7 @@ Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds, doub
   d.residual_after = residual_axes(fit_model(current, c), c);
   std::string where;
   const bool left = structured(d.residual_after, where);
+  d.structure_left = left;
   if (d.added.empty()) {
     d.verdict = left ? "structure left that no candidate explains: " + where
                      : "no missing effect found: no candidate term improves the held-out trials "

@@ -100,6 +100,7 @@ struct AxisResidual {
   double eta2 = 0;
   double slope_sign_trials_p = 1;  ///< sign test over trials of the within-trial slope
   int trials_positive = 0, trials_negative = 0;
+  double split_half_r = 0;  ///< bin profile of even- vs odd-numbered trials (Pearson r)
 };
 std::vector<AxisResidual> residual_axes(const FittedModel& m, const Campaign& c);
 
@@ -116,6 +117,7 @@ struct Discovery {
   std::vector<std::vector<Candidate>> rounds;  ///< ranking per forward step
   std::vector<std::string> added;               ///< winners, in order
   std::string verdict;                          ///< the sentence for users
+  bool structure_left = false;                  ///< residuals still structured after the additions
   std::vector<AxisResidual> residual_before, residual_after;
 };
 /// Forward selection from `baseline` over all other registered terms by grouped-CV improvement,

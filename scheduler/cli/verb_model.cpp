@@ -75,13 +75,13 @@ results::Table error_table(const std::vector<results::ComparedModel>& cm) {
 }
 
 void print_axes(const std::vector<results::AxisResidual>& axes, const std::string& format) {
-  results::Table t({"axis", "eta2", "trials_slope_up", "trials_slope_down", "sign_test_p", "mean_residual_over_g_by_bin"});
+  results::Table t({"axis", "eta2", "split_half_r", "trials_slope_up", "trials_slope_down", "sign_test_p", "mean_residual_over_g_by_bin"});
   for (const auto& a : axes) {
     std::string bins;
     for (std::size_t i = 0; i < a.bin_center.size(); ++i)
       bins += fmt::format("{}{:.3g}:{:+.3f}", i ? " " : "", a.bin_center[i], a.bin_mean_r_over_g[i]);
     const bool trial_level = a.trials_positive + a.trials_negative == 0;
-    t.add({a.axis, num(a.eta2, 3), trial_level ? "-" : std::to_string(a.trials_positive),
+    t.add({a.axis, num(a.eta2, 3), num(a.split_half_r, 2), trial_level ? "-" : std::to_string(a.trials_positive),
            trial_level ? "-" : std::to_string(a.trials_negative), trial_level ? "-" : num(a.slope_sign_trials_p, 2), bins});
   }
   t.print(format);
