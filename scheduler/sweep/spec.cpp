@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -436,6 +437,7 @@ SweepSpec parse_spec(const json& doc, const std::string& file, const std::filesy
     throw SpecError(file, {{"/axes", fmt::format("{} points", spec.points()), "at most 5000000 points per sweep"}});
   spec.source = doc;
   spec.source["base"] = spec.base;
+  spec.file = file;
   return spec;
 }
 
@@ -471,6 +473,7 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
   const std::size_t n = spec.points();
   std::vector<std::size_t> idx(spec.groups.size(), 0);
   std::vector<SpecProblem> problems;
+  std::vector<std::size_t> repeats;
   drops.reserve(n);
   for (std::size_t p = 0; p < n; ++p) {
     // Mixed-radix digits of p, last group fastest.
@@ -502,8 +505,16 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
       if (!bed_key) throw std::runtime_error("no bed key function (the impact pipeline is not built in)");
       key = bed_key(job.scenario);
     } catch (const std::exception& e) {
-      if (problems.size() < 20)
-        problems.push_back({"/base", "the scenario at point " + job.params.dump(), std::string("a valid scenario: ") + e.what()});
+      // One problem per distinct message: a bad base field fails every point the same way.
+      const std::string expected = std::string("a valid scenario: ") + e.what();
+      auto same = std::find_if(problems.begin(), problems.end(),
+                               [&](const SpecProblem& p) { return p.expected == expected; });
+      if (same != problems.end()) {
+        ++repeats[static_cast<std::size_t>(same - problems.begin())];
+      } else if (problems.size() < 20) {
+        problems.push_back({"/base", "the scenario at point " + job.params.dump(), expected});
+        repeats.push_back(0);
+      }
       continue;
     }
     const std::string bed_id = job_id("bed", key);
@@ -526,7 +537,9 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
     job.deps.push_back(bed_id);
     drops.push_back(std::move(job));
   }
-  if (!problems.empty()) throw SpecError(spec.name, problems);
+  for (std::size_t i = 0; i < problems.size(); ++i)
+    if (repeats[i] > 0) problems[i].found += fmt::format(" (and {} more point{} with this problem)", repeats[i], repeats[i] == 1 ? "" : "s");
+  if (!problems.empty()) throw SpecError(spec.file.empty() ? spec.name : spec.file, problems);
   for (auto& b : beds) {  // drop the parameters that vary within the bed
     json kept = json::object();
     for (auto it = b.params.begin(); it != b.params.end(); ++it)

@@ -54,6 +54,7 @@ struct SweepSpec {
   int max_attempts = 3;
   int priority = 0;
   nlohmann::json source;            ///< the spec as read (with the base inlined)
+  std::string file;                 ///< where it was read from (for error messages)
   [[nodiscard]] std::size_t points() const;
 };
 
