@@ -123,6 +123,12 @@ void run_status(const StatusOptions& o) {
     } else {
       if (o.watch_s > 0) fmt::print("\x1b[H\x1b[2J");
       fmt::print("{}", render_status(s, o.db, secs));
+      // Provenance: results from another build of gravsweep (like Snakemake's code rerun trigger).
+      db::Statement other(db, "SELECT count(*), group_concat(DISTINCT code_version) FROM results WHERE code_version != ?");
+      other.bind(1, std::string(GRAVSWEEP_VERSION));
+      if (other.step() && other.get_int(0) > 0)
+        fmt::print("{} result(s) were computed by another code version ({}); this is {}\n", other.get_int(0),
+                   other.get_text(1), GRAVSWEEP_VERSION);
     }
     std::fflush(stdout);
     if (o.watch_s <= 0) break;
