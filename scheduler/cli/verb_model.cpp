@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <unistd.h>
 #include <string>
 #include <vector>
 
@@ -147,14 +148,19 @@ void setup_model(CLI::App& app) {
       "paper's Eq. 2-4, the baseline and the model side by side: trace RMS, zstop, tstop, apeak.\n\n"
       "Examples:\n"
       "  gravsweep model fit ../shared/data/measurements/depth-friction-dev --model base+depth_friction\n"
-      "  gravsweep model fit DIR --model spec.json --plot error_falls.png --format csv");
+      "  gravsweep model fit DIR --model spec.json --plot fall.png --format csv\n"
+      "The figure of the error falling is written to --plot (default error_falls.png).");
   fit->add_option("dir", of->dir, "campaign folder")->required();
   fit->add_option("--model", of->model, "model: 'base+depth_friction' or a JSON spec file")->capture_default_str();
   fit->add_option("--baseline", of->baseline, "the 'before' model")->capture_default_str();
   fit->add_option("--folds", of->folds, "cross-validation folds (whole trials)")->check(CLI::Range(2, 100))->capture_default_str();
-  fit->add_option("--plot", of->plot, "write the error-falling figure (PNG) here");
+  of->plot = "error_falls.png";
+  fit->add_option("--plot", of->plot, "write the error-falling figure (PNG) here")->capture_default_str();
+  auto no_plot = std::make_shared<bool>(false);
+  fit->add_flag("--no-plot", *no_plot, "do not write the figure");
   fit->add_option("--format", of->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
-  fit->callback([of]() {
+  fit->callback([of, no_plot]() {
+    if (*no_plot) of->plot.clear();
     const auto c = load(of->dir);
     const auto base = spec_of(of->baseline);
     const auto spec = spec_of(of->model);
@@ -167,12 +173,20 @@ void setup_model(CLI::App& app) {
     if (!of->plot.empty()) {
       namespace fs = std::filesystem;
       const fs::path png = fs::absolute(of->plot);
-      const fs::path tmp = png.parent_path() / (png.stem().string() + "_data");
-      results::write_report_data(tmp.string(), c, cm, {base, spec}, nullptr);
+      // The plot's data go to a private temporary folder, removed afterwards.
+      struct Tmp {
+        fs::path p;
+        ~Tmp() {
+          std::error_code ec;
+          fs::remove_all(p, ec);
+        }
+      } tmp{fs::temp_directory_path() / fmt::format("gravsweep-fit-{}", ::getpid())};
+      results::write_report_data(tmp.p.string(), c, cm, {base, spec}, nullptr);
       std::string log;
-      if (results::run_plots(tmp.string(), "errors", log) != 0) throw std::runtime_error("plotting failed: " + log);
-      fs::copy_file(tmp / "error_falls.png", png, fs::copy_options::overwrite_existing);
-      std::fprintf(stderr, "wrote %s (data in %s)\n", png.c_str(), tmp.c_str());
+      if (results::run_plots(tmp.p.string(), "errors", log) != 0) throw std::runtime_error("plotting failed: " + log);
+      fs::create_directories(png.parent_path());
+      fs::copy_file(tmp.p / "error_falls.png", png, fs::copy_options::overwrite_existing);
+      if (of->format == "table") fmt::print("\nwrote {}\n", png.string());
     }
   });
 

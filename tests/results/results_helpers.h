@@ -32,3 +32,10 @@ inline std::string dev_campaign() {
 }
 
 }  // namespace gravsweep::testing
+
+/// The dev campaign lives outside the repository (../shared); skip, saying so, where it is absent.
+#define GRAVSWEEP_REQUIRE_DEV_CAMPAIGN()                                                      \
+  do {                                                                                        \
+    if (!std::filesystem::exists(gravsweep::testing::dev_campaign() + "/trials.csv"))          \
+      GTEST_SKIP() << "no dev campaign at " << gravsweep::testing::dev_campaign();             \
+  } while (0)

@@ -35,6 +35,7 @@ Run run(const std::string& args, bool merge_stderr = false) {
 }  // namespace
 
 TEST(Cli, ImportsTheDevCampaignIntoSqlite) {
+  GRAVSWEEP_REQUIRE_DEV_CAMPAIGN();
   TempDir d;
   const auto r = run("measurements import '" + gravsweep::testing::dev_campaign() + "' --db '" + d.str() + "/lab.db'");
   EXPECT_EQ(r.code, 0) << r.out;
@@ -54,11 +55,14 @@ TEST(Cli, ImportReportsBadTraceAndExitsIncomplete) {
 }
 
 TEST(Cli, ModelFitPrintsBeforeAndAfterAsCsvAndJson) {
+  GRAVSWEEP_REQUIRE_DEV_CAMPAIGN();
   const std::string dev = gravsweep::testing::dev_campaign();
-  const auto csv = run("model fit '" + dev + "' --model base+depth_friction --format csv");
+  TempDir d;
+  const auto csv = run("model fit '" + dev + "' --model base+depth_friction --format csv --plot '" + d.str() + "/fall.png'");
   ASSERT_EQ(csv.code, 0);
   EXPECT_NE(csv.out.find("model,trace_rms_m_s2,trace_rel_pct,zstop_rms_mm"), std::string::npos) << csv.out;
   EXPECT_NE(csv.out.find("base+depth_friction,"), std::string::npos);
+  EXPECT_GT(fs::file_size(d.path / "fall.png"), 10000u);
   const auto t3 = run("model table3 '" + dev + "' --format json");
   ASSERT_EQ(t3.code, 0);
   const auto j = nlohmann::json::parse(t3.out);
@@ -67,7 +71,8 @@ TEST(Cli, ModelFitPrintsBeforeAndAfterAsCsvAndJson) {
 }
 
 TEST(Cli, BadModelNameIsAUsageError) {
-  const auto r = run("model fit '" + gravsweep::testing::dev_campaign() + "' --model base+warp", true);
+  GRAVSWEEP_REQUIRE_DEV_CAMPAIGN();
+  const auto r = run("model fit '" + gravsweep::testing::dev_campaign() + "' --model base+warp --no-plot", true);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.out.find("unknown model term 'warp'"), std::string::npos) << r.out;
 }

@@ -92,6 +92,7 @@ TEST(Terms, ANewTermIsAFeatureFunctionAndFitsLikeTheOthers) {
 }
 
 TEST(Table3, PaperMethodGivesParametersWithUncertainties) {
+  GRAVSWEEP_REQUIRE_DEV_CAMPAIGN();
   const auto rows = table3(dev());
   ASSERT_EQ(rows.size(), 3u);
   for (const auto& r : rows) {
@@ -114,6 +115,7 @@ TEST(Table3, PaperMethodGivesParametersWithUncertainties) {
 }
 
 TEST(Fit, TraceFitRecoversTheHiddenDepthFrictionOnTheDevCampaign) {
+  GRAVSWEEP_REQUIRE_DEV_CAMPAIGN();
   const FittedModel m = fit_model(parse_model("base+depth_friction"), dev());
   // Truth (ANSWER.md): k = f0/lambda = 1.6 m g / 3 cm per gravity level.
   for (int gi = 0; gi < 3; ++gi) {
@@ -125,6 +127,7 @@ TEST(Fit, TraceFitRecoversTheHiddenDepthFrictionOnTheDevCampaign) {
 }
 
 TEST(Discovery, DevCampaignBaselineFailsWithDepthAndDepthFrictionWins) {
+  GRAVSWEEP_REQUIRE_DEV_CAMPAIGN();
   const Discovery d = discover(dev(), parse_model("base"));
   // Where it fails: of the state axes the residual varies most with depth, growing with it (the
   // model misses a resistance that grows with depth), consistently across trials.
@@ -147,6 +150,7 @@ TEST(Discovery, DevCampaignBaselineFailsWithDepthAndDepthFrictionWins) {
 }
 
 TEST(Discovery, AddingDepthFrictionCutsHeldOutZstopAndTstopErrors) {
+  GRAVSWEEP_REQUIRE_DEV_CAMPAIGN();
   const auto base = summarize(dev(), cross_validate(parse_model("base"), dev(), 6, 1));
   const auto after = summarize(dev(), cross_validate(parse_model("base+depth_friction"), dev(), 6, 1));
   const auto paper = summarize(dev(), cross_validate_paper(dev(), 6, 1));
