@@ -142,6 +142,19 @@ def plot_fig10():
         z = [num(r["zstop_m"]) for r in t]
         ax.loglog([100 * h for h in H], [100 * x for x in z], "o", ms=3, color=COLORS[k % len(COLORS)],
                   label=f"g = {g:g} m/s2")
+    curves = read(os.path.join(D, "model_curves.csv"))
+    models = []
+    for r in curves:
+        if r["model"] not in models:
+            models.append(r["model"])
+    styles = ["-", "--", ":", "-."]
+    for k, g in enumerate(gs):
+        for mi, m in enumerate(models):
+            c = [r for r in curves if r["model"] == m and num(r["gravity_m_s2"]) == g and num(r["zstop_m"]) > 0]
+            H = [100 * (num(r["vc_m_s"]) ** 2 / (2 * g) + num(r["zstop_m"])) for r in c]
+            z = [100 * num(r["zstop_m"]) for r in c]
+            ax.loglog(H, z, styles[mi % len(styles)], lw=1, color=COLORS[k % len(COLORS)],
+                      label=m if k == 0 else None)
     ax.set_xlabel("H = drop height + zstop (cm)")
     ax.set_ylabel("zstop (cm)")
     ax.set_title("Penetration depth vs total height (Fig. 10)")

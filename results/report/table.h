@@ -48,10 +48,21 @@ class Table {
       for (std::size_t j = 0; j < cols_.size(); ++j) w[j] = cols_[j].size();
       for (const auto& r : rows_)
         for (std::size_t j = 0; j < r.size(); ++j) w[j] = std::max(w[j], r[j].size());
+      // Numbers right-aligned, text left-aligned (a column is numeric when all its cells are).
+      std::vector<bool> numeric(cols_.size(), true);
+      for (const auto& r : rows_)
+        for (std::size_t j = 0; j < r.size(); ++j) {
+          char* end = nullptr;
+          std::strtod(r[j].c_str(), &end);
+          if (!(r[j].empty() || r[j] == "nan" || r[j] == "-" || (end && *end == '\0'))) numeric[j] = false;
+        }
+      numeric[0] = false;
       auto line = [&](const std::vector<std::string>& r) {
+        std::string l;
         for (std::size_t j = 0; j < r.size(); ++j)
-          out += (j ? "  " : "") + (j == 0 ? fmt::format("{:<{}}", r[j], w[j]) : fmt::format("{:>{}}", r[j], w[j]));
-        out += "\n";
+          l += (j ? "  " : "") + (numeric[j] ? fmt::format("{:>{}}", r[j], w[j]) : fmt::format("{:<{}}", r[j], w[j]));
+        while (!l.empty() && l.back() == ' ') l.pop_back();
+        out += l + "\n";
       };
       line(cols_);
       for (const auto& r : rows_) line(r);
