@@ -239,7 +239,8 @@ CREATE TABLE IF NOT EXISTS trial_samples (
 CREATE TABLE IF NOT EXISTS trial_metrics (
   trial_id TEXT PRIMARY KEY REFERENCES trials(trial_id) ON DELETE CASCADE,
   vc_m_s REAL, apeak_m_s2 REAL, zstop_m REAL, tstop_s REAL, t_start_s REAL, t_end_s REAL,
-  rebound INTEGER, bias_m_s2 REAL, note TEXT);
+  rebound INTEGER, bias_m_s2 REAL, note TEXT, i_start INTEGER, i_end INTEGER, fit_begin INTEGER,
+  fit_end INTEGER, processed_rate_hz REAL);
 )");
   db::Transaction tx(db);
   db::Statement del(db, "DELETE FROM trials WHERE trial_id = ?");
@@ -253,7 +254,8 @@ CREATE TABLE IF NOT EXISTS trial_metrics (
                     "accel_filtered_m_s2, velocity_m_s, depth_m) VALUES (?,?,?,?,?,?,?)");
   db::Statement met(db,
                     "INSERT INTO trial_metrics (trial_id, vc_m_s, apeak_m_s2, zstop_m, tstop_s, "
-                    "t_start_s, t_end_s, rebound, bias_m_s2, note) VALUES (?,?,?,?,?,?,?,?,?,?)");
+                    "t_start_s, t_end_s, rebound, bias_m_s2, note, i_start, i_end, fit_begin, fit_end, "
+                    "processed_rate_hz) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)");
   int stored = 0;
   for (const auto& t : c.trials) {
     const auto& i = t.info;
@@ -281,12 +283,90 @@ CREATE TABLE IF NOT EXISTS trial_metrics (
     met.reset();
     met.bind(1, i.trial_id).bind(2, m.vc_m_s).bind(3, m.apeak_m_s2).bind(4, m.zstop_m)
         .bind(5, m.tstop_s).bind(6, m.t_start_s).bind(7, m.t_end_s).bind(8, m.rebound ? 1 : 0)
-        .bind(9, p.bias_m_s2).bind(10, m.note);
+        .bind(9, p.bias_m_s2).bind(10, m.note).bind(11, static_cast<std::int64_t>(p.i_start))
+        .bind(12, static_cast<std::int64_t>(p.i_end)).bind(13, static_cast<std::int64_t>(t.fit_begin))
+        .bind(14, static_cast<std::int64_t>(t.fit_end)).bind(15, p.sample_rate_hz);
     met.run();
     ++stored;
   }
   tx.commit();
   return stored;
+}
+
+Campaign load_campaign_db(db::Database& db) {
+  Campaign c;
+  c.directory = db.path();
+  db::Statement q(db,
+                  "SELECT t.trial_id, t.trace_file, t.gravity_m_s2, t.impact_velocity_m_s, t.fill_height_m, "
+                  "t.projectile_mass_kg, t.projectile_diameter_m, t.grain_diameter_m, t.bulk_density_kg_m3, "
+                  "t.sample_rate_hz, m.vc_m_s, m.apeak_m_s2, m.zstop_m, m.tstop_s, m.t_start_s, m.t_end_s, "
+                  "m.rebound, m.bias_m_s2, m.note, m.i_start, m.i_end, m.fit_begin, m.fit_end, "
+                  "m.processed_rate_hz, t.campaign_dir FROM trials t JOIN trial_metrics m USING (trial_id) "
+                  "ORDER BY t.rowid");
+  db::Statement smp(db,
+                    "SELECT t_s, accel_raw_m_s2, accel_filtered_m_s2, velocity_m_s, depth_m FROM trial_samples "
+                    "WHERE trial_id = ? ORDER BY sample");
+  while (q.step()) {
+    Trial t;
+    auto& i = t.info;
+    i.trial_id = q.get_text(0);
+    i.trace_file = q.get_text(1);
+    i.gravity_m_s2 = q.get_double(2);
+    i.impact_velocity_m_s = q.get_double(3);
+    i.fill_height_m = q.get_double(4);
+    i.projectile_mass_kg = q.get_double(5);
+    i.projectile_diameter_m = q.get_double(6);
+    i.grain_diameter_m = q.get_double(7);
+    i.bulk_density_kg_m3 = q.get_double(8);
+    i.sample_rate_hz = q.get_double(9);
+    auto& p = t.processed;
+    auto& m = p.metrics;
+    m.vc_m_s = q.get_double(10);
+    m.apeak_m_s2 = q.get_double(11);
+    m.zstop_m = q.get_double(12);
+    m.tstop_s = q.get_double(13);
+    m.t_start_s = q.get_double(14);
+    m.t_end_s = q.get_double(15);
+    m.rebound = q.get_int(16) != 0;
+    p.bias_m_s2 = q.get_double(17);
+    m.note = q.is_null(18) ? "" : q.get_text(18);
+    if (q.is_null(19) || q.is_null(21))
+      throw std::runtime_error(fmt::format("{}: trial '{}' was imported by an older gravsweep without fit "
+                                           "windows; import the campaign again",
+                                           db.path(), i.trial_id));
+    p.i_start = static_cast<std::size_t>(q.get_int(19));
+    p.i_end = static_cast<std::size_t>(q.get_int(20));
+    t.fit_begin = static_cast<std::size_t>(q.get_int(21));
+    t.fit_end = static_cast<std::size_t>(q.get_int(22));
+    p.sample_rate_hz = q.get_double(23);
+    if (c.directory == db.path()) c.directory = q.get_text(24);
+    smp.reset();
+    smp.bind(1, i.trial_id);
+    while (smp.step()) {
+      t.raw.t_s.push_back(smp.get_double(0));
+      t.raw.accel_up_m_s2.push_back(smp.get_double(1));
+      p.t_s.push_back(smp.get_double(0));
+      p.accel_up_m_s2.push_back(smp.get_double(2));
+      p.velocity_down_m_s.push_back(smp.get_double(3));
+      p.depth_m.push_back(smp.get_double(4));
+    }
+    if (t.fit_end > p.t_s.size() || t.fit_begin > t.fit_end)
+      throw std::runtime_error(fmt::format("{}: trial '{}': fit window [{}, {}) outside its {} samples",
+                                           db.path(), i.trial_id, t.fit_begin, t.fit_end, p.t_s.size()));
+    c.trials.push_back(std::move(t));
+  }
+  return c;
+}
+
+Campaign load_campaign_any(const std::string& path, double cutoff_hz) {
+  namespace fs = std::filesystem;
+  if (fs::is_regular_file(path)) {
+    db::Database db(path, 30000, true);
+    Campaign c = load_campaign_db(db);
+    if (c.trials.empty()) throw std::runtime_error(fmt::format("{}: no imported trials", path));
+    return c;
+  }
+  return load_campaign(path, cutoff_hz);
 }
 
 }  // namespace gravsweep::results

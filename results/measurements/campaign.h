@@ -63,4 +63,10 @@ Campaign load_campaign(const std::string& directory, double cutoff_hz = 500.0);
 /// missing), replacing earlier rows of the same trial ids. Returns the number of trials stored.
 int store_campaign(db::Database& db, const Campaign& campaign);
 
+/// Reads a campaign back from a database written by store_campaign (no reprocessing).
+Campaign load_campaign_db(db::Database& db);
+
+/// A campaign folder (read and processed) or an SQLite file (as imported).
+Campaign load_campaign_any(const std::string& path, double cutoff_hz = 500.0);
+
 }  // namespace gravsweep::results

@@ -36,7 +36,7 @@ struct ModelOptions {
 
 results::Campaign load(const std::string& dir) {
   try {
-    auto c = results::load_campaign(dir);
+    auto c = results::load_campaign_any(dir);
     for (const auto& is : c.issues) std::fprintf(stderr, "warning: skipped %s/%s\n", dir.c_str(), is.to_string().c_str());
     if (c.trials.size() < 6)
       throw UsageError(fmt::format("{}: only {} usable trials; at least 6 are needed", dir, c.trials.size()));
@@ -127,7 +127,7 @@ void setup_model(CLI::App& app) {
       "The paper's method (Sunday et al. 2021 Sect. 4): per gravity level fit Eq. 2 to apeak(vc),\n"
       "print f0, 1/d1, vt (Eq. 5) and alpha (zstop ~ H^alpha) with standard errors, as Table 3.\n\n"
       "Example:\n  gravsweep model table3 ../shared/data/measurements/depth-friction-dev");
-  t3->add_option("dir", o3->dir, "campaign folder")->required();
+  t3->add_option("dir", o3->dir, "campaign folder, or an SQLite file from `measurements import`")->required();
   t3->add_option("--format", o3->format, "table, csv or json")->capture_default_str();
   t3->callback([o3]() {
     const auto c = load(o3->dir);
@@ -150,7 +150,7 @@ void setup_model(CLI::App& app) {
       "  gravsweep model fit ../shared/data/measurements/depth-friction-dev --model base+depth_friction\n"
       "  gravsweep model fit DIR --model spec.json --plot fall.png --format csv\n"
       "The figure of the error falling is written to --plot (default error_falls.png).");
-  fit->add_option("dir", of->dir, "campaign folder")->required();
+  fit->add_option("dir", of->dir, "campaign folder, or an SQLite file from `measurements import`")->required();
   fit->add_option("--model", of->model, "model: 'base+depth_friction' or a JSON spec file")->capture_default_str();
   fit->add_option("--baseline", of->baseline, "the 'before' model")->capture_default_str();
   fit->add_option("--folds", of->folds, "cross-validation folds (whole trials)")->check(CLI::Range(2, 100))->capture_default_str();
@@ -201,7 +201,7 @@ void setup_model(CLI::App& app) {
       "with eta^2 (share of residual variance the binning explains) and a sign test over trials\n"
       "of the within-trial slope.\n\n"
       "Example:\n  gravsweep model residuals ../shared/data/measurements/depth-friction-dev --model base");
-  res->add_option("dir", ores->dir, "campaign folder")->required();
+  res->add_option("dir", ores->dir, "campaign folder, or an SQLite file from `measurements import`")->required();
   res->add_option("--model", ores->model, "model: 'base' or a JSON spec file")->capture_default_str();
   res->add_option("--format", ores->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
   res->callback([ores]() {
@@ -233,7 +233,7 @@ void setup_model(CLI::App& app) {
       "effect found', or 'structure left that no candidate explains' with where it lies.\n\n"
       "Example:\n  gravsweep model rank ../shared/data/measurements/depth-friction-dev");
   rank->alias("discover");
-  rank->add_option("dir", orank->dir, "campaign folder")->required();
+  rank->add_option("dir", orank->dir, "campaign folder, or an SQLite file from `measurements import`")->required();
   rank->add_option("--baseline", orank->baseline, "starting model")->capture_default_str();
   rank->add_option("--folds", orank->folds, "cross-validation folds")->check(CLI::Range(2, 100))->capture_default_str();
   rank->add_option("--alpha", orank->alpha, "family-wise significance level")->capture_default_str();

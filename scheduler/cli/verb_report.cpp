@@ -34,7 +34,7 @@ void setup_report(CLI::App& app) {
       "missing effect is searched for (as `gravsweep model rank`) and the winner is added.\n\n"
       "Example:\n"
       "  gravsweep report ../shared/data/measurements/depth-friction-dev --out report-dev");
-  sub->add_option("dir", o->dir, "campaign folder")->required();
+  sub->add_option("dir", o->dir, "campaign folder, or an SQLite file from `measurements import`")->required();
   sub->add_option("--out", o->out, "report folder")->capture_default_str();
   sub->add_option("--baseline", o->baseline, "the 'before' model")->capture_default_str();
   sub->add_option("--model", o->model, "the 'after' model (default: baseline + discovered terms)");
@@ -42,7 +42,7 @@ void setup_report(CLI::App& app) {
   sub->callback([o]() {
     results::Campaign c;
     try {
-      c = results::load_campaign(o->dir);
+      c = results::load_campaign_any(o->dir);
     } catch (const std::runtime_error& e) {
       throw UsageError(e.what());
     }

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "results/measurements/campaign.h"
+#include "results/model/model.h"
 #include "results/model/synth.h"
 #include "results_helpers.h"
 #include "scheduler/db/sqlite.h"
@@ -132,4 +133,26 @@ TEST(Campaign, StoresTrialsSamplesAndMetricsInSqlite) {
   db::Statement g(db, "SELECT gravity_m_s2 FROM trials WHERE trial_id = 'S001'");
   ASSERT_TRUE(g.step());
   EXPECT_DOUBLE_EQ(g.get_double(0), 9.81);
+}
+
+TEST(Campaign, ReadBackFromSqliteFitsExactlyAsFromTheFolder) {
+  TempDir d;
+  write_synthetic_campaign((d.path / "c").string(), parse_model("base+depth_friction"), small());
+  const Campaign c = load_campaign((d.path / "c").string());
+  const std::string dbfile = (d.path / "lab.db").string();
+  {
+    db::Database db(dbfile);
+    store_campaign(db, c);
+  }
+  const Campaign back = load_campaign_any(dbfile);
+  ASSERT_EQ(back.trials.size(), c.trials.size());
+  for (std::size_t i = 0; i < c.trials.size(); ++i) {
+    EXPECT_EQ(back.trials[i].info.trial_id, c.trials[i].info.trial_id);
+    EXPECT_EQ(back.trials[i].fit_begin, c.trials[i].fit_begin);
+    EXPECT_EQ(back.trials[i].fit_end, c.trials[i].fit_end);
+    EXPECT_DOUBLE_EQ(back.trials[i].processed.metrics.zstop_m, c.trials[i].processed.metrics.zstop_m);
+  }
+  const auto spec = parse_model("base+depth_friction");
+  const auto a = fit_model(spec, c), b = fit_model(spec, back);
+  for (Eigen::Index j = 0; j < a.coef.size(); ++j) EXPECT_NEAR(b.coef(j), a.coef(j), 1e-9 * std::abs(a.coef(j)));
 }
