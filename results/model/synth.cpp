@@ -49,8 +49,7 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
     for (double v0 : o.impact_velocity_m_s) {
       for (int rep = 0; rep < o.repeats; ++rep) {
         ++id;
-        const double H = o.fill_height_m[(gi * o.impact_velocity_m_s.size() * o.repeats +
-                                          static_cast<std::size_t>(rep)) % o.fill_height_m.size()];
+        const double H = o.fill_height_m[static_cast<std::size_t>(id - 1) % o.fill_height_m.size()];
         // Per-trial bed preparation: friction-like and drag-like coefficients scatter.
         FittedModel m = tm;
         const double sf = 1.0 + o.bed_spread_f0 * n01(rng);
