@@ -103,6 +103,7 @@ DropResult drop_projectile(System& sys, double surface_height_m, const Projectil
       below = speed < stop.speed_m_s ? below + 1 : 0;
       if (below >= hold_samples) {
         res.stopped = true;
+        res.rest_s = s.t_s - static_cast<double>(hold_samples - 1) * sample_dt;
         break;
       }
     }

@@ -57,6 +57,7 @@ struct DropResult {
   double release_speed_m_s = 0;    ///< downward speed at release
   std::optional<double> first_contact_s;
   bool stopped = false;            ///< stop criterion met (false: the time cap ended the run)
+  std::optional<double> rest_s;    ///< start of the hold window that met the stop criterion
   long long steps = 0;
   ParticleIndex projectile = 0;
 };

@@ -48,6 +48,8 @@ void print_metrics(const nlohmann::json& m, const nlohmann::json& bed_report) {
   fmt::print("{:<28} {:>14}\n", "rebound",
              m["rebound"].is_boolean() ? (m["rebound"].get<bool>() ? "yes" : "no") : "n/a");
   fmt::print("{:<28} {:>14}\n", "max_depth_cm", num(m["max_depth_m"], 100, "{:.3f}"));
+  fmt::print("{:<28} {:>14}\n", "final_depth_cm", num(m["final_depth_m"], 100, "{:.3f}"));
+  fmt::print("{:<28} {:>14}\n", "duration_to_rest_ms", num(m["duration_to_rest_s"], 1000, "{:.1f}"));
   fmt::print("{:<28} {:>14}\n", "simulated_time_s", num(m["simulated_time_s"], 1, "{:.4f}"));
   fmt::print("{:<28} {:>14}\n", "stopped_at_rest", m.value("stopped", false) ? "yes" : "no (time cap)");
   fmt::print("{:<28} {:>14}\n", "grains", m.value("grains", 0));

@@ -215,6 +215,12 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   m["final_depth_m"] = td.depth_m.empty() ? 0.0 : td.depth_m.back();
   m["first_contact_s"] = dr.first_contact_s ? json(*dr.first_contact_s) : json(nullptr);
   m["stopped"] = dr.stopped;
+  // Sect. 2.2's stop criterion (speed < stop.speed_m_s after contact): when the projectile came to
+  // rest, and how long after the collision start (a DEM-side duration next to the paper's tstop).
+  m["rest_time_s"] = dr.rest_s ? json(*dr.rest_s) : json(nullptr);
+  m["duration_to_rest_s"] = dr.rest_s && m["t_start_s"].is_number()
+                                ? json(*dr.rest_s - m["t_start_s"].get<double>())
+                                : json(nullptr);
   m["simulated_time_s"] = td.t_s.empty() ? 0.0 : td.t_s.back();
   m["steps"] = dr.steps;
   m["dt_s"] = td.dt_s;

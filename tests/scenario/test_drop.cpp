@@ -62,6 +62,8 @@ TEST(Drop, ImpactSpeedModeReachesTheSurfaceAtThatSpeed) {
   ASSERT_TRUE(r.first_contact_s.has_value());
   EXPECT_NEAR(*r.first_contact_s, 0.07, 0.01);  // 6 cm at about 0.7-1.0 m/s
   EXPECT_TRUE(r.stopped);
+  ASSERT_TRUE(r.rest_s.has_value());
+  EXPECT_NEAR(*r.rest_s, r.samples.back().t_s - stop.hold_time_s, 2e-4);
   EXPECT_NEAR(r.samples.back().depth_m, 0.05, 1e-3);
   EXPECT_EQ(r.samples.back().contacts, 1);
   EXPECT_LT(std::abs(r.samples.back().velocity_down_m_s), 1e-3);
