@@ -105,3 +105,10 @@ TEST(Cli, ReportWritesFiguresAndSummary) {
   EXPECT_NE(s.find("immersion_drag"), std::string::npos);
   EXPECT_NE(s.find("Table 3"), std::string::npos);
 }
+
+TEST(Cli, CheckDetectionCountsRankedFirstAndNullReports) {
+  const auto r = run("model check-detection --terms immersion_drag --seeds 1 --null-seeds 1 --format csv");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("immersion_drag,1,1,1,1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(nothing hidden),1,-,-,0"), std::string::npos) << r.out;
+}
