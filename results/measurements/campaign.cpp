@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "results/io/trace_file.h"
 #include "scheduler/db/sqlite.h"
 
 namespace gravsweep::results {
@@ -75,7 +76,7 @@ const char* kRequired[] = {"trial_id",         "trace_file",         "gravity_m_
                            "projectile_diameter_m", "grain_diameter_m", "bulk_density_kg_m3",
                            "sample_rate_hz"};
 
-Trace read_trace(const fs::path& path, const std::string& rel) {
+Trace read_trace_csv(const fs::path& path, const std::string& rel) {
   std::ifstream in(path);
   if (!in) throw ParseError{{rel, 0, 0, "cannot open the trace file"}};
   std::string line;
@@ -184,7 +185,7 @@ Campaign load_campaign(const std::string& directory, double cutoff_hz) {
       ti.projectile_mass_kg = num("projectile_mass_kg", true);
       ti.projectile_diameter_m = num("projectile_diameter_m", true);
       ti.grain_diameter_m = num("grain_diameter_m", true);
-      ti.bulk_density_kg_m3 = num("bulk_density_kg_m3", true);
+      ti.bulk_density_kg_m3 = num("bulk_density_kg_m3", false);  // kept, not used by the models
       ti.sample_rate_hz = num("sample_rate_hz", true);
       for (const auto& [name, i] : col) {
         bool req = name == "drop_height_m";
@@ -192,7 +193,16 @@ Campaign load_campaign(const std::string& directory, double cutoff_hz) {
         if (!req && i < static_cast<int>(f.size())) ti.attributes[name] = f[i];
       }
       const std::string rel = ti.trace_file;
-      t.raw = read_trace(dir / rel, rel);
+      if (fs::path(rel).extension() == ".h5") {
+        // A DEM trace written by `gravsweep run` (results/io/trace_file.h): it carries z and v.
+        try {
+          t.raw = read_trace(dir / rel).to_trace();
+        } catch (const std::exception& e) {
+          throw ParseError{{rel, 0, 0, e.what()}};
+        }
+      } else {
+        t.raw = read_trace_csv(dir / rel, rel);
+      }
       MetricOptions o;
       o.gravity_m_s2 = ti.gravity_m_s2;
       o.cutoff_hz = cutoff_hz;
@@ -291,6 +301,48 @@ CREATE TABLE IF NOT EXISTS trial_metrics (
   }
   tx.commit();
   return stored;
+}
+
+int write_campaign_from_runs(const std::vector<std::string>& roots, const std::string& out_dir,
+                             std::vector<ImportIssue>& issues) {
+  std::vector<fs::path> traces;
+  for (const auto& r : roots) {
+    if (fs::is_regular_file(r)) {
+      traces.emplace_back(r);
+      continue;
+    }
+    if (!fs::is_directory(r)) {
+      issues.push_back({r, 0, 0, "neither a trace.h5 file nor a folder"});
+      continue;
+    }
+    for (const auto& e : fs::recursive_directory_iterator(r))
+      if (e.is_regular_file() && e.path().filename() == "trace.h5") traces.push_back(e.path());
+  }
+  std::sort(traces.begin(), traces.end());
+  fs::create_directories(out_dir);
+  std::ofstream csv(fs::path(out_dir) / "trials.csv");
+  if (!csv) throw std::runtime_error(fmt::format("{}: cannot write trials.csv", out_dir));
+  csv << "trial_id,trace_file,gravity_m_s2,impact_velocity_m_s,fill_height_m,projectile_mass_kg,"
+         "projectile_diameter_m,grain_diameter_m,bulk_density_kg_m3,sample_rate_hz,code_version\n";
+  int n = 0;
+  std::set<std::string> ids;
+  for (const auto& p : traces) {
+    try {
+      const TraceData td = read_trace(p);
+      MetricOptions o;
+      o.gravity_m_s2 = td.gravity_m_s2;
+      const Metrics m = compute_metrics(td.to_trace(), o);  // vc from the trace's own velocity
+      std::string id = p.parent_path().filename().string();
+      if (id.empty() || !ids.insert(id).second) id = fmt::format("{}_{}", id, n + 1);
+      csv << fmt::format("{},{},{},{},{},{},{},{},0,{},{}\n", id, fs::absolute(p).string(), td.gravity_m_s2,
+                         m.vc_m_s, td.fill_height_m, td.projectile_mass_kg, td.projectile_diameter_m,
+                         td.grain_diameter_m, td.sample_rate_hz, td.code_version);
+      ++n;
+    } catch (const std::exception& e) {
+      issues.push_back({p.string(), 0, 0, e.what()});
+    }
+  }
+  return n;
 }
 
 Campaign load_campaign_db(db::Database& db) {

@@ -63,6 +63,13 @@ Campaign load_campaign(const std::string& directory, double cutoff_hz = 500.0);
 /// missing), replacing earlier rows of the same trial ids. Returns the number of trials stored.
 int store_campaign(db::Database& db, const Campaign& campaign);
 
+/// Turns DEM runs (`gravsweep run` folders holding trace.h5, searched recursively under each root)
+/// into a campaign folder: writes <out_dir>/trials.csv pointing at the traces, so the model verbs
+/// treat simulations exactly as laboratory records. Unreadable traces become issues. Returns the
+/// number of trials written.
+int write_campaign_from_runs(const std::vector<std::string>& roots, const std::string& out_dir,
+                             std::vector<ImportIssue>& issues);
+
 /// Reads a campaign back from a database written by store_campaign (no reprocessing).
 Campaign load_campaign_db(db::Database& db);
 

@@ -186,7 +186,9 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
   const std::size_t head = std::max<std::size_t>(1, ipk / 3);
   std::vector<double> h(af.begin(), af.begin() + static_cast<std::ptrdiff_t>(head));
   std::nth_element(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(h.size() / 2), h.end());
-  double bias = h[h.size() / 2] + g;
+  // Simulated traces (they carry their own velocity and depth) have no sensor: no bias removal.
+  const bool simulated = !trace.velocity_down_m_s.empty() && !trace.depth_m.empty();
+  double bias = simulated ? 0.0 : h[h.size() / 2] + g;
 
   const double end_level = o.end_threshold_g * g;
   // Edge width: a zero-phase Butterworth spreads (and rings around) a step over about fs/fc
@@ -226,13 +228,15 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
     }
     // Free-fall segment: up to the edge width before the start.
     const std::size_t ff_end = i_start > w + 1 ? i_start - w - 1 : 0;
-    // End: acceleration below end_threshold_g * g after the peak, staying there for 3 samples.
+    // End: acceleration below end_threshold_g * g after the peak, staying there for 2 ms (at least
+    // 3 samples), so that a grain-scale dip inside the collision does not end it.
+    const std::size_t hold = std::max<std::size_t>(3, static_cast<std::size_t>(std::ceil(0.002 * fs)));
     std::size_t j = ipk;
     bool found = false;
     for (; j < n; ++j) {
       bool stays = true;
-      for (std::size_t k = j; k < std::min(n, j + 3); ++k) stays = stays && a[k] < end_level;
-      if (stays && j + 3 <= n) {
+      for (std::size_t k = j; k < std::min(n, j + hold); ++k) stays = stays && a[k] < end_level;
+      if (stays && j + std::min<std::size_t>(hold, 3) <= n) {
         found = true;
         break;
       }
@@ -258,7 +262,10 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
       }
     }
     // Rest segment: from the edge width after the end to the end of the record.
-    const std::size_t rest_begin = std::min(n, i_end + w + 1);
+    // Rest segment: the last three quarters of what follows the collision end, so that late settling
+    // (grain-scale bursts after the 0.1 g crossing) stays out of it.
+    const std::size_t after = std::min(n, i_end + w + 1);
+    const std::size_t rest_begin = after + (n - after) / 4;
     const std::size_t n_ff = ff_end, n_rest = n - rest_begin;
     double b_sum = 0, w_sum = 0;
     if (n_ff >= 3) {
@@ -270,7 +277,7 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
       b_sum += static_cast<double>(n_rest) * mean_of(af, rest_begin, n);
       w_sum += static_cast<double>(n_rest);
     }
-    if (w_sum > 0) bias = b_sum / w_sum;
+    if (w_sum > 0 && !simulated) bias = b_sum / w_sum;
     out.free_fall_samples = n_ff;
     out.rest_samples = n_rest;
   }

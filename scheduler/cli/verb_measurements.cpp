@@ -45,6 +45,30 @@ void setup_measurements(CLI::App& app) {
   imp->add_option("--db", o->db, "SQLite file to store into (created if missing)")->capture_default_str();
   imp->add_option("--cutoff", o->cutoff_hz, "low-pass cut-off, Hz")->capture_default_str();
   imp->add_option("--format", o->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
+  auto runs = std::make_shared<std::vector<std::string>>();
+  auto runs_out = std::make_shared<std::string>();
+  auto* fr = sub->add_subcommand(
+      "from-runs",
+      "Make a measurement campaign from DEM runs: finds every trace.h5 written by `gravsweep run`\n"
+      "under the given folders and writes OUT/trials.csv pointing at them (gravity, impact speed\n"
+      "from the trace, fill height, projectile, sampling rate, code version), so that `measurements\n"
+      "import`, `model rank`, `model fit` and `report` treat simulations like laboratory records.\n\n"
+      "Example:\n"
+      "  gravsweep measurements from-runs runs/ --out runs-campaign && gravsweep model rank runs-campaign");
+  fr->add_option("runs", *runs, "run folders (searched recursively) or trace.h5 files")->required();
+  fr->add_option("--out", *runs_out, "campaign folder to write")->required();
+  fr->callback([runs, runs_out]() {
+    std::vector<results::ImportIssue> issues;
+    const int n = results::write_campaign_from_runs(*runs, *runs_out, issues);
+    for (const auto& is : issues) std::fprintf(stderr, "error: %s\n", is.to_string().c_str());
+    fmt::print("{} DEM trials written to {}/trials.csv\n", n, *runs_out);
+    if (n == 0) throw UsageError("no readable trace.h5 under the given folders");
+    if (!issues.empty()) {
+      std::fflush(stdout);
+      std::exit(kExitIncomplete);
+    }
+  });
+
   imp->callback([o]() {
     results::Campaign c;
     try {

@@ -189,3 +189,34 @@ TEST(Metrics, FlagsReachingTheFloor) {
   o.fill_height_m = 0.2;
   EXPECT_FALSE(compute_metrics(sample(p, 1400, 0.02, 0.0, 0.0, 1), o).rebound);
 }
+
+TEST(Metrics, SimulatedTracesGetNoBiasAndShortDipsDoNotEndTheCollision) {
+  // A DEM-like trace at 10 kHz (own velocity and depth): a 1 ms dip below 0.1 g in the middle of
+  // the collision must not end it, and settling bursts after the stop must not be taken for a
+  // sensor bias (simulations have none).
+  Poncelet p;
+  Trace tr = sample(p, 10000, 0.01, 0.0, 0.0, 1);
+  const double th0 = std::atan(p.v0 / std::sqrt(p.A() * p.d1()));
+  for (std::size_t i = 0; i < tr.t_s.size(); ++i) {
+    const double t = tr.t_s[i];
+    const double tc = std::clamp(t - 0.01, -1.0, p.tstop());
+    double v, z;
+    if (tc < 0) {
+      v = p.v0 + p.g * tc;
+      z = p.v0 * tc + 0.5 * p.g * tc * tc;
+    } else {
+      const double ph = th0 - tc * std::sqrt(p.A() / p.d1());
+      v = std::sqrt(p.A() * p.d1()) * std::tan(ph);
+      z = p.d1() * std::log(std::cos(ph) / std::cos(th0));
+    }
+    tr.velocity_down_m_s.push_back(v);
+    tr.depth_m.push_back(z);
+    const double after = t - 0.01 - p.tstop();
+    if (t - 0.01 > 0.5 * p.tstop() && t - 0.01 < 0.5 * p.tstop() + 0.001) tr.accel_up_m_s2[i] = 0.0;
+    if (after > 0.005 && after < 0.015) tr.accel_up_m_s2[i] = 0.5 * p.g * std::sin(6.28 * after / 0.01);
+  }
+  const ProcessedTrace out = process_trace(tr, MetricOptions{});
+  EXPECT_EQ(out.bias_m_s2, 0.0);
+  EXPECT_NEAR(out.metrics.tstop_s, p.tstop(), 0.02 * p.tstop());
+  EXPECT_NEAR(out.metrics.zstop_m, p.zstop(), 0.02 * p.zstop());
+}
