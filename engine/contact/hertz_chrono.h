@@ -25,10 +25,11 @@ struct HertzChrono {
     return -2.0 * std::sqrt(5.0 / 6.0) * beta;
   }
 
-  /// Caches the damping factor of the pair (damping_n; Chrono uses the normal COR for both).
+  /// Caches the damping factors of the pair. Chrono uses the normal COR for both directions:
+  /// gn = f sqrt(Sn m*), gt = f sqrt(St m*) = [f sqrt(4 G*/E*)] sqrt(Sn m*) since St/Sn = 4 G*/E*.
   static void prepare(PairCoefficients& c) {
     c.damping_n = damping_factor(c.cor_normal);
-    c.damping_t = c.damping_n;
+    c.damping_t = c.damping_n * std::sqrt(4.0 * c.G_eff_Pa / c.E_eff_Pa);
   }
 
   /// Rayleigh time T_R = pi R sqrt(rho/G) / (0.1631 nu + 0.8766), G = E / (2(1+nu)) (dem-physics 4.3).
@@ -53,7 +54,7 @@ struct HertzChrono {
     }
   }
 
-  static void evaluate(const ContactGeometry& g, const PairCoefficients& c,
+  GRAVSWEEP_INLINE static void evaluate(const ContactGeometry& g, const PairCoefficients& c,
                        const ContactOptions& opt, ContactHistory& h, double dt_s,
                        ContactForce& out) {
     const Vec3& n = g.n;
@@ -78,8 +79,9 @@ struct HertzChrono {
     const double kn = (2.0 / 3.0) * Sn;
     const double kt = St;
     const double damp_n = c.damping_n;
-    const double gn = damp_n * std::sqrt(Sn * g.m_eff_kg);
-    const double gt = damp_n * std::sqrt(St * g.m_eff_kg);
+    const double sqrt_Sn_m = std::sqrt(Sn * g.m_eff_kg);
+    const double gn = damp_n * sqrt_Sn_m;
+    const double gt = c.damping_t * sqrt_Sn_m;
     double Fn = kn * delta - gn * v_n;  // unclamped, as in Chrono
     if (opt.clamp_normal && Fn < 0) Fn = 0;
 

@@ -63,7 +63,7 @@ struct HookePkdgrav {
       }
   }
 
-  static void evaluate(const ContactGeometry& g, const PairCoefficients& c,
+  GRAVSWEEP_INLINE static void evaluate(const ContactGeometry& g, const PairCoefficients& c,
                        const ContactOptions& /*opt*/, ContactHistory& h, double dt_s,
                        ContactForce& out) {
     const Vec3& n = g.n;

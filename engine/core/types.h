@@ -7,6 +7,13 @@
 #include <limits>
 #include <numbers>
 
+/// Contact kernels are inlined into the one pair loop (engine/system/force_loop.h).
+#if defined(__GNUC__)
+#define GRAVSWEEP_INLINE [[gnu::always_inline]] inline
+#else
+#define GRAVSWEEP_INLINE inline
+#endif
+
 namespace gravsweep {
 
 using Vec3 = Eigen::Vector3d;

@@ -8,18 +8,53 @@ namespace gravsweep {
 
 namespace {
 
+/// Runs body(i) on every particle in parallel; body returns the particle's new position, which
+/// the step checks read from registers (re-reading it from memory right after the store stalls).
+template <class Body>
+void end_loop(Particles& p, StepCheck& check, Body&& body) {
+  const std::size_t n = p.size();
+  long long bad = -1;
+  int cause = 0;
+  double max_d2 = 0;
+#pragma omp parallel reduction(max : max_d2)
+  {
+    long long my_bad = -1;
+    int my_cause = 0;
+#pragma omp for schedule(static) nowait
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 x = body(i);
+      const int c = check.visit(x, i, &max_d2);
+      if (c != 0 && my_bad < 0) {
+        my_bad = static_cast<long long>(i);
+        my_cause = c;
+      }
+    }
+    if (my_bad >= 0) {
+#pragma omp critical(gravsweep_step_check)
+      if (bad < 0 || my_bad < bad) {
+        bad = my_bad;
+        cause = my_cause;
+      }
+    }
+  }
+  check.bad_particle = bad;
+  check.bad_cause = cause;
+  check.max_displacement2_m2 = max_d2;
+}
+
 /// Chrono::Multicore: v_{n+1} = v_n + h a(x_n, v_n); x_{n+1} = x_n + h v_{n+1} (dem-physics.md 1.6).
 class SemiImplicitEuler final : public Integrator {
  public:
   void begin_step(Particles&, double) override {}
-  void end_step(Particles& p, double dt) override {
-    const std::size_t n = p.size();
-#pragma omp parallel for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) {
-      p.velocity_m_s[i] += dt * p.inv_mass_1_kg[i] * p.force_N[i];
+  void end_step(Particles& p, double dt, StepCheck& check) override {
+    end_loop(p, check, [&](std::size_t i) -> Vec3 {
+      const Vec3 v = p.velocity_m_s[i] + dt * p.inv_mass_1_kg[i] * p.force_N[i];
+      p.velocity_m_s[i] = v;
       p.omega_rad_s[i] += dt * p.inv_inertia_1_kg_m2[i] * p.torque_N_m[i];
-      if (p.inv_mass_1_kg[i] > 0) p.position_m[i] += dt * p.velocity_m_s[i];
-    }
+      const Vec3 x = p.inv_mass_1_kg[i] > 0 ? Vec3(p.position_m[i] + dt * v) : p.position_m[i];
+      p.position_m[i] = x;
+      return x;
+    });
   }
 };
 
@@ -36,13 +71,14 @@ class VelocityVerlet final : public Integrator {
       if (p.inv_mass_1_kg[i] > 0) p.position_m[i] += dt * p.velocity_m_s[i];
     }
   }
-  void end_step(Particles& p, double dt) override {
-    const std::size_t n = p.size();
-#pragma omp parallel for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) {
-      p.velocity_m_s[i] += 0.5 * dt * p.inv_mass_1_kg[i] * p.force_N[i];
+  void end_step(Particles& p, double dt, StepCheck& check) override {
+    end_loop(p, check, [&](std::size_t i) -> Vec3 {
+      const Vec3 v = p.velocity_m_s[i] + 0.5 * dt * p.inv_mass_1_kg[i] * p.force_N[i];
+      p.velocity_m_s[i] = v;
       p.omega_rad_s[i] += 0.5 * dt * p.inv_inertia_1_kg_m2[i] * p.torque_N_m[i];
-    }
+      // Positions moved in begin_step; a NaN velocity shows in the position next step.
+      return std::isfinite(v.x() + v.y() + v.z()) ? p.position_m[i] : v;
+    });
   }
 };
 
@@ -65,13 +101,14 @@ class LeapfrogKdk final : public Integrator {
       if (p.inv_mass_1_kg[i] > 0) p.position_m[i] += dt * p.velocity_m_s[i];
     }
   }
-  void end_step(Particles& p, double dt) override {
-    const std::size_t n = p.size();
-#pragma omp parallel for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) {
-      p.velocity_m_s[i] += 0.5 * dt * p.inv_mass_1_kg[i] * p.force_N[i];
+  void end_step(Particles& p, double dt, StepCheck& check) override {
+    end_loop(p, check, [&](std::size_t i) -> Vec3 {
+      const Vec3 v = p.velocity_m_s[i] + 0.5 * dt * p.inv_mass_1_kg[i] * p.force_N[i];
+      p.velocity_m_s[i] = v;
       p.omega_rad_s[i] += 0.5 * dt * p.inv_inertia_1_kg_m2[i] * p.torque_N_m[i];
-    }
+      // Positions moved in begin_step; a NaN velocity shows in the position next step.
+      return std::isfinite(v.x() + v.y() + v.z()) ? p.position_m[i] : v;
+    });
   }
 };
 

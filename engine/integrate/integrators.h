@@ -5,19 +5,44 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "engine/core/particles.h"
 
 namespace gravsweep {
 
+/// Checks made on every particle in the integrator's last loop of a step, so the state is read
+/// once: non-finite values, a centre outside the domain, and the largest displacement since the
+/// neighbour list was built (drives the rebuild).
+struct StepCheck {
+  // Inputs.
+  bool have_domain = false;
+  Vec3 lo_m = Vec3::Zero(), hi_m = Vec3::Zero();
+  const Vec3* position_at_build = nullptr;  ///< null: no list yet (rebuild anyway)
+  // Outputs (reduced over threads).
+  long long bad_particle = -1;
+  int bad_cause = 0;                         ///< 1 non-finite, 2 outside the domain
+  double max_displacement2_m2 = 0;
+
+  /// Per-particle check on the particle's new position (a NaN or inf in a velocity reaches the
+  /// position in the same step); returns the cause (0 = fine) and updates *max_d2.
+  GRAVSWEEP_INLINE int visit(const Vec3& x, std::size_t i, double* max_d2) const {
+    if (!std::isfinite(x.x() + x.y() + x.z())) return 1;
+    if (have_domain && ((x.array() < lo_m.array()).any() || (x.array() > hi_m.array()).any())) return 2;
+    if (position_at_build != nullptr) *max_d2 = std::max(*max_d2, (x - position_at_build[i]).squaredNorm());
+    return 0;
+  }
+};
+
 class Integrator {
  public:
   virtual ~Integrator() = default;
   /// Called before the force evaluation of the step.
   virtual void begin_step(Particles& p, double dt_s) = 0;
-  /// Called after the forces at the new positions are known.
-  virtual void end_step(Particles& p, double dt_s) = 0;
+  /// Called after the forces at the new positions are known; runs `check` on every particle.
+  virtual void end_step(Particles& p, double dt_s, StepCheck& check) = 0;
   /// True when the force loop must read Particles::eval_velocity/eval_omega (predicted velocities).
   [[nodiscard]] virtual bool uses_eval_velocities() const { return false; }
   /// True when begin_step needs the forces of the previous step (evaluated once before step 1).

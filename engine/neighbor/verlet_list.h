@@ -28,6 +28,10 @@ class VerletList {
   [[nodiscard]] long long builds() const { return builds_; }
   [[nodiscard]] double skin_m() const { return skin_m_; }
   [[nodiscard]] std::size_t bytes() const;
+  /// Positions at the last build (for the displacement check), or null when nothing is built.
+  [[nodiscard]] const Vec3* positions_at_build(std::size_t n) const {
+    return position_at_build_.size() == n && offset.size() == n + 1 ? position_at_build_.data() : nullptr;
+  }
 
   // CSR storage: pairs of particle i are [offset[i], offset[i+1]).
   std::vector<std::uint32_t> offset;

@@ -7,7 +7,7 @@ namespace gravsweep {
 struct RollingNone {
   static constexpr const char* name = "none";
   static constexpr const char* description = "no rolling or twisting resistance";
-  static void apply(const ContactGeometry&, const PairCoefficients&, const ContactOptions&,
+  GRAVSWEEP_INLINE static void apply(const ContactGeometry&, const PairCoefficients&, const ContactOptions&,
                     ContactHistory&, double, ContactForce&) {}
 };
 

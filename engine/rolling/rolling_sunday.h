@@ -15,7 +15,7 @@ struct RollingSunday {
       "Chrono/Sunday 2020 constant-magnitude rolling (mu_r F_n R) and spinning (mu_t r_c F_n) "
       "torques with activation gate and 1e-4 speed thresholds";
 
-  static void apply(const ContactGeometry& g, const PairCoefficients& c, const ContactOptions& opt,
+  GRAVSWEEP_INLINE static void apply(const ContactGeometry& g, const PairCoefficients& c, const ContactOptions& opt,
                     ContactHistory& h, double /*dt_s*/, ContactForce& out) {
     if (h.duration_s <= h.gate_s) return;  // activation gate: mu_r = mu_t = 0 early in a contact
     const Vec3& n = g.n;

@@ -14,7 +14,7 @@ struct RollingZhang {
       "pkdgrav/Zhang 2017 rolling and twisting spring-dashpot-sliders, k_R = kN (beta Rbar)^2, "
       "M_R <= mu_r beta Rbar |F_N|, M_Q <= mu_t mu_s beta Rbar |F_N|";
 
-  static void apply(const ContactGeometry& g, const PairCoefficients& c, const ContactOptions&,
+  GRAVSWEEP_INLINE static void apply(const ContactGeometry& g, const PairCoefficients& c, const ContactOptions&,
                     ContactHistory& h, double dt_s, ContactForce& out) {
     const Vec3& n = g.n;
     const double Rbar = g.wall ? g.r1_m : g.r1_m * g.r2_m / (g.r1_m + g.r2_m);

@@ -22,6 +22,7 @@ struct ForceContext {
   const std::vector<Wall>& walls;
   VerletList& nlist;
   std::vector<ContactHistory>& wall_history;
+  const std::vector<std::uint32_t>& wall_candidates;  ///< particle * walls + wall
   const PairTable& pairs;
   const ContactOptions& options;
   std::vector<std::vector<Vec3>>& thread_force;
@@ -84,7 +85,7 @@ void force_loop(ForceContext& c) {
         const double dist2 = d.squaredNorm();
         ContactHistory& h = hist[k];
         if (dist2 >= rsum * rsum) {
-          h.active = false;  // contact ended: history erased
+          if (h.active) h.active = false;  // contact ended: history erased (no write otherwise)
           continue;
         }
         if (inv_m[i] == 0 && inv_m[j] == 0) continue;  // two fixed particles
@@ -120,42 +121,42 @@ void force_loop(ForceContext& c) {
       }
     }
     if (n_walls > 0) {
+      const std::size_t n_cand = c.wall_candidates.size();
 #pragma omp for schedule(static) nowait
-      for (std::size_t i = 0; i < n; ++i) {
-        if (inv_m[i] == 0) continue;
-        for (std::size_t w = 0; w < n_walls; ++w) {
-          ContactHistory& h = c.wall_history[i * n_walls + w];
-          WallTouch touch;
-          if (!touch_wall(c.walls[w], X[i], R[i], touch)) {
-            h.active = false;
-            continue;
-          }
-          g.n = touch.n;
-          g.overlap_m = touch.overlap_m;
-          g.distance_m = touch.distance_m;
-          g.r1_m = R[i];
-          g.r2_m = kInf;
-          g.R_eff_m = touch.R_eff_m;
-          g.m_eff_kg = M[i];
-          g.v1 = V[i];
-          g.v2.setZero();
-          g.w1 = W[i];
-          g.w2.setZero();
-          g.wall = true;
-          const double ratio = touch.overlap_m / R[i];
-          if (ratio > kMaxOverlapFraction && ratio > my_ratio) {
-            my_ratio = ratio;
-            my_bad_i = i;
-            my_bad_j = -2 - static_cast<long long>(w);
-          }
-          const PairCoefficients& pc = c.pairs(mat[i], c.walls[w].material);
-          Law::evaluate(g, pc, c.options, h, dt, out);
-          Rolling::apply(g, pc, c.options, h, dt, out);
-          F[i] -= out.force_on_2;
-          T[i] += out.torque_1;
-          ++wall_contacts;
-          if (c.track_energy) energy += out.elastic_energy_J;
+      for (std::size_t k = 0; k < n_cand; ++k) {
+        const std::uint32_t code = c.wall_candidates[k];
+        const std::size_t i = code / n_walls, w = code % n_walls;
+        ContactHistory& h = c.wall_history[code];
+        WallTouch touch;
+        if (!touch_wall(c.walls[w], X[i], R[i], touch)) {
+          if (h.active) h.active = false;
+          continue;
         }
+        g.n = touch.n;
+        g.overlap_m = touch.overlap_m;
+        g.distance_m = touch.distance_m;
+        g.r1_m = R[i];
+        g.r2_m = kInf;
+        g.R_eff_m = touch.R_eff_m;
+        g.m_eff_kg = M[i];
+        g.v1 = V[i];
+        g.v2.setZero();
+        g.w1 = W[i];
+        g.w2.setZero();
+        g.wall = true;
+        const double ratio = touch.overlap_m / R[i];
+        if (ratio > kMaxOverlapFraction && ratio > my_ratio) {
+          my_ratio = ratio;
+          my_bad_i = static_cast<long long>(i);
+          my_bad_j = -2 - static_cast<long long>(w);
+        }
+        const PairCoefficients& pc = c.pairs(mat[i], c.walls[w].material);
+        Law::evaluate(g, pc, c.options, h, dt, out);
+        Rolling::apply(g, pc, c.options, h, dt, out);
+        F[i] -= out.force_on_2;
+        T[i] += out.torque_1;
+        ++wall_contacts;
+        if (c.track_energy) energy += out.elastic_energy_J;
       }
     }
     if (my_bad_i >= 0) {
@@ -166,19 +167,20 @@ void force_loop(ForceContext& c) {
         bad_j = my_bad_j;
       }
     }
-  }
-  // Sum the thread buffers in a fixed order and add gravity.
-  const int nt = c.threads;
-#pragma omp parallel for schedule(static) num_threads(c.threads)
-  for (std::size_t i = 0; i < n; ++i) {
-    Vec3 f = inv_m[i] > 0 ? Vec3(M[i] * c.gravity_m_s2) : Vec3::Zero();
-    Vec3 tq = Vec3::Zero();
-    for (int t = 0; t < nt; ++t) {
-      f += c.thread_force[t][i];
-      tq += c.thread_torque[t][i];
+    // Sum the thread buffers in a fixed order and add gravity (same parallel region).
+#pragma omp barrier
+    const int nt = omp_get_num_threads();
+#pragma omp for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      Vec3 f = inv_m[i] > 0 ? Vec3(M[i] * c.gravity_m_s2) : Vec3::Zero();
+      Vec3 tq = Vec3::Zero();
+      for (int tt = 0; tt < nt; ++tt) {
+        f += c.thread_force[tt][i];
+        tq += c.thread_torque[tt][i];
+      }
+      p.force_N[i] = f;
+      p.torque_N_m[i] = tq;
     }
-    p.force_N[i] = f;
-    p.torque_N_m[i] = tq;
   }
   c.stats.contacts = contacts;
   c.stats.wall_contacts = wall_contacts;

@@ -21,6 +21,8 @@ int System::threads() const {
 
 void System::invalidate() {
   initialized_ = false;
+  rebuild_due_ = true;
+  have_step_checks_ = false;
   have_forces_ = false;
   nlist_.clear();
   wall_history_.clear();
@@ -44,6 +46,8 @@ void System::remove_particles(const std::vector<bool>& remove) {
   }
   particles.remove_if(remove);
   initialized_ = false;  // thread buffers and checks follow the new size; histories are kept
+  rebuild_due_ = true;   // wall candidates hold particle indices
+  have_step_checks_ = false;
 }
 
 void System::initialize() {
@@ -106,17 +110,44 @@ void System::initialize() {
   if (wall_history_.size() != particles.size() * walls.size())
     wall_history_.assign(particles.size() * walls.size(), ContactHistory{});
   if (nlist_.offset.size() != particles.size() + 1) nlist_.clear();
-  nlist_.build(particles, config_.skin_m, nt);
   initialized_ = true;
+  rebuild_neighbors();
 }
 
-void System::compute_forces() {
+void System::rebuild_neighbors() {
+  nlist_.build(particles, config_.skin_m, threads());
+  wall_candidates_.clear();
+  const std::size_t nw = walls.size();
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    if (particles.inv_mass_1_kg[i] == 0) continue;
+    for (std::size_t w = 0; w < nw; ++w) {
+      const double reach = particles.radius_m[i] + config_.skin_m;
+      WallTouch touch;
+      // A wall is a candidate when the particle, grown by the skin, touches it.
+      if (touch_wall(walls[w], particles.position_m[i], reach, touch))
+        wall_candidates_.push_back(static_cast<std::uint32_t>(i * nw + w));
+    }
+  }
+  // Histories of pairs no longer within reach end now (they cannot be touching).
+  std::vector<char> keep(wall_history_.size(), 0);
+  for (auto c : wall_candidates_) keep[c] = 1;
+  for (std::size_t k = 0; k < wall_history_.size(); ++k)
+    if (!keep[k]) wall_history_[k].active = false;
+  rebuild_due_ = false;
+}
+
+void System::compute_forces() { force_pass(false); }
+
+void System::force_pass(bool displacement_checked) {
   if (!initialized_) initialize();
-  if (nlist_.needs_rebuild(particles)) nlist_.build(particles, config_.skin_m, threads());
+  // Inside step() the previous end-of-step checks measured the displacements; otherwise (a call
+  // from outside, positions possibly edited) measure them now.
+  if (rebuild_due_ || (!displacement_checked && nlist_.needs_rebuild(particles))) rebuild_neighbors();
   ForceContext ctx{particles,
                    walls,
                    nlist_,
                    wall_history_,
+                   wall_candidates_,
                    pairs_,
                    config_.options,
                    thread_force_,
@@ -142,40 +173,18 @@ void System::compute_forces() {
   }
 }
 
-void System::check_state() {
-  const std::size_t n = particles.size();
-  long long bad = -1;
-  int cause = 0;  // 1 NaN, 2 outside domain
-  const bool have_domain = config_.domain.has_value();
-  const Domain dom = have_domain ? *config_.domain : Domain{};
-#pragma omp parallel for schedule(static) num_threads(threads())
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3& x = particles.position_m[i];
-    const Vec3& v = particles.velocity_m_s[i];
-    int c = 0;
-    if (!x.allFinite() || !v.allFinite() || !particles.omega_rad_s[i].allFinite()) c = 1;
-    else if (have_domain && ((x.array() < dom.lo_m.array()).any() || (x.array() > dom.hi_m.array()).any())) c = 2;
-    if (c != 0) {
-#pragma omp critical(gravsweep_state_failure)
-      if (bad < 0 || static_cast<long long>(i) < bad) {
-        bad = static_cast<long long>(i);
-        cause = c;
-      }
-    }
-  }
-  if (bad >= 0) {
-    const Vec3& x = particles.position_m[bad];
-    if (cause == 1)
-      throw NumericalFailure(fmt::format("step {} (t = {:.6g} s): particle {} has a non-finite "
-                                         "position or velocity (NaN/inf)",
-                                         step_, time_s_, bad),
-                             step_, bad);
-    throw NumericalFailure(
-        fmt::format("step {} (t = {:.6g} s): particle {} left the container: position ({:.4g}, "
-                    "{:.4g}, {:.4g}) m is outside the domain",
-                    step_, time_s_, bad, x.x(), x.y(), x.z()),
-        step_, bad);
-  }
+void System::raise_state_failure(long long bad, int cause) {
+  const Vec3& x = particles.position_m[bad];
+  if (cause == 1)
+    throw NumericalFailure(fmt::format("step {} (t = {:.6g} s): particle {} has a non-finite "
+                                       "position or velocity (NaN/inf)",
+                                       step_, time_s_, bad),
+                           step_, bad);
+  throw NumericalFailure(
+      fmt::format("step {} (t = {:.6g} s): particle {} left the container: position ({:.4g}, "
+                  "{:.4g}, {:.4g}) m is outside the domain",
+                  step_, time_s_, bad, x.x(), x.y(), x.z()),
+      step_, bad);
 }
 
 void System::step() {
@@ -184,11 +193,22 @@ void System::step() {
   omp_set_num_threads(threads());  // integrators use the default team size
   if (integrator_->needs_initial_forces() && !have_forces_) compute_forces();
   integrator_->begin_step(particles, dt);
-  compute_forces();
-  integrator_->end_step(particles, dt);
+  force_pass(have_step_checks_);
+  StepCheck check;
+  if (config_.domain) {
+    check.have_domain = true;
+    check.lo_m = config_.domain->lo_m;
+    check.hi_m = config_.domain->hi_m;
+  }
+  check.position_at_build = nlist_.positions_at_build(particles.size());
+  integrator_->end_step(particles, dt, check);
   ++step_;
   time_s_ += dt;
-  check_state();
+  if (check.bad_particle >= 0) raise_state_failure(check.bad_particle, check.bad_cause);
+  if (check.position_at_build == nullptr ||
+      check.max_displacement2_m2 > 0.25 * config_.skin_m * config_.skin_m)
+    rebuild_due_ = true;
+  have_step_checks_ = true;
 }
 
 void System::advance(long long steps) {

@@ -65,8 +65,8 @@ class System {
   /// Validates parameters, builds the pair table and the neighbour list. Called by step() when
   /// needed; call it after changing particles, walls or config (or use invalidate()).
   void initialize();
-  /// Marks particle indices as changed (after adding particles or changing walls): contact
-  /// histories are dropped.
+  /// Marks particle indices as changed (after adding particles, moving particles by hand or
+  /// changing walls): contact histories are dropped.
   void invalidate();
   /// Removes the flagged particles, keeping the order and the contact histories of the others.
   void remove_particles(const std::vector<bool>& remove);
@@ -110,8 +110,16 @@ class System {
   bool initialized_ = false;
   bool have_forces_ = false;
 
-  void check_state();
-  friend struct ForceContextBuilder;
+  /// Particle-wall pairs within reach (radius + skin) of the wall at the last list build; only
+  /// these are tested each step. Encoded as particle * walls + wall.
+  std::vector<std::uint32_t> wall_candidates_;
+  bool rebuild_due_ = true;   ///< set by the step checks when a particle moved more than skin/2
+  /// The last step's end checks measured every displacement. Particles edited between steps
+  /// (positions, walls) must be followed by invalidate() or compute_forces().
+  bool have_step_checks_ = false;
+  void force_pass(bool displacement_checked);
+  void rebuild_neighbors();
+  void raise_state_failure(long long particle, int cause);
 };
 
 /// Names of the registered contact laws and rolling models (engine/contact/registry.cpp).

@@ -11,6 +11,7 @@
 
 #include "engine/scenario/bed.h"
 #include "engine/scenario/paper_params.h"
+#include "results/io/bed_file.h"
 #include "scheduler/cli/progress.h"
 #include "scheduler/cli/verbs.h"
 
@@ -23,10 +24,11 @@ struct BenchOptions {
   double dt_s = 1e-6;
   std::vector<int> threads{1, 2};
   double settle_dt_s = 5e-6;
-  double settle_cap_s = 0.6;
+  double settle_cap_s = 0.3;
   double fill_height_m = 0.10;
   bool scaling = false;
-  std::string law = "hertz";
+  double diameter_m = 0.315;
+  std::string bed_file;
 };
 
 struct BenchRow {
@@ -91,6 +93,21 @@ std::unique_ptr<System> make_bed(double container_diameter_m, bool full_settle, 
   return sys;
 }
 
+/// A bed written by `gravsweep run` (bed.h5), in a system with Table 1's Chrono set.
+std::unique_ptr<System> load_bed(const std::string& path) {
+  const results::BedData b = results::read_bed(path);
+  auto sys = std::make_unique<System>(chrono_table1_config());
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    const ParticleIndex k = sys->particles.add(Vec3(b.position_m[3 * i], b.position_m[3 * i + 1], b.position_m[3 * i + 2]),
+                                               b.radius_m[i], b.mass_kg[i], b.material[i], SizeClass::grain);
+    sys->particles.velocity_m_s[k] = Vec3(b.velocity_m_s[3 * i], b.velocity_m_s[3 * i + 1], b.velocity_m_s[3 * i + 2]);
+  }
+  ContainerSpec c;
+  c.diameter_m = b.container_diameter_m;
+  add_container_walls(*sys, c, b.wall_height_m, kWallMaterial);
+  return sys;
+}
+
 void run_bench(const BenchOptions& o) {
   ProgressBar bar;
   std::vector<BenchRow> rows;
@@ -99,7 +116,14 @@ void run_bench(const BenchOptions& o) {
     double diameter_m;
     bool full_settle;
   };
-  std::vector<BedCase> cases{{"paper 31.5 cm", 0.315, true}};
+  std::vector<BedCase> cases;
+  if (!o.bed_file.empty()) {
+    auto bed = load_bed(o.bed_file);
+    fmt::print("bed {}: {} grains loaded\n", o.bed_file, bed->particles.size());
+    for (int t : o.threads) rows.push_back(time_bed(*bed, "file", o, t));
+  } else {
+    cases.push_back({fmt::format("{:.1f} cm", 100 * o.diameter_m), o.diameter_m, true});
+  }
   if (o.scaling) {
     cases.push_back({"x8 wide 89 cm", 0.315 * std::sqrt(8.0), false});
     cases.push_back({"x64 wide 252 cm", 0.315 * 8.0, false});
@@ -132,11 +156,14 @@ void setup_bench(CLI::App& app) {
       "contacts per particle and bytes per particle.\n\n"
       "Example:\n"
       "  gravsweep bench --threads 1,2              # the issue's figures\n"
+      "  gravsweep bench --bed runs/1g/bed.h5       # time a bed prepared by `gravsweep run`\n"
       "  gravsweep bench --scaling --steps 200      # also 64,000 and 512,000 grains");
   sub->add_option("--steps", opt->steps, "timed steps per thread count")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--threads", opt->threads, "thread counts to time, comma separated")->delimiter(',')->capture_default_str();
   sub->add_option("--dt", opt->dt_s, "time step of the timed run, s")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--settle-cap", opt->settle_cap_s, "cap on simulated settling time, s")->capture_default_str();
+  sub->add_option("--diameter", opt->diameter_m, "container diameter of the bed to build, m")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--bed", opt->bed_file, "time a bed written by `gravsweep run` (DIR/bed.h5) instead of building one")->check(CLI::ExistingFile);
   sub->add_flag("--scaling", opt->scaling, "also time 8x and 64x wider beds (about 64,000 and 512,000 grains)");
   sub->callback([opt]() { run_bench(*opt); });
 }
