@@ -1,11 +1,37 @@
 #!/usr/bin/env bash
 # The README's main job: installs the Debian packages, builds, and runs a small end-to-end
-# example on this machine. Output goes to ./runs/demo.
+# campaign on the embedded SQLite default, into ./runs/demo:
+#   1. submit a sweep (2 gravities x 3 speeds x 2 seeds; bed jobs shared by their drops),
+#   2. run it with 2 worker processes, 3. show status and the result table (and export CSV),
+#   4. compare the collision model with a laboratory campaign (depth-friction-dev, if present):
+#      import, rank the candidate terms, fit base vs base+depth_friction, write the report.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$root/deploy/install-deps.sh"
 "$root/deploy/build.sh"
 gs="${GRAVSWEEP_BUILD_DIR:-$root/build}/scheduler/gravsweep"
 out="$root/runs/demo"
+rm -rf "$out"
 mkdir -p "$out"
-"$gs" bench --steps 500 --threads 1,2 | tee "$out/bench.txt"
+db="$out/campaign.db"
+
+echo "== 1. submit"
+"$gs" submit "$root/examples/sweep_tiny.json" --db "$db"
+echo "== 2. work (2 worker processes, 1 thread each)"
+"$gs" work --db "$db" --workers 2 --threads 1
+echo "== 3. status and results"
+"$gs" status --db "$db"
+"$gs" results --db "$db" --format table
+"$gs" results --db "$db" --format csv > "$out/results.csv"
+echo "   results exported to $out/results.csv"
+
+lab="$root/../shared/data/measurements/depth-friction-dev"
+if [ -d "$lab" ]; then
+  echo "== 4. model vs measurements ($lab)"
+  "$gs" measurements import "$lab" --db "$out/lab.db"
+  "$gs" model rank "$out/lab.db"
+  "$gs" model fit "$out/lab.db" --model base+depth_friction --plot "$out/error_falls.png"
+  "$gs" report "$out/lab.db" --out "$out/report"
+  echo "   report written to $out/report"
+fi
+echo "demo finished: $out"
