@@ -54,41 +54,23 @@ struct Particles {
     return static_cast<ParticleIndex>(position_m.size() - 1);
   }
 
+  /// Applies f to every per-particle array (a generic lambda taking `auto& vec`).
+  template <class F>
+  void for_each_array(F&& f) {
+    f(position_m), f(velocity_m_s), f(omega_rad_s), f(eval_velocity_m_s), f(eval_omega_rad_s);
+    f(force_N), f(torque_N_m), f(radius_m), f(mass_kg), f(inv_mass_1_kg), f(inv_inertia_1_kg_m2);
+    f(material), f(size_class);
+  }
+
   /// Removes the particles whose flag is true, keeping the order of the others.
   void remove_if(const std::vector<bool>& remove) {
-    std::size_t w = 0;
-    for (std::size_t r = 0; r < size(); ++r) {
-      if (remove[r]) continue;
-      if (w != r) {
-        position_m[w] = position_m[r];
-        velocity_m_s[w] = velocity_m_s[r];
-        omega_rad_s[w] = omega_rad_s[r];
-        eval_velocity_m_s[w] = eval_velocity_m_s[r];
-        eval_omega_rad_s[w] = eval_omega_rad_s[r];
-        force_N[w] = force_N[r];
-        torque_N_m[w] = torque_N_m[r];
-        radius_m[w] = radius_m[r];
-        mass_kg[w] = mass_kg[r];
-        inv_mass_1_kg[w] = inv_mass_1_kg[r];
-        inv_inertia_1_kg_m2[w] = inv_inertia_1_kg_m2[r];
-        material[w] = material[r];
-        size_class[w] = size_class[r];
-      }
-      ++w;
-    }
-    position_m.resize(w);
-    velocity_m_s.resize(w);
-    omega_rad_s.resize(w);
-    eval_velocity_m_s.resize(w);
-    eval_omega_rad_s.resize(w);
-    force_N.resize(w);
-    torque_N_m.resize(w);
-    radius_m.resize(w);
-    mass_kg.resize(w);
-    inv_mass_1_kg.resize(w);
-    inv_inertia_1_kg_m2.resize(w);
-    material.resize(w);
-    size_class.resize(w);
+    const std::size_t n = size();
+    for_each_array([&](auto& v) {
+      std::size_t w = 0;
+      for (std::size_t r = 0; r < n; ++r)
+        if (!remove[r]) v[w++] = v[r];
+      v.resize(w);
+    });
   }
 };
 
