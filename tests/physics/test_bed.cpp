@@ -51,7 +51,7 @@ struct Pile {
 };
 
 Pile pile(const SystemConfig& cfg) {
-  auto sp = settled_column(0.12, 0.135, 0.3, 2, cfg);
+  auto sp = settled_column(0.12, 0.135, 0.3, 1, cfg);  // 1 thread: ctest runs tests side by side
   System& s = *sp;
   EXPECT_GT(s.particles.size(), 1500u);
   constexpr double kBaseRadius_m = 0.08;
