@@ -145,8 +145,8 @@ void setup_run(CLI::App& app) {
       "  gravsweep run examples/impact_1g.json --out runs/1g\n"
       "  gravsweep run runs/1g_mur0.json --out runs/1g_mur0 --bed runs/1g/bed.h5   # reuse a bed:\n"
       "      only fields outside the bed (speed, offsets, dt of the drop, ...) may differ\n\n"
-      "On a machine shared with other jobs, run with OMP_WAIT_POLICY=passive: with spinning\n"
-      "OpenMP threads an oversubscribed 2-core machine ran the paper's bed ~50x slower.");
+      "gravsweep waits passively between OpenMP steps (OMP_WAIT_POLICY=passive unless you set it):\n"
+      "with spinning threads an oversubscribed 2-core machine ran the paper's bed ~50x slower.");
   sub->add_option("scenario", opt->scenario, "scenario spec (JSON, see schemas/scenario.schema.json)")
       ->required()
       ->check(CLI::ExistingFile);
