@@ -12,6 +12,7 @@
 #include "engine/scenario/bed.h"
 #include "engine/scenario/paper_params.h"
 #include "results/io/bed_file.h"
+#include "scheduler/pipeline/impact_job.h"
 #include "scheduler/cli/progress.h"
 #include "scheduler/cli/verbs.h"
 
@@ -94,17 +95,9 @@ std::unique_ptr<System> make_bed(double container_diameter_m, bool full_settle, 
 }
 
 /// A bed written by `gravsweep run` (bed.h5), in a system with Table 1's Chrono set.
-std::unique_ptr<System> load_bed(const std::string& path) {
-  const results::BedData b = results::read_bed(path);
+std::unique_ptr<System> load_bed_file(const std::string& path) {
   auto sys = std::make_unique<System>(chrono_table1_config());
-  for (std::size_t i = 0; i < b.size(); ++i) {
-    const ParticleIndex k = sys->particles.add(Vec3(b.position_m[3 * i], b.position_m[3 * i + 1], b.position_m[3 * i + 2]),
-                                               b.radius_m[i], b.mass_kg[i], b.material[i], SizeClass::grain);
-    sys->particles.velocity_m_s[k] = Vec3(b.velocity_m_s[3 * i], b.velocity_m_s[3 * i + 1], b.velocity_m_s[3 * i + 2]);
-  }
-  ContainerSpec c;
-  c.diameter_m = b.container_diameter_m;
-  add_container_walls(*sys, c, b.wall_height_m, kWallMaterial);
+  pipeline::load_bed(*sys, results::read_bed(path));
   return sys;
 }
 
@@ -118,7 +111,7 @@ void run_bench(const BenchOptions& o) {
   };
   std::vector<BedCase> cases;
   if (!o.bed_file.empty()) {
-    auto bed = load_bed(o.bed_file);
+    auto bed = load_bed_file(o.bed_file);
     fmt::print("bed {}: {} grains loaded\n", o.bed_file, bed->particles.size());
     for (int t : o.threads) rows.push_back(time_bed(*bed, "file", o, t));
   } else {

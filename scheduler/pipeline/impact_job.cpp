@@ -116,6 +116,20 @@ BedJobResult run_bed_job(const json& scenario, const std::filesystem::path& bed_
   return BedJobResult{bed_out, report};
 }
 
+void load_bed(System& sys, const results::BedData& bed) {
+  for (std::size_t i = 0; i < bed.size(); ++i) {
+    const Vec3 x(bed.position_m[3 * i], bed.position_m[3 * i + 1], bed.position_m[3 * i + 2]);
+    const ParticleIndex k = sys.particles.add(x, bed.radius_m[i], bed.mass_kg[i], bed.material[i], SizeClass::grain);
+    sys.particles.velocity_m_s[k] = Vec3(bed.velocity_m_s[3 * i], bed.velocity_m_s[3 * i + 1], bed.velocity_m_s[3 * i + 2]);
+    sys.particles.omega_rad_s[k] = Vec3(bed.omega_rad_s[3 * i], bed.omega_rad_s[3 * i + 1], bed.omega_rad_s[3 * i + 2]);
+    sys.particles.eval_velocity_m_s[k] = sys.particles.velocity_m_s[k];
+    sys.particles.eval_omega_rad_s[k] = sys.particles.omega_rad_s[k];
+  }
+  ContainerSpec cs;
+  cs.diameter_m = bed.container_diameter_m;
+  add_container_walls(sys, cs, bed.wall_height_m, kWallMaterial);
+}
+
 DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& bed_in,
                            const std::filesystem::path& trace_out, int threads, const Progress& progress,
                            const std::atomic<bool>* stop) {
@@ -146,17 +160,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
 
   // Rebuild the bed in a fresh system: bit-exact state, no contact history (as after any restart).
   System sys(p.drop_config);
-  for (std::size_t i = 0; i < bed.size(); ++i) {
-    const Vec3 x(bed.position_m[3 * i], bed.position_m[3 * i + 1], bed.position_m[3 * i + 2]);
-    const ParticleIndex k = sys.particles.add(x, bed.radius_m[i], bed.mass_kg[i], bed.material[i], SizeClass::grain);
-    sys.particles.velocity_m_s[k] = Vec3(bed.velocity_m_s[3 * i], bed.velocity_m_s[3 * i + 1], bed.velocity_m_s[3 * i + 2]);
-    sys.particles.omega_rad_s[k] = Vec3(bed.omega_rad_s[3 * i], bed.omega_rad_s[3 * i + 1], bed.omega_rad_s[3 * i + 2]);
-    sys.particles.eval_velocity_m_s[k] = sys.particles.velocity_m_s[k];
-    sys.particles.eval_omega_rad_s[k] = sys.particles.omega_rad_s[k];
-  }
-  ContainerSpec cs;
-  cs.diameter_m = bed.container_diameter_m;
-  add_container_walls(sys, cs, bed.wall_height_m, kWallMaterial);
+  load_bed(sys, bed);
 
   const DropResult dr = drop_projectile(sys, bed.surface_height_m, p.projectile, p.stop, p.sample_rate_hz,
                                         [&](double f, const std::string& d) {

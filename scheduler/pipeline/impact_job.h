@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "engine/system/system.h"
+#include "results/io/bed_file.h"
 #include "scheduler/pipeline/json_schema.h"
 
 namespace gravsweep::pipeline {
@@ -50,5 +52,9 @@ DropJobResult run_drop_job(const nlohmann::json& scenario, const std::filesystem
 /// Canonical key of the bed a scenario needs (container, grains, fill, gravity, materials, contact
 /// law, preparation settings and seed): drops with equal keys share a bed. Validates the scenario.
 nlohmann::json bed_key(const nlohmann::json& scenario);
+
+/// Puts a saved bed (grains, bit-exact state, no contact history) and its container walls into
+/// `sys`, whose config holds the contact parameters.
+void load_bed(System& sys, const results::BedData& bed);
 
 }  // namespace gravsweep::pipeline
