@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
+#include "tests/common/temp_dir.h"  // TempDir
 
 namespace gravsweep::test {
 
@@ -24,22 +25,5 @@ inline nlohmann::json tiny_scenario() {
     "stop": {"max_time_s": 0.3}
   })");
 }
-
-/// A fresh temporary folder, removed at the end of the scope.
-struct TempDir {
-  std::filesystem::path path;
-  TempDir() {
-    std::random_device rd;
-    path = std::filesystem::temp_directory_path() /
-           ("gravsweep-scenario-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
-    std::filesystem::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-};
 
 }  // namespace gravsweep::test

@@ -116,27 +116,27 @@ TEST(ScenarioSpec, WrongTypesAndRangesAreRefused) {
 TEST(ScenarioSpec, CrossFieldRulesAreRefusedAtTheRightField) {
   json s = minimal();
   s["projectile"]["drop_height_m"] = 0.05;
-  refused_at(s, "/projectile/drop_height_m");  // both speed and height
+  EXPECT_NO_FATAL_FAILURE(refused_at(s, "/projectile/drop_height_m"));  // both speed and height
   s = json{{"projectile", json::object()}};
-  refused_at(s, "/projectile/impact_speed_m_s");  // neither
+  EXPECT_NO_FATAL_FAILURE(refused_at(s, "/projectile/impact_speed_m_s"));  // neither
   s = minimal();
   s["grains"]["diameter_spread_m"] = 0.006;
-  refused_at(s, "/grains/diameter_spread_m");
+  EXPECT_NO_FATAL_FAILURE(refused_at(s, "/grains/diameter_spread_m"));
   s = minimal();
   s["projectile"]["impact_speed_m_s"] = 0.2;  // 5 mm of free fall at 1 g already gives 0.31 m/s
-  refused_at(s, "/projectile/start_gap_m");
+  EXPECT_NO_FATAL_FAILURE(refused_at(s, "/projectile/start_gap_m"));
   s = minimal();
   s["projectile"]["vertical_offset_max_grain_diameters"] = 10;
-  refused_at(s, "/projectile/vertical_offset_max_grain_diameters");
+  EXPECT_NO_FATAL_FAILURE(refused_at(s, "/projectile/vertical_offset_max_grain_diameters"));
   s = minimal();
   s["projectile"]["lateral_offset_max_grain_diameters"] = 20;
-  refused_at(s, "/projectile/lateral_offset_max_grain_diameters");
+  EXPECT_NO_FATAL_FAILURE(refused_at(s, "/projectile/lateral_offset_max_grain_diameters"));
   s = minimal();
   s["output"]["sample_rate_hz"] = 2e6;  // above 1/dt
-  refused_at(s, "/output/sample_rate_hz");
+  EXPECT_NO_FATAL_FAILURE(refused_at(s, "/output/sample_rate_hz"));
   s = minimal();
   s["container"]["diameter_m"] = 0.03;
-  refused_at(s, "/container/diameter_m");
+  EXPECT_NO_FATAL_FAILURE(refused_at(s, "/container/diameter_m"));
 }
 
 TEST(ScenarioSpec, TimeStepsAboveTheStabilityBoundAreRefused) {

@@ -16,24 +16,9 @@
 #include <vector>
 
 #include "scheduler/db/sqlite.h"
+#include "tests/common/temp_dir.h"  // TempDir
 
 namespace gravsweep::test {
-
-struct TempDir {
-  std::filesystem::path path;
-  TempDir() {
-    std::random_device rd;
-    path = std::filesystem::temp_directory_path() /
-           ("gravsweep-sched-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
-    std::filesystem::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-};
 
 inline void write_text(const std::filesystem::path& p, const std::string& text) {
   std::ofstream f(p);

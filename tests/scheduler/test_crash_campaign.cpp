@@ -134,5 +134,5 @@ TEST(CrashCampaign, NoopJobsSurviveSigkillToo) {
               {"max_attempts", 6},
               {"base", {{"g", 1.5}, {"sleep_s", 0.5}}},
               {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 0.1}, {"stop", 3.0}, {"step", 0.1}}}}}}};
-  crash_campaign(doc, 30, 30, {"gravity_m_s2", "noop_value"}, 3, 3);
+  EXPECT_NO_FATAL_FAILURE(crash_campaign(doc, 30, 30, {"gravity_m_s2", "noop_value"}, 3, 3));
 }
