@@ -53,7 +53,6 @@ struct ContactForce {
   Vec3 u_contact = Vec3::Zero();   ///< relative contact-point velocity (2 minus 1)
   double lever1_m = 0, lever2_m = 0;  ///< distances from centres to the contact plane
   Quat frame_rotation = Quat::Identity();  ///< rotation of the contact frame this step
-  double elastic_energy_J = 0;     ///< normal spring energy (for energy checks)
 };
 
 }  // namespace gravsweep

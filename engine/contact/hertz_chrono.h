@@ -32,6 +32,13 @@ struct HertzChrono {
     c.damping_t = c.damping_n * std::sqrt(4.0 * c.G_eff_Pa / c.E_eff_Pa);
   }
 
+  /// Normal spring energy U = integral of (4/3) E* sqrt(R*) d^1.5 = (8/15) E* sqrt(R*) d^2.5,
+  /// evaluated only when energy is tracked.
+  static double normal_energy_J(const ContactGeometry& g, const PairCoefficients& c) {
+    const double d = g.overlap_m;
+    return (8.0 / 15.0) * c.E_eff_Pa * std::sqrt(g.R_eff_m) * d * d * std::sqrt(d);
+  }
+
   /// Rayleigh time T_R = pi R sqrt(rho/G) / (0.1631 nu + 0.8766), G = E / (2(1+nu)) (dem-physics 4.3).
   static double rayleigh_time_s(const Material& m, double radius_m) {
     const double G = m.young_modulus_Pa / (2 * (1 + m.poisson_ratio));
@@ -123,8 +130,6 @@ struct HertzChrono {
     out.lever1_m = g.r1_m;
     out.lever2_m = g.wall ? kInf : g.r2_m;
     out.frame_rotation = Quat::Identity();
-    // U = integral of (4/3) E* sqrt(R*) d^1.5 = (8/15) E* sqrt(R*) d^2.5
-    out.elastic_energy_J = (8.0 / 15.0) * c.E_eff_Pa * std::sqrt(g.R_eff_m) * delta * delta * std::sqrt(delta);
   }
 };
 

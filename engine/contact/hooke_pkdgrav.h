@@ -30,6 +30,11 @@ struct HookePkdgrav {
     c.damping_t = c.cor_tangential >= 1.0 ? 0.0 : damping_prefactor(c.cor_tangential);
   }
 
+  /// Normal spring energy U = kN x^2 / 2, evaluated only when energy is tracked.
+  static double normal_energy_J(const ContactGeometry& g, const PairCoefficients& c) {
+    return 0.5 * c.kn_N_m * g.overlap_m * g.overlap_m;
+  }
+
   /// Linear-contact duration t_c = pi sqrt(mu/k) sqrt(1 + ln^2 e / pi^2) (dem-physics.md 2.4).
   static double contact_time_s(double k_N_m, double m_eff_kg, double cor) {
     const double loge = std::log(cor);
@@ -130,7 +135,6 @@ struct HookePkdgrav {
     out.lever1_m = l1;
     out.lever2_m = l2;
     out.frame_rotation = rot;
-    out.elastic_energy_J = 0.5 * c.kn_N_m * g.overlap_m * g.overlap_m;
   }
 };
 

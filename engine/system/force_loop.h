@@ -117,7 +117,7 @@ void force_loop(ForceContext& c) {
         T[i] += out.torque_1;
         T[j] += out.torque_2;
         ++contacts;
-        if (c.track_energy) energy += out.elastic_energy_J;
+        if (c.track_energy) energy += Law::normal_energy_J(g, pc);
       }
     }
     if (n_walls > 0) {
@@ -156,7 +156,7 @@ void force_loop(ForceContext& c) {
         F[i] -= out.force_on_2;
         T[i] += out.torque_1;
         ++wall_contacts;
-        if (c.track_energy) energy += out.elastic_energy_J;
+        if (c.track_energy) energy += Law::normal_energy_J(g, pc);
       }
     }
     if (my_bad_i >= 0) {

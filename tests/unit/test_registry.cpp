@@ -2,6 +2,8 @@
 // that name the law/model and the parameter.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "engine/core/error.h"
 #include "engine/scenario/paper_params.h"
 #include "engine/system/system.h"
@@ -87,4 +89,20 @@ TEST(Validation, HookeNeedsSpringAndStableStep) {
   cfg.dt_s = 2e-5;  // grain-grain contact ~93 us -> bound 9.3 us
   msg = init_error(cfg);
   EXPECT_NE(msg.find("stability bound"), std::string::npos) << msg;
+}
+
+// With track_energy the force pass sums the normal spring energy: (8/15) E* sqrt(R*) d^2.5 for hertz.
+TEST(Energy, HertzNormalSpringEnergyIsReported) {
+  auto cfg = chrono_table1_config();
+  cfg.gravity_m_s2 = Vec3::Zero();
+  cfg.track_energy = true;
+  System s(cfg);
+  const double r = 0.005, d = 1e-5;
+  s.particles.add(Vec3::Zero(), r, 1.3e-3, 0, SizeClass::grain);
+  s.particles.add(Vec3(0, 0, 2 * r - d), r, 1.3e-3, 0, SizeClass::grain);
+  s.compute_forces();
+  const double E_eff = s.pair_table()(0, 0).E_eff_Pa;
+  const double expect = 8.0 / 15.0 * E_eff * std::sqrt(r / 2) * std::pow(d, 2.5);
+  EXPECT_NEAR(s.stats().elastic_energy_J, expect, 1e-9 * expect + 1e-18);
+  EXPECT_GT(expect, 0);
 }
