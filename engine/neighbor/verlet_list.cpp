@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include "engine/core/error.h"
 
@@ -57,6 +58,16 @@ void VerletList::remap(const std::vector<long long>& new_index) {
   neighbor_ = std::move(nb);
   history = std::move(hist);
   position_at_build_ = std::move(pos);
+}
+
+void VerletList::extend(std::size_t n_total) {
+  if (offset.empty() || n_total + 1 < offset.size()) {
+    clear();
+    return;
+  }
+  offset.resize(n_total + 1, offset.back());
+  // NaN positions: needs_rebuild() sees every new particle as moved.
+  position_at_build_.resize(n_total, Vec3::Constant(std::numeric_limits<double>::quiet_NaN()));
 }
 
 bool VerletList::needs_rebuild(const Particles& p) const {

@@ -41,6 +41,10 @@ class VerletList {
   /// Forget everything (after particles were added: indices changed).
   void clear();
 
+  /// Particles were appended (indices of the others unchanged): the new ones get empty rows, so
+  /// the next build() carries every existing history over. Needs a build before use.
+  void extend(std::size_t n_total);
+
   /// Drops the removed particles and renumbers the rest (order kept), keeping the histories of
   /// the surviving pairs. new_index[i] is the new index of particle i, or -1 if removed.
   void remap(const std::vector<long long>& new_index);

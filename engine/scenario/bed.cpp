@@ -89,6 +89,15 @@ void grain_speeds(const System& sys, double& rms_m_s, double& max_m_s) {
 bool settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress,
             BedPhase phase, double* rms_out, double* max_out) {
   const double dt = sys.config().dt_s;
+  // The settling threshold of rolling friction holds for this phase only (SettleCriteria).
+  struct ThresholdScope {
+    System& sys;
+    double kept_m_s;
+    ThresholdScope(System& s, double v) : sys(s), kept_m_s(s.config().options.min_roll_vel_m_s) {
+      sys.mutable_config().options.min_roll_vel_m_s = v;
+    }
+    ~ThresholdScope() { sys.mutable_config().options.min_roll_vel_m_s = kept_m_s; }
+  } threshold(sys, c.min_roll_vel_m_s);
   const auto check_steps = std::max<long long>(1, std::llround(c.check_interval_s / dt));
   const double t0 = sys.time_s();
   double rms = 0, mx = 0;

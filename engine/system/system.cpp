@@ -28,6 +28,19 @@ void System::invalidate() {
   wall_history_.clear();
 }
 
+void System::particles_appended() {
+  const std::size_t n = particles.size(), nw = walls.size();
+  nlist_.extend(n);
+  if (nw > 0 && wall_history_.size() % nw == 0 && wall_history_.size() / nw <= n)
+    wall_history_.resize(n * nw, ContactHistory{});
+  else
+    wall_history_.clear();
+  initialized_ = false;  // thread buffers follow the new size
+  rebuild_due_ = true;
+  have_step_checks_ = false;
+  have_forces_ = false;
+}
+
 void System::remove_particles(const std::vector<bool>& remove) {
   const std::size_t n = particles.size();
   std::vector<long long> new_index(n, -1);

@@ -68,6 +68,9 @@ class System {
   /// Marks particle indices as changed (after adding particles, moving particles by hand or
   /// changing walls): contact histories are dropped.
   void invalidate();
+  /// Call after appending particles with particles.add() (a pour): the indices of the others are
+  /// unchanged, so their contact histories are kept; the neighbour list is rebuilt at the next step.
+  void particles_appended();
   /// Removes the flagged particles, keeping the order and the contact histories of the others.
   void remove_particles(const std::vector<bool>& remove);
 

@@ -11,6 +11,7 @@
 
 #include "engine/scenario/bed.h"
 #include "engine/scenario/paper_params.h"
+#include "engine/scenario/tile.h"
 #include "results/io/bed_file.h"
 #include "scheduler/pipeline/impact_job.h"
 #include "scheduler/cli/progress.h"
@@ -28,6 +29,8 @@ struct BenchOptions {
   double settle_cap_s = 0.3;
   double fill_height_m = 0.10;
   bool scaling = false;
+  std::vector<double> scaling_grains{64000, 512000};  ///< target sizes of the tiled beds
+  double tile_relax_s = 0.005;                        ///< relaxation of a tiled bed before timing
   double diameter_m = 0.315;
   std::string bed_file;
 };
@@ -70,7 +73,7 @@ BenchRow time_bed(const System& bed, const std::string& label, const BenchOption
                   static_cast<double>(sys.neighbor_list().builds() - builds0)};
 }
 
-std::unique_ptr<System> make_bed(double container_diameter_m, bool full_settle, const BenchOptions& o,
+std::unique_ptr<System> make_bed(double container_diameter_m, const BenchOptions& o,
                                  ProgressBar& bar, std::string& note) {
   SystemConfig cfg = chrono_table1_config();
   cfg.dt_s = o.settle_dt_s;
@@ -78,8 +81,8 @@ std::unique_ptr<System> make_bed(double container_diameter_m, bool full_settle, 
   BedSpec spec;
   spec.container.diameter_m = container_diameter_m;
   spec.fill_height_m = o.fill_height_m;
-  spec.settle.max_time_s = full_settle ? o.settle_cap_s : 0.03;
-  spec.relax_time_s = full_settle ? 0.05 : 0.01;
+  spec.settle.max_time_s = o.settle_cap_s;
+  spec.relax_time_s = 0.05;
   const auto t0 = std::chrono::steady_clock::now();
   const BedReport rep = prepare_bed(*sys, spec, [&](BedPhase ph, double f, const std::string& d) {
     bar.update(to_string(ph), f, d);
@@ -101,31 +104,60 @@ std::unique_ptr<System> load_bed_file(const std::string& path) {
   return sys;
 }
 
+/// The base bed tiled to about `target` grains (square patches of the inscribed square), relaxed
+/// for o.tile_relax_s so the seams between copies close, with a label naming the layout.
+std::unique_ptr<System> make_tiled_bed(const System& base, double target, const BenchOptions& o,
+                                       ProgressBar& bar, std::string& label) {
+  double radius = 0;
+  for (const auto& w : base.walls)
+    if (w.kind == WallKind::cylinder) radius = w.radius_m;
+  TileSpec ts;
+  ts.patch_side_m = radius > 0 ? std::sqrt(2.0) * radius : 0.22;
+  const double per_tile = static_cast<double>(grains_in_patch(base, ts.patch_side_m));
+  const int tiles = std::max(1, static_cast<int>(std::lround(target / std::max(per_tile, 1.0))));
+  ts.nx = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(tiles))));
+  ts.ny = std::max(1, static_cast<int>(std::lround(static_cast<double>(tiles) / ts.nx)));
+  SystemConfig cfg = base.config();
+  cfg.dt_s = o.settle_dt_s;
+  auto sys = std::make_unique<System>(cfg);
+  tile_bed(base, ts, *sys);
+  label = fmt::format("tiled {}x{}", ts.nx, ts.ny);
+  const long long steps = std::max<long long>(1, std::llround(o.tile_relax_s / o.settle_dt_s));
+  const long long chunk = std::max<long long>(1, steps / 50);
+  for (long long k = 0; k < steps; k += chunk) {
+    sys->advance(std::min(chunk, steps - k));
+    bar.update("relax", static_cast<double>(k + chunk) / static_cast<double>(steps),
+               fmt::format("{} grains, {:.1f} x {:.1f} m", sys->particles.size(), ts.nx * ts.patch_side_m,
+                           ts.ny * ts.patch_side_m));
+  }
+  bar.finish();
+  return sys;
+}
+
 void run_bench(const BenchOptions& o) {
   ProgressBar bar;
   std::vector<BenchRow> rows;
-  struct BedCase {
-    std::string label;
-    double diameter_m;
-    bool full_settle;
-  };
-  std::vector<BedCase> cases;
+  std::unique_ptr<System> base;
+  std::string base_label;
   if (!o.bed_file.empty()) {
-    auto bed = load_bed_file(o.bed_file);
-    fmt::print("bed {}: {} grains loaded\n", o.bed_file, bed->particles.size());
-    for (int t : o.threads) rows.push_back(time_bed(*bed, "file", o, t));
+    base = load_bed_file(o.bed_file);
+    base_label = "file";
+    fmt::print("bed {}: {} grains loaded\n", o.bed_file, base->particles.size());
   } else {
-    cases.push_back({fmt::format("{:.1f} cm", 100 * o.diameter_m), o.diameter_m, true});
-  }
-  if (o.scaling) {
-    cases.push_back({"x8 wide 89 cm", 0.315 * std::sqrt(8.0), false});
-    cases.push_back({"x64 wide 252 cm", 0.315 * 8.0, false});
-  }
-  for (const auto& c : cases) {
     std::string note;
-    auto bed = make_bed(c.diameter_m, c.full_settle, o, bar, note);
-    fmt::print("bed {}: {}\n", c.label, note);
-    for (int t : o.threads) rows.push_back(time_bed(*bed, c.label, o, t));
+    base_label = fmt::format("{:.1f} cm", 100 * o.diameter_m);
+    base = make_bed(o.diameter_m, o, bar, note);
+    fmt::print("bed {}: {}\n", base_label, note);
+  }
+  for (int t : o.threads) rows.push_back(time_bed(*base, base_label, o, t));
+  if (o.scaling) {
+    for (double target : o.scaling_grains) {
+      std::string label;
+      auto wide = make_tiled_bed(*base, target, o, bar, label);
+      fmt::print("bed {}: {} grains (copies of the base bed's inscribed square, relaxed {} s)\n", label,
+                 wide->particles.size(), o.tile_relax_s);
+      for (int t : o.threads) rows.push_back(time_bed(*wide, label, o, t));
+    }
   }
   fmt::print("\n{:<18} {:>9} {:>8} {:>22} {:>22} {:>20} {:>16}\n", "bed", "grains", "threads",
              "ns_per_particle_step", "contacts_per_particle", "bytes_per_particle", "nlist_rebuilds");
@@ -150,14 +182,19 @@ void setup_bench(CLI::App& app) {
       "Example:\n"
       "  gravsweep bench --threads 1,2              # the issue's figures\n"
       "  gravsweep bench --bed runs/1g/bed.h5       # time a bed prepared by `gravsweep run`\n"
-      "  gravsweep bench --scaling --steps 200      # also 64,000 and 512,000 grains");
+      "  gravsweep bench --scaling --steps 300      # also about 64,000 and 512,000 grains\n\n"
+      "--scaling copies the settled base bed's inscribed square side by side into a wide box\n"
+      "(tiles), relaxes it briefly and times it too: cost per particle-step against N at the\n"
+      "settled bed's contact density (settling 500,000 poured grains would take hours).");
   sub->add_option("--steps", opt->steps, "timed steps per thread count")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--threads", opt->threads, "thread counts to time, comma separated")->delimiter(',')->capture_default_str();
   sub->add_option("--dt", opt->dt_s, "time step of the timed run, s")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--settle-cap", opt->settle_cap_s, "cap on simulated settling time, s")->capture_default_str();
   sub->add_option("--diameter", opt->diameter_m, "container diameter of the bed to build, m")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--bed", opt->bed_file, "time a bed written by `gravsweep run` (DIR/bed.h5) instead of building one")->check(CLI::ExistingFile);
-  sub->add_flag("--scaling", opt->scaling, "also time 8x and 64x wider beds (about 64,000 and 512,000 grains)");
+  sub->add_flag("--scaling", opt->scaling, "also time the base bed tiled to about 64,000 and 512,000 grains");
+  sub->add_option("--scaling-grains", opt->scaling_grains, "target sizes of the tiled beds, comma separated")->delimiter(',')->capture_default_str();
+  sub->add_option("--tile-relax", opt->tile_relax_s, "relaxation of a tiled bed before timing, s")->check(CLI::NonNegativeNumber)->capture_default_str();
   sub->callback([opt]() { run_bench(*opt); });
 }
 

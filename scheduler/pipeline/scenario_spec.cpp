@@ -244,6 +244,7 @@ ScenarioParams scenario_params(const json& s) {
   b.settle.max_speed_m_s = bj["/settle/max_speed_m_s"_json_pointer];
   b.settle.max_time_s = bj["/settle/max_time_s"_json_pointer];
   b.settle.check_interval_s = bj["/settle/check_interval_s"_json_pointer];
+  b.settle.min_roll_vel_m_s = bj["/settle/min_roll_vel_m_s"_json_pointer];
   b.relax_time_s = bj.at("relax_time_s");
   b.grain_material = kGrainMaterial;
   b.wall_material = kWallMaterial;

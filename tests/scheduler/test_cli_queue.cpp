@@ -140,7 +140,7 @@ TEST(CliQueue, ImpactSweepSharesBedsAndExtendsIdempotently) {
   EXPECT_NE(r.out.find("0 new, 14 already present"), std::string::npos) << r.out;
   // One more impact speed: 4 new drops (2 gravities x 2 seeds) on the 2 existing beds.
   json doc = json::parse(std::ifstream(example));
-  doc["axes"][1]["range"]["stop"] = 2.0;
+  doc["axes"][1]["values"].push_back(1.3);
   write_text(d.path / "more.json", doc.dump());
   r = run_cli({"submit", "more.json", "--db", "c.db"}, d.path);
   ASSERT_EQ(r.code, 0) << r.err;

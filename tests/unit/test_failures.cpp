@@ -77,3 +77,30 @@ TEST(Particles, RemoveKeepsOrderAndHistories) {
   s.step();
   EXPECT_EQ(s.stats().contacts, 1);  // only the pair (2, 3) still touches
 }
+
+// Appending particles (a pour) keeps the histories of the contacts that exist: the tangential
+// spring and the contact duration of a touching pair continue instead of restarting.
+TEST(Particles, AppendKeepsHistories) {
+  System s(no_gravity());
+  s.particles.add(Vec3(0, 0, 0), 0.005, 1.3e-3, 0, SizeClass::grain);
+  s.particles.add(Vec3(0.0099, 0, 0), 0.005, 1.3e-3, 0, SizeClass::grain);
+  s.advance(10);
+  auto pair_duration = [&] {
+    const auto& l = s.neighbor_list();
+    for (auto k = l.offset[0]; k < l.offset[1]; ++k)
+      if (l.neighbor_[k] == 1) return l.history[k].duration_s;
+    return -1.0;
+  };
+  const double before = pair_duration();
+  ASSERT_GT(before, 0.0);
+  s.particles.add(Vec3(0.05, 0, 0), 0.005, 1.3e-3, 0, SizeClass::grain);
+  s.particles_appended();
+  s.step();
+  EXPECT_EQ(s.particles.size(), 3u);
+  EXPECT_EQ(s.stats().contacts, 1);
+  EXPECT_NEAR(pair_duration(), before + s.config().dt_s, 1e-15);
+  // invalidate() is the other way: histories are dropped and the contact starts again.
+  s.invalidate();
+  s.step();
+  EXPECT_LT(pair_duration(), before);
+}
