@@ -100,6 +100,31 @@ double stddev_of(const std::vector<double>& x, std::size_t b, std::size_t e) {
   return std::sqrt(s / static_cast<double>(e - b - 1));
 }
 
+/// Velocity (positive down) and depth from the acceleration (positive up), dv_down/dt = -a_up, by
+/// trapezoids both ways from the collision start (v = v0, z = 0 at t_start, between samples
+/// i_start and i_start + 1).
+void integrate_from_start(const std::vector<double>& t, const std::vector<double>& a, std::size_t i_start,
+                          double t_start, double v0, std::vector<double>& v, std::vector<double>& z) {
+  const std::size_t n = t.size();
+  v.assign(n, 0.0);
+  z.assign(n, 0.0);
+  const std::size_t i0 = std::min(n - 1, i_start + 1);  // first sample after t_start
+  const double dt0 = t[i0] - t_start;
+  const double a_start = interp_at(t, a, t_start);
+  v[i0] = v0 - 0.5 * (a_start + a[i0]) * dt0;
+  z[i0] = 0.5 * (v0 + v[i0]) * dt0;
+  for (std::size_t k = i0 + 1; k < n; ++k) {
+    const double dt = t[k] - t[k - 1];
+    v[k] = v[k - 1] - 0.5 * (a[k] + a[k - 1]) * dt;
+    z[k] = z[k - 1] + 0.5 * (v[k] + v[k - 1]) * dt;
+  }
+  for (std::size_t k = i0; k-- > 0;) {
+    const double dt = t[k + 1] - t[k];
+    v[k] = v[k + 1] + 0.5 * (a[k] + a[k + 1]) * dt;
+    z[k] = z[k + 1] - 0.5 * (v[k] + v[k + 1]) * dt;
+  }
+}
+
 void validate(const Trace& tr) {
   const std::size_t n = tr.t_s.size();
   if (tr.accel_up_m_s2.size() != n)
@@ -229,11 +254,26 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
     // Free-fall segment: up to the edge width before the start.
     const std::size_t ff_end = i_start > w + 1 ? i_start - w - 1 : 0;
     // End: acceleration below end_threshold_g * g after the peak, staying there for 2 ms (at least
-    // 3 samples), so that a grain-scale dip inside the collision does not end it.
+    // 3 samples), so that a grain-scale dip inside the collision does not end it, with the speed
+    // down to end_speed_fraction of the collision speed, so that a lull between force-chain bursts
+    // does not either (MetricOptions).
+    std::vector<double> v_pass, z_pass;
+    const std::vector<double>* speed = nullptr;
+    double vc_pass = 0;
+    if (simulated) {
+      speed = &trace.velocity_down_m_s;
+      vc_pass = interp_at(t, trace.velocity_down_m_s, m.t_start_s);
+    } else if (o.impact_velocity_m_s) {
+      integrate_from_start(t, a, i_start, m.t_start_s, *o.impact_velocity_m_s, v_pass, z_pass);
+      speed = &v_pass;
+      vc_pass = *o.impact_velocity_m_s;
+    }
+    const double v_end = o.end_speed_fraction * std::abs(vc_pass);
     const std::size_t hold = std::max<std::size_t>(3, static_cast<std::size_t>(std::ceil(0.002 * fs)));
     std::size_t j = ipk;
     bool found = false;
     for (; j < n; ++j) {
+      if (speed && (*speed)[j] > v_end) continue;
       bool stays = true;
       for (std::size_t k = j; k < std::min(n, j + hold); ++k) stays = stays && a[k] < end_level;
       if (stays && j + std::min<std::size_t>(hold, 3) <= n) {
@@ -243,9 +283,9 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
     }
     if (!found)
       throw std::invalid_argument(fmt::format(
-          "trace shorter than the collision: the acceleration never falls below {} g after the "
-          "peak at t = {:.4f} s",
-          o.end_threshold_g, t[ipk]));
+          "trace shorter than the collision: after the peak at t = {:.4f} s the acceleration never "
+          "stays below {} g with the speed below {} of the collision speed",
+          t[ipk], o.end_threshold_g, o.end_speed_fraction));
     i_end = j;
     m.t_end_s = j > 0 ? crossing_time(t, a, j - 1, end_level) : t[j];
     step_end = false;
@@ -261,7 +301,6 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
         }
       }
     }
-    // Rest segment: from the edge width after the end to the end of the record.
     // Rest segment: the last three quarters of what follows the collision end, so that late settling
     // (grain-scale bursts after the 0.1 g crossing) stays out of it.
     const std::size_t after = std::min(n, i_end + w + 1);
@@ -299,24 +338,7 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
           "no velocity in the trace and no impact velocity given: cannot integrate a into v and z");
     const double v0 = *o.impact_velocity_m_s;
     m.vc_m_s = v0;
-    // dv_down/dt = -a_up, trapezoids from t_start (v = v0, z = 0) both ways.
-    const std::size_t i0 = i_start + 1;  // first sample after t_start
-    auto& v = out.velocity_down_m_s;
-    auto& z = out.depth_m;
-    const double dt0 = t[i0] - m.t_start_s;
-    const double a_start = interp_at(t, a, m.t_start_s);
-    v[i0] = v0 - 0.5 * (a_start + a[i0]) * dt0;
-    z[i0] = 0.5 * (v0 + v[i0]) * dt0;
-    for (std::size_t k = i0 + 1; k < n; ++k) {
-      const double dt = t[k] - t[k - 1];
-      v[k] = v[k - 1] - 0.5 * (a[k] + a[k - 1]) * dt;
-      z[k] = z[k - 1] + 0.5 * (v[k] + v[k - 1]) * dt;
-    }
-    for (std::size_t k = i0; k-- > 0;) {
-      const double dt = t[k + 1] - t[k];
-      v[k] = v[k + 1] + 0.5 * (a[k] + a[k + 1]) * dt;
-      z[k] = z[k + 1] - 0.5 * (v[k] + v[k + 1]) * dt;
-    }
+    integrate_from_start(t, a, i_start, m.t_start_s, v0, out.velocity_down_m_s, out.depth_m);
   }
   // Peak: the largest filtered upward acceleration of the collision, leaving out the filter's
   // ringing next to step edges; at a step-like contact the collision's early samples (beyond

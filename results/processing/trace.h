@@ -26,6 +26,12 @@ struct MetricOptions {
   double cutoff_hz = 500.0;            ///< 2nd-order Butterworth low-pass (paper: 500 Hz)
   int filter_order = 2;
   double end_threshold_g = 0.1;        ///< collision ends when |a| < 0.1 g (paper)
+  /// ... and the projectile has lost this much of its collision speed: its downward speed is below
+  /// end_speed_fraction * vc. A DEM projectile is stopped by bursts of force chains with lulls of
+  /// near-zero acceleration between them (coasting at half its speed for 10-20 ms in a small bed);
+  /// the paper's threshold alone would end the collision at the first lull. A lab record that
+  /// stops as Eq. 1 does (speed to zero at the end) is not affected.
+  double end_speed_fraction = 0.1;
   /// Speed at first contact, used to integrate a into v and z when the trace has none.
   std::optional<double> impact_velocity_m_s;
   /// For the rebound flag: bed depth and grain diameter (a projectile within one grain of the
@@ -42,7 +48,8 @@ struct Metrics {
   double zstop_m = 0;        ///< penetration depth at collision end
   double tstop_s = 0;        ///< collision duration (end - start)
   double t_start_s = 0;      ///< collision start: no longer in free fall
-  double t_end_s = 0;        ///< collision end: acceleration below end_threshold_g after the peak
+  double t_end_s = 0;        ///< collision end: acceleration below end_threshold_g after the peak,
+                             ///< with the speed below end_speed_fraction * vc
   bool rebound = false;      ///< moved up after contact, or came within one grain of the floor
   std::string note;          ///< why a metric could not be found, if so
 };

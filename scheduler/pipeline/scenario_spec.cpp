@@ -277,6 +277,7 @@ ScenarioParams scenario_params(const json& s) {
   mo.gravity_m_s2 = out.gravity_m_s2;
   mo.cutoff_hz = s["/output/filter_cutoff_hz"_json_pointer];
   mo.end_threshold_g = s["/output/end_threshold_g"_json_pointer];
+  mo.end_speed_fraction = s["/output/end_speed_fraction"_json_pointer];
   mo.fill_height_m = b.fill_height_m;
   mo.grain_diameter_m = b.grains.diameter_m;
   mo.projectile_diameter_m = ps.diameter_m;

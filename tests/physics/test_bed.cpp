@@ -41,7 +41,7 @@ std::unique_ptr<System> settled_column(double diameter_m, double fill_m, double 
 // (15 cm radius); grains that roll off the base are removed; the angle is the least-squares slope
 // of the heap's flank (engine/scenario/pile.h). dt = 10 us (0.2 Rayleigh times; Fig. 4 of the
 // paper: 10 us leaves the impact metrics unchanged), one thread (ctest runs tests side by side).
-// Measured on this machine: 22.9 deg (22.4 at dt = 5 us); with mu_r = 0, 14-15 deg.
+// Measured on this machine: 22.4-23.5 deg (dt 5 and 10 us, two seeds); with mu_r = 0, 14.4-16.8 deg.
 PileResult chrono_pile(double mu_rolling) {
   SystemConfig cfg = chrono_table1_config(mu_rolling);
   cfg.dt_s = 1e-5;
@@ -70,10 +70,10 @@ TEST(Pile, ChronoTable1ReposeAngleBetween20And30Degrees) {
 }
 
 // Rolling friction is what raises the heap: without it the 0.16 sliding friction alone holds the
-// flank below 18 degrees (measured 14-15), so the 20-30 degrees above are mu_r's doing.
+// flank below the 20 degrees of glass beads (measured 14-17), so the 20-30 degrees above are mu_r's doing.
 TEST(Pile, WithoutRollingFrictionTheHeapIsFlatter) {
   const PileResult p = chrono_pile(0.0);
-  EXPECT_LT(p.angle_deg, 18.0);
+  EXPECT_LT(p.angle_deg, 20.0);
   EXPECT_GT(p.angle_deg, 5.0);  // still a heap: the rough base and sliding friction hold it
 }
 
