@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The README's main job: installs the Debian packages, builds, and runs a small end-to-end
 # campaign on the embedded SQLite default, into ./runs/demo:
-#   1. submit a sweep (2 gravities x 3 speeds x 2 seeds; bed jobs shared by their drops),
+#   1. submit a sweep (2 gravities x 3 speeds x 2 start offsets; bed jobs shared by their drops),
 #   2. run it with 2 worker processes, 3. show status and the result table (and export CSV),
 #   4. compare the collision model with a laboratory campaign (depth-friction-dev, if present):
 #      import, rank the candidate terms, fit base vs base+depth_friction, write the report.
@@ -21,7 +21,9 @@ echo "== 2. work (2 worker processes, 1 thread each)"
 "$gs" work --db "$db" --workers 2 --threads 1
 echo "== 3. status and results"
 "$gs" status --db "$db"
-"$gs" results --db "$db" --format table
+# The table shows the swept parameters and the paper's metrics; the CSV has every column.
+"$gs" results --db "$db" --sort gravity_m_s2 \
+  --columns gravity_m_s2,impact_speed_m_s,projectile_seed,vc_m_s,apeak_m_s2,zstop_m,tstop_s,rebound
 "$gs" results --db "$db" --format csv > "$out/results.csv"
 echo "   results exported to $out/results.csv"
 
