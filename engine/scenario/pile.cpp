@@ -108,7 +108,9 @@ PileResult pour_pile(System& sys, const PileSpec& spec, const PileProgress& prog
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const double base_top = add_rough_base(sys, spec, rng);
   const double R = spec.base_radius_m;
-  sys.mutable_config().domain = Domain{Vec3(-2 * R, -2 * R, -0.5), Vec3(2 * R, 2 * R, 2 * R + 1.0)};
+  // Grains leaving the base fly off at up to ~1 m/s; they are removed once below the base (z < 0).
+  const double reach = 2 * R + 0.5;
+  sys.mutable_config().domain = Domain{Vec3(-reach, -reach, -0.5), Vec3(reach, reach, reach + 1.0)};
   sys.invalidate();
   const double dt = sys.config().dt_s;
   const double d = spec.grains.diameter_m;

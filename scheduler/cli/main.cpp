@@ -19,6 +19,7 @@ using SetupFn = void (*)(CLI::App&);
 constexpr SetupFn kVerbs[] = {
     &gravsweep::cli::setup_run,
     &gravsweep::cli::setup_bench,
+    &gravsweep::cli::setup_pile,
     &gravsweep::cli::setup_measurements,
     &gravsweep::cli::setup_model,
     &gravsweep::cli::setup_synth,

@@ -18,5 +18,6 @@ void setup_status(CLI::App& app);
 void setup_resume(CLI::App& app);
 void setup_results(CLI::App& app);
 void setup_bench_queue(CLI::App& app);
+void setup_pile(CLI::App& app);
 
 }  // namespace gravsweep::cli
