@@ -123,6 +123,25 @@ bool settle(System& sys, const SettleCriteria& c, double min_time_s, const BedPr
   return met;
 }
 
+void ramp_gravity(System& sys, const Vec3& to_m_s2, double ramp_s, double interval_s, const BedProgress& progress) {
+  const Vec3 g0 = sys.config().gravity_m_s2;
+  const double n0 = g0.norm(), n1 = to_m_s2.norm();
+  const double dt = sys.config().dt_s;
+  const auto steps = static_cast<long long>(std::llround(ramp_s / dt));
+  const long long chunk = std::max<long long>(1, std::llround(interval_s / dt));
+  const bool same_direction = n0 > 0 && n1 > 0 && g0.dot(to_m_s2) > (1 - 1e-12) * n0 * n1;
+  if (steps > 0 && same_direction) {
+    for (long long k = 0; k < steps; k += chunk) {
+      const double f = static_cast<double>(k) / static_cast<double>(steps);
+      sys.set_gravity(to_m_s2 / n1 * (n0 * std::pow(n1 / n0, f)));  // geometric: equal ratios per step
+      sys.advance(std::min(chunk, steps - k));
+      if (progress)
+        progress(BedPhase::relax, 0.0, fmt::format("gravity ramp: {:.3g} m/s2", sys.config().gravity_m_s2.norm()));
+    }
+  }
+  sys.set_gravity(to_m_s2);
+}
+
 double surface_height(const System& sys, double container_radius_m) {
   // Mean top height of the grains within 60 % of the container radius that stand highest in
   // their column: bin the central disk on a grid of ~1.5 grain diameters and average bin maxima.
@@ -182,8 +201,10 @@ BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progr
                 sys.particles.position_m[i].z() > spec.fill_height_m;
   sys.remove_particles(remove);
   if (progress) progress(BedPhase::flatten, 1.0, fmt::format("{} grains kept", sys.particles.size()));
-  // Relax the new surface (at the drop's gravity when the bed was settled at another).
-  if (spec.relax_gravity_m_s2) sys.mutable_config().gravity_m_s2 = *spec.relax_gravity_m_s2;
+  // Relax the new surface (at the drop's gravity when the bed was settled at another, reached by a
+  // geometric ramp so that the contacts unload gradually).
+  if (spec.relax_gravity_m_s2)
+    ramp_gravity(sys, *spec.relax_gravity_m_s2, spec.gravity_ramp_s, spec.settle.check_interval_s, progress);
   const double t1 = sys.time_s();
   met = settle(sys, spec.settle, spec.relax_time_s, progress, BedPhase::relax, &rep.rms_speed_m_s,
                &rep.max_speed_m_s) && met;

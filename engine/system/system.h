@@ -81,6 +81,8 @@ class System {
   [[nodiscard]] long long step_count() const { return step_; }
   [[nodiscard]] const SystemConfig& config() const { return config_; }
   SystemConfig& mutable_config() { initialized_ = false; return config_; }
+  /// Changes gravity between steps without re-initialising (gravity enters only the force sum).
+  void set_gravity(const Vec3& g_m_s2) { config_.gravity_m_s2 = g_m_s2; }
   [[nodiscard]] const StepStats& stats() const { return stats_; }
   [[nodiscard]] const PairTable& pair_table() const { return pairs_; }
   [[nodiscard]] const VerletList& neighbor_list() const { return nlist_; }

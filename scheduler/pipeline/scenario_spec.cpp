@@ -249,6 +249,7 @@ ScenarioParams scenario_params(const json& s) {
   b.grain_material = kGrainMaterial;
   b.wall_material = kWallMaterial;
   if (settle_g != out.gravity_m_s2) b.relax_gravity_m_s2 = Vec3(0, 0, -out.gravity_m_s2);
+  b.gravity_ramp_s = bj.at("gravity_ramp_s");
 
   const json& pj = s.at("projectile");
   ProjectileSpec& ps = out.projectile;
