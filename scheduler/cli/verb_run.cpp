@@ -137,7 +137,8 @@ void setup_run(CLI::App& app) {
       "run",
       "Run one impact as in Sunday et al. 2021 Sect. 2.2-2.3: fill the container, settle the grains,\n"
       "flatten the bed at the fill height, drop the projectile, stop when it rests, and measure\n"
-      "vc, apeak, zstop, tstop (Butterworth 500 Hz, end at a < 0.1 g) and the rebound flag.\n"
+      "vc, apeak, zstop, tstop (Butterworth 500 Hz, end at a < 0.1 g with the speed below 10 % of vc)\n"
+      "and the rebound flag.\n"
       "Writes DIR/bed.h5 (the prepared bed, reusable), DIR/trace.h5 (the projectile at 10 kHz),\n"
       "DIR/metrics.json, and prints the metrics. The spec is checked against\n"
       "schemas/scenario.schema.json before any work; errors name the JSON pointer of the field.\n\n"

@@ -199,7 +199,8 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   td.bed_file = std::filesystem::absolute(bed_in).string();
   td.code_version = GRAVSWEEP_VERSION;
 
-  // Sect. 2.3: Butterworth 500 Hz, start = end of free fall, end = a below 0.1 g.
+  // Sect. 2.3: Butterworth 500 Hz, start = end of free fall, end = a below 0.1 g (and speed below
+  // 10 % of vc, MetricOptions::end_speed_fraction).
   results::MetricOptions mo = p.metric_options;
   mo.fill_height_m = bed.surface_height_m;  // the floor lies this far below the mean surface
   json m;
