@@ -1,8 +1,8 @@
 // The paper's processing of a projectile trace (Sunday et al. 2021 Sect. 2.3): 2nd-order
 // Butterworth low-pass at 500 Hz, collision start = no longer in free fall, collision end =
 // acceleration below 0.1 g (and the speed below 10 % of vc, see MetricOptions), velocity and
-// depth by integrating the acceleration from the impact
-// speed, and the metrics vc, apeak, zstop, tstop. Conventions in trace.h (z down, a up).
+// depth by integrating the acceleration from the impact speed, and the metrics vc, apeak, zstop,
+// tstop. Conventions in trace.h (z down, a up).
 #include "results/processing/trace.h"
 
 #include <fmt/format.h>

@@ -36,8 +36,8 @@ void setup_measurements(CLI::App& app) {
       "Read DIR/trials.csv and DIR/traces/*.csv, filter each trace (2nd-order Butterworth,\n"
       "500 Hz, zero phase), remove the sensor bias from the free-fall and rest segments,\n"
       "integrate a into v and z from the reported impact speed, find the collision start and\n"
-      "end (0.1 g, with the speed below 10 % of vc), and store trials, processed samples and metrics (vc, apeak, zstop, tstop)\n"
-      "in the SQLite file (tables trials, trial_samples, trial_metrics). A bad row or trace is\n"
+      "end (0.1 g, with the speed below 10 % of vc), and store trials, processed samples and\n"
+      "metrics (vc, apeak, zstop, tstop) in the SQLite file (tables trials, trial_samples, trial_metrics). A bad row or trace is\n"
       "reported by file:line:column and does not stop the others (exit code 4 then).\n\n"
       "Example:\n"
       "  gravsweep measurements import ../shared/data/measurements/depth-friction-dev --db lab.db");
