@@ -37,8 +37,9 @@ void setup_measurements(CLI::App& app) {
       "500 Hz, zero phase), remove the sensor bias from the free-fall and rest segments,\n"
       "integrate a into v and z from the reported impact speed, find the collision start and\n"
       "end (0.1 g, with the speed below 10 % of vc), and store trials, processed samples and\n"
-      "metrics (vc, apeak, zstop, tstop) in the SQLite file (tables trials, trial_samples, trial_metrics). A bad row or trace is\n"
-      "reported by file:line:column and does not stop the others (exit code 4 then).\n\n"
+      "metrics (vc, apeak, zstop, tstop) in the SQLite file (tables trials, trial_samples,\n"
+      "trial_metrics). A bad row or trace is reported by file:line:column and does not stop the\n"
+      "others (exit code 4 then).\n\n"
       "Example:\n"
       "  gravsweep measurements import ../shared/data/measurements/depth-friction-dev --db lab.db");
   imp->add_option("dir", o->dir, "campaign folder (holds trials.csv and traces/)")->required();
