@@ -30,7 +30,7 @@ struct BenchOptions {
   double fill_height_m = 0.10;
   bool scaling = false;
   std::vector<double> scaling_grains{64000, 512000};  ///< target sizes of the tiled beds
-  double tile_relax_s = 0.005;                        ///< relaxation of a tiled bed before timing
+  double tile_relax_s = 0.01;                         ///< relaxation of a tiled bed before timing
   double diameter_m = 0.315;
   std::string bed_file;
 };
