@@ -28,6 +28,7 @@ struct ResultsOptions {
   std::string out;
   long limit = -1;
   bool full = false;
+  bool all = false;
 };
 
 std::string cell(const nlohmann::json& v, bool for_table, const std::string& col, bool full) {
@@ -46,7 +47,11 @@ void run_results(const ResultsOptions& o) {
   if (!std::filesystem::exists(o.db)) throw UsageError(fmt::format("--db: no campaign database at '{}'", o.db));
   db::Database db(o.db);
   queue::ensure_schema(db);
-  queue::ResultsQuery q{o.where, o.columns, o.sweep, o.sort, o.limit};
+  // A table shows the swept parameters and the paper's metrics unless asked for more; CSV and JSON
+  // exports carry every column.
+  const bool summary = o.format == "table" && o.columns.empty() && !o.all;
+  const std::vector<std::string> columns = summary ? queue::summary_result_columns(db) : o.columns;
+  queue::ResultsQuery q{o.where, columns, o.sweep, o.sort, o.limit};
   queue::ResultsTable t;
   try {
     t = queue::query_results(db, q);
@@ -72,6 +77,10 @@ void run_results(const ResultsOptions& o) {
     }
     text = o.format == "csv" ? queue::render_csv(tt)
                              : queue::render_table(tt) + fmt::format("({} row{})\n", t.rows.size(), t.rows.size() == 1 ? "" : "s");
+    if (summary) {
+      const std::size_t more = queue::result_columns(db).size() - t.columns.size();
+      text += fmt::format("({} more columns: --all, --columns a,b,... or --format csv)\n", more);
+    }
   }
   if (o.out.empty()) {
     fmt::print("{}", text);
@@ -95,7 +104,9 @@ void setup_results(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "results",
       "Print the results table: one row per finished drop, with one column per swept parameter and\n"
-      "per metric (units in the names), the trace path and its SHA-256. Filters are parsed and bound\n"
+      "per metric (units in the names), the trace path and its SHA-256. As a table it shows the\n"
+      "job, the swept parameters and the paper's metrics (vc, apeak, zstop, tstop, rebound) unless\n"
+      "--all or --columns asks for more; CSV and JSON carry every column. Filters are parsed and bound\n"
       "as SQL parameters (never pasted into SQL): column op value, joined by 'and' or ','; op is one\n"
       "of < <= > >= = != ~ (text contains). Several --where are ANDed.\n\n"
       "Examples:\n"
@@ -112,6 +123,7 @@ void setup_results(CLI::App& app) {
   sub->add_option("--format", opt->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
   sub->add_option("--out", opt->out, "write to this file (temporary name, then renamed) instead of stdout");
   sub->add_flag("--full", opt->full, "table: do not shorten checksums");
+  sub->add_flag("--all", opt->all, "table: every column, not only the parameters and the paper's metrics");
   sub->callback([opt]() { run_results(*opt); });
 }
 

@@ -778,4 +778,17 @@ std::vector<std::string> result_columns(Database& db) {
   return cols;
 }
 
+std::vector<std::string> summary_result_columns(Database& db) {
+  static const std::vector<std::string> kPaperMetrics{"vc_m_s", "apeak_m_s2", "zstop_m", "tstop_s", "rebound"};
+  std::vector<std::string> cols{"job_id"}, metrics;
+  Statement st(db, "SELECT name, role FROM results_columns ORDER BY position");
+  while (st.step()) {
+    if (st.get_text(1) == "param") cols.push_back(st.get_text(0));
+    else metrics.push_back(st.get_text(0));
+  }
+  for (const auto& m : kPaperMetrics)
+    if (std::find(metrics.begin(), metrics.end(), m) != metrics.end()) cols.push_back(m);
+  return cols;
+}
+
 }  // namespace gravsweep::queue

@@ -99,6 +99,18 @@ TEST(CliQueue, WorkersRunEverythingRetryAndReportDeadJobs) {
   ASSERT_EQ(rows.size(), 1u);
   EXPECT_EQ(rows[0]["gravity_m_s2"], 4.0);
   EXPECT_EQ(rows[0]["trace_sha256"].get<std::string>().size(), 64u);
+  // The default table: the job and the swept parameters (no paper metrics in no-op jobs); --all
+  // shows every column.
+  r = run_cli({"results", "--db", "c.db"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string header = r.out.substr(0, r.out.find('\n'));
+  EXPECT_NE(header.find("job_id"), std::string::npos) << r.out;
+  EXPECT_NE(header.find("gravity_m_s2"), std::string::npos) << r.out;
+  EXPECT_EQ(header.find("trace_sha256"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("more columns: --all"), std::string::npos) << r.out;
+  r = run_cli({"results", "--db", "c.db", "--all"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.substr(0, r.out.find('\n')).find("trace_sha256"), std::string::npos) << r.out;
   r = run_cli({"results", "--db", "c.db", "--where", "gravity_m_s2<1; DELETE FROM jobs"}, d.path);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("expected 'and'"), std::string::npos) << r.err;
