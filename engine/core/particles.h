@@ -54,6 +54,13 @@ struct Particles {
     return static_cast<ParticleIndex>(position_m.size() - 1);
   }
 
+  /// Sets the state velocities of particle i and the copies the force evaluation reads (so a
+  /// particle added between steps moves with them from its first force evaluation).
+  void set_velocity(ParticleIndex i, const Vec3& v_m_s, const Vec3& omega_rad_s_ = Vec3::Zero()) {
+    velocity_m_s[i] = eval_velocity_m_s[i] = v_m_s;
+    omega_rad_s[i] = eval_omega_rad_s[i] = omega_rad_s_;
+  }
+
   /// Applies f to every per-particle array (a generic lambda taking `auto& vec`).
   template <class F>
   void for_each_array(F&& f) {

@@ -24,6 +24,11 @@ inline constexpr double kInf = std::numeric_limits<double>::infinity();
 /// Small-number guard used by Chrono for |delta_t| and contact-circle radii (dem-physics.md 1.4).
 inline constexpr double kTinyLength_m = 1e-12;
 
+/// Mass of a solid sphere, rho pi d^3 / 6.
+inline double sphere_mass_kg(double density_kg_m3, double diameter_m) {
+  return density_kg_m3 * kPi / 6 * diameter_m * diameter_m * diameter_m;
+}
+
 /// Index of a particle inside Particles (structure of arrays).
 using ParticleIndex = std::uint32_t;
 

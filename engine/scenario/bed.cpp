@@ -59,8 +59,8 @@ std::size_t place_grains(System& sys, const BedSpec& spec) {
         if (std::hypot(pos.x(), pos.y()) > r_free) continue;
         const double diameter = g.diameter_m + g.diameter_spread_m * uni(rng);
         const double radius = 0.5 * diameter;
-        const double mass = g.density_kg_m3 * kPi / 6 * diameter * diameter * diameter;
-        const ParticleIndex i = sys.particles.add(pos, radius, mass, spec.grain_material, SizeClass::grain);
+        const ParticleIndex i = sys.particles.add(pos, radius, sphere_mass_kg(g.density_kg_m3, diameter),
+                                                  spec.grain_material, SizeClass::grain);
         // Small random velocities mix the pour (paper: "mix and settle").
         sys.particles.velocity_m_s[i] = 0.05 * Vec3(uni(rng), uni(rng), uni(rng));
         ++placed;

@@ -58,8 +58,7 @@ DropResult drop_projectile(System& sys, double surface_height_m, const Projectil
     if (cfg.domain) cfg.domain->hi_m.z() = std::max(cfg.domain->hi_m.z(), centre.z() + 2 * R);
   }
   const ParticleIndex ip = sys.particles.add(centre, R, ps.mass_kg, ps.material, SizeClass::projectile);
-  sys.particles.velocity_m_s[ip] = Vec3(0, 0, -v0);
-  sys.particles.eval_velocity_m_s[ip] = sys.particles.velocity_m_s[ip];
+  sys.particles.set_velocity(ip, Vec3(0, 0, -v0));
   sys.invalidate();
   sys.initialize();
   res.projectile = ip;

@@ -19,7 +19,7 @@ namespace {
 double add_rough_base(System& sys, const PileSpec& spec, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const double d = spec.grains.diameter_m, r = 0.5 * d;
-  const double mass = spec.grains.density_kg_m3 * kPi / 6 * d * d * d;
+  const double mass = sphere_mass_kg(spec.grains.density_kg_m3, d);
   const double row = d * std::sqrt(3.0) / 2;
   const int n = static_cast<int>(std::ceil(spec.base_radius_m / row)) + 1;
   for (int j = -n; j <= n; ++j)
@@ -141,10 +141,9 @@ PileResult pour_pile(System& sys, const PileSpec& spec, const PileProgress& prog
       for (std::size_t i = 0; i < p.size() && free; ++i)
         free = (p.position_m[i] - x).norm() > 0.5 * dia + p.radius_m[i] + 1e-4;
       if (!free) continue;
-      const ParticleIndex k = sys.particles.add(x, 0.5 * dia, spec.grains.density_kg_m3 * kPi / 6 * dia * dia * dia,
+      const ParticleIndex k = sys.particles.add(x, 0.5 * dia, sphere_mass_kg(spec.grains.density_kg_m3, dia),
                                                 spec.grain_material, SizeClass::grain);
-      sys.particles.velocity_m_s[k] = Vec3(0, 0, -spec.release_speed_m_s);
-      sys.particles.eval_velocity_m_s[k] = sys.particles.velocity_m_s[k];
+      sys.particles.set_velocity(k, Vec3(0, 0, -spec.release_speed_m_s));
       ++released;
       ++poured;
     }

@@ -40,10 +40,7 @@ std::size_t tile_bed(const System& source, const TileSpec& spec, System& out) {
         if (!in_patch(source, i, half)) continue;
         const ParticleIndex k =
             out.particles.add(p.position_m[i] + shift, p.radius_m[i], p.mass_kg[i], p.material[i], SizeClass::grain);
-        out.particles.velocity_m_s[k] = p.velocity_m_s[i];
-        out.particles.omega_rad_s[k] = p.omega_rad_s[i];
-        out.particles.eval_velocity_m_s[k] = p.velocity_m_s[i];
-        out.particles.eval_omega_rad_s[k] = p.omega_rad_s[i];
+        out.particles.set_velocity(k, p.velocity_m_s[i], p.omega_rad_s[i]);
         top = std::max(top, p.position_m[i].z() + p.radius_m[i]);
       }
     }

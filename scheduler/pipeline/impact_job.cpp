@@ -120,10 +120,8 @@ void load_bed(System& sys, const results::BedData& bed) {
   for (std::size_t i = 0; i < bed.size(); ++i) {
     const Vec3 x(bed.position_m[3 * i], bed.position_m[3 * i + 1], bed.position_m[3 * i + 2]);
     const ParticleIndex k = sys.particles.add(x, bed.radius_m[i], bed.mass_kg[i], bed.material[i], SizeClass::grain);
-    sys.particles.velocity_m_s[k] = Vec3(bed.velocity_m_s[3 * i], bed.velocity_m_s[3 * i + 1], bed.velocity_m_s[3 * i + 2]);
-    sys.particles.omega_rad_s[k] = Vec3(bed.omega_rad_s[3 * i], bed.omega_rad_s[3 * i + 1], bed.omega_rad_s[3 * i + 2]);
-    sys.particles.eval_velocity_m_s[k] = sys.particles.velocity_m_s[k];
-    sys.particles.eval_omega_rad_s[k] = sys.particles.omega_rad_s[k];
+    sys.particles.set_velocity(k, Vec3(bed.velocity_m_s[3 * i], bed.velocity_m_s[3 * i + 1], bed.velocity_m_s[3 * i + 2]),
+                               Vec3(bed.omega_rad_s[3 * i], bed.omega_rad_s[3 * i + 1], bed.omega_rad_s[3 * i + 2]));
   }
   ContainerSpec cs;
   cs.diameter_m = bed.container_diameter_m;

@@ -98,7 +98,7 @@ void engine_checks(const json& s, const SystemConfig& cfg, const std::string& dt
     SystemConfig c = cfg;
     c.dt_s = dt;
     System sys(c);
-    sys.particles.add(Vec3(0, 0, 1), r_min, rho * kPi / 6 * std::pow(2 * r_min, 3), kGrainMaterial, SizeClass::grain);
+    sys.particles.add(Vec3(0, 0, 1), r_min, sphere_mass_kg(rho, 2 * r_min), kGrainMaterial, SizeClass::grain);
     const double Rp = 0.5 * s["/projectile/diameter_m"_json_pointer].get<double>();
     sys.particles.add(Vec3(0, 0, 3 + Rp), Rp, s["/projectile/mass_kg"_json_pointer], kProjectileMaterial,
                       SizeClass::projectile);
