@@ -20,6 +20,22 @@ double grain_kinetic_energy_J(const System& sys) {
   return e;
 }
 
+std::optional<FirstTouch> first_touch_bottom(const System& sys, double x_m, double y_m, double radius_m) {
+  const auto& p = sys.particles;
+  std::optional<FirstTouch> best;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.size_class[i] != SizeClass::grain) continue;
+    const double dx = p.position_m[i].x() - x_m, dy = p.position_m[i].y() - y_m;
+    const double reach = radius_m + p.radius_m[i];
+    const double d2 = dx * dx + dy * dy;
+    if (d2 >= reach * reach) continue;
+    // Centre height at which the falling sphere touches grain i: |c - x_i| = R + r_i.
+    const double bottom = p.position_m[i].z() + std::sqrt(reach * reach - d2) - radius_m;
+    if (!best || bottom > best->bottom_height_m) best = FirstTouch{bottom, static_cast<ParticleIndex>(i)};
+  }
+  return best;
+}
+
 DropResult drop_projectile(System& sys, double surface_height_m, const ProjectileSpec& ps,
                            const DropStop& stop, double sample_rate_hz, const DropProgress& progress) {
   if (ps.impact_speed_m_s.has_value() == ps.drop_height_m.has_value())
@@ -35,6 +51,13 @@ DropResult drop_projectile(System& sys, double surface_height_m, const Projectil
   res.surface_height_m = surface_height_m;
   double v0 = 0;  // downward speed at release
   double bottom = 0;
+  // The grain the projectile meets first, falling straight down at its lateral offset: the start
+  // gap is measured from there, not from the mean surface (a grain standing proud of the mean
+  // surface would otherwise be inside the projectile at release).
+  const std::optional<FirstTouch> touch =
+      first_touch_bottom(sys, ps.lateral_offset_x_m, ps.lateral_offset_y_m, R);
+  const double touch_bottom = touch ? touch->bottom_height_m : surface_height_m;
+  res.first_touch_height_m = touch_bottom;
   if (ps.impact_speed_m_s) {
     const double gap = ps.start_gap_m + ps.vertical_offset_m;
     const double v2 = (*ps.impact_speed_m_s) * (*ps.impact_speed_m_s) - 2 * g * gap;
@@ -44,10 +67,17 @@ DropResult drop_projectile(System& sys, double surface_height_m, const Projectil
           "at g = {} m/s2 (free fall alone gives more); lower start_gap_m or the vertical offset",
           *ps.impact_speed_m_s, gap, g));
     v0 = std::sqrt(v2);
-    bottom = surface_height_m + gap;
+    bottom = touch_bottom + gap;
   } else {
     bottom = surface_height_m + *ps.drop_height_m + ps.vertical_offset_m;
   }
+  if (touch && bottom < touch_bottom)
+    throw ConfigError(fmt::format(
+        "projectile: at release (bottom at z = {:.4f} m, lateral offset ({:.4f}, {:.4f}) m) it would "
+        "overlap grain {} whose top under the projectile reaches z = {:.4f} m ({:.2f} mm above the "
+        "mean surface); start it higher (drop_height_m, start_gap_m or the vertical offset)",
+        bottom, ps.lateral_offset_x_m, ps.lateral_offset_y_m, touch->grain, touch_bottom,
+        1e3 * (touch_bottom - surface_height_m)));
   res.release_height_m = bottom;
   res.release_speed_m_s = v0;
   const Vec3 centre(ps.lateral_offset_x_m, ps.lateral_offset_y_m, bottom + R);

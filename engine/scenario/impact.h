@@ -18,12 +18,14 @@ struct ProjectileSpec {
   double diameter_m = 0.10;              ///< paper: 10 cm
   double mass_kg = 1.0;                  ///< paper: 1 kg
   std::uint8_t material = 2;             ///< kProjectileMaterial
-  /// Exactly one of the two: speed when the projectile's bottom reaches the mean bed surface
-  /// (start gap_m above it, velocity set so that free fall gives this speed at the surface), or
-  /// the height of the bottom above the surface for a release from rest.
+  /// Exactly one of the two: speed when the projectile first touches a grain (it starts
+  /// start_gap_m above the highest grain under its footprint, with the velocity that free fall
+  /// turns into this speed at the touch), or the height of the bottom above the mean surface for
+  /// a release from rest. Either way a start that would overlap a grain is refused.
   std::optional<double> impact_speed_m_s;
   std::optional<double> drop_height_m;
-  double start_gap_m = 0.005;            ///< impact-speed mode: bottom-to-surface gap at release
+  double start_gap_m = 0.005;            ///< impact-speed mode: gap between the projectile's bottom
+                                         ///< and the first grain it would touch, at release
   double lateral_offset_x_m = 0;         ///< start offset from the container axis (already drawn)
   double lateral_offset_y_m = 0;
   double vertical_offset_m = 0;          ///< added to the start height (already drawn)
@@ -55,12 +57,22 @@ struct DropResult {
   double surface_height_m = 0;     ///< engine z of the mean bed surface (depth 0)
   double release_height_m = 0;     ///< engine z of the projectile's bottom at release
   double release_speed_m_s = 0;    ///< downward speed at release
+  double first_touch_height_m = 0; ///< engine z of the projectile's bottom where it would first
+                                   ///< touch a grain falling straight down (mean surface if none)
   std::optional<double> first_contact_s;
   bool stopped = false;            ///< stop criterion met (false: the time cap ended the run)
   std::optional<double> rest_s;    ///< start of the hold window that met the stop criterion
   long long steps = 0;
   ParticleIndex projectile = 0;
 };
+
+/// The grain a sphere of radius_m falling straight down along (x_m, y_m) touches first, and the
+/// engine z of the sphere's bottom at that moment; nothing when no grain lies under it.
+struct FirstTouch {
+  double bottom_height_m = 0;
+  ParticleIndex grain = 0;
+};
+std::optional<FirstTouch> first_touch_bottom(const System& sys, double x_m, double y_m, double radius_m);
 
 /// progress(fraction of the time cap, detail); may throw to abort the run.
 using DropProgress = std::function<void(double, const std::string&)>;

@@ -12,6 +12,13 @@ Trace TraceData::to_trace() const {
   t.accel_up_m_s2 = accel_up_m_s2;
   t.depth_m = depth_m;
   t.velocity_down_m_s = velocity_down_m_s;
+  // The engine's first contact: the last sample before the first one that counts a contact.
+  for (std::size_t k = 0; k < contacts.size() && k < t_s.size(); ++k) {
+    if (contacts[k] > 0) {
+      t.contact_start_s = t_s[k == 0 ? 0 : k - 1];
+      break;
+    }
+  }
   return t;
 }
 

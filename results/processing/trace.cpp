@@ -126,6 +126,43 @@ void integrate_from_start(const std::vector<double>& t, const std::vector<double
   }
 }
 
+/// The collision start: the last sample before it and its time, and whether it is a step edge
+/// (faster than the filter, located at half height).
+struct CollisionStart {
+  std::size_t i_start = 0;
+  double t_start_s = 0;
+  bool step = false;
+};
+
+/// DEM records: the engine's first contact (Trace::contact_start_s).
+CollisionStart contact_start(const std::vector<double>& t, double t_contact_s) {
+  const auto it = std::upper_bound(t.begin(), t.end(), t_contact_s);
+  const std::size_t i = it == t.begin() ? 0 : static_cast<std::size_t>(it - t.begin()) - 1;
+  return {i, t_contact_s, false};
+}
+
+/// The paper's rule (Sect. 2.3): the last sample before the peak ipk still within the free-fall
+/// band -g + thr; a step edge (rising within the edge width w) is located at its half height.
+CollisionStart free_fall_start(const std::vector<double>& t, const std::vector<double>& a,
+                               std::size_t ipk, double g, double thr, std::size_t w) {
+  const std::size_t n = t.size();
+  std::size_t i = ipk;
+  while (i > 0 && a[i] > -g + thr) --i;
+  if (i == 0 && a[0] > -g + thr)
+    throw std::invalid_argument(
+        "the record does not start in free fall (no sample reads -g before the peak)");
+  CollisionStart cs{i, crossing_time(t, a, i, -g + thr), false};
+  // Height of the edge: the level reached 2w samples after the threshold crossing.
+  const std::size_t k_hi = std::min(n - 1, i + 2 * w);
+  const double top = *std::max_element(a.begin() + static_cast<std::ptrdiff_t>(i + 1),
+                                       a.begin() + static_cast<std::ptrdiff_t>(k_hi + 1));
+  const double half = -g + 0.5 * (top + g);
+  std::size_t k = i;
+  while (k < k_hi && a[k + 1] < half) ++k;
+  if (k < k_hi && k + 1 <= i + w && top + g > 4.0 * thr) cs = {k, crossing_time(t, a, k, half), true};
+  return cs;
+}
+
 void validate(const Trace& tr) {
   const std::size_t n = tr.t_s.size();
   if (tr.accel_up_m_s2.size() != n)
@@ -228,30 +265,13 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
   std::vector<double> a(n);
   for (int pass = 0; pass < 3; ++pass) {
     for (std::size_t i = 0; i < n; ++i) a[i] = af[i] - bias;
-    // Start: the last sample before the peak still within the free-fall band.
     const double thr = std::max(6.0 * sigma_ff, 0.03 * g);
-    std::size_t i = ipk;
-    while (i > 0 && a[i] > -g + thr) --i;
-    if (i == 0 && a[0] > -g + thr)
-      throw std::invalid_argument(
-          "the record does not start in free fall (no sample reads -g before the peak)");
-    i_start = i;
-    m.t_start_s = crossing_time(t, a, i, -g + thr);
-    step_start = false;
-    {
-      // Height of the edge: the level reached 2w samples after the threshold crossing.
-      const std::size_t k_hi = std::min(n - 1, i + 2 * w);
-      const double top = *std::max_element(a.begin() + static_cast<std::ptrdiff_t>(i + 1),
-                                           a.begin() + static_cast<std::ptrdiff_t>(k_hi + 1));
-      const double half = -g + 0.5 * (top + g);
-      std::size_t k = i;
-      while (k < k_hi && a[k + 1] < half) ++k;
-      if (k < k_hi && k + 1 <= i + w && top + g > 4.0 * thr) {
-        step_start = true;
-        m.t_start_s = crossing_time(t, a, k, half);
-        i_start = k;
-      }
-    }
+    const CollisionStart cs = trace.contact_start_s
+                                  ? contact_start(t, *trace.contact_start_s)
+                                  : free_fall_start(t, a, ipk, g, thr, w);
+    i_start = cs.i_start;
+    m.t_start_s = cs.t_start_s;
+    step_start = cs.step;
     // Free-fall segment: up to the edge width before the start.
     const std::size_t ff_end = i_start > w + 1 ? i_start - w - 1 : 0;
     // End: acceleration below end_threshold_g * g after the peak, staying there for 2 ms (at least

@@ -19,6 +19,12 @@ struct Trace {
   /// Optional (DEM traces have them; lab records usually not): same length as t_s when present.
   std::vector<double> depth_m;
   std::vector<double> velocity_down_m_s;
+  /// DEM records only: the time of the engine's first contact (the last sample before the
+  /// projectile touched anything). When set, the collision starts there instead of where the
+  /// filtered record leaves free fall: a DEM drop released 1 mm above the bed has 1-6 ms of free
+  /// fall, which the 500 Hz filter's edge swallows (no sample reads -g before the peak). Lab
+  /// records leave it empty and keep the paper's rule (Sect. 2.3).
+  std::optional<double> contact_start_s;
 };
 
 struct MetricOptions {

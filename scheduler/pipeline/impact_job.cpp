@@ -233,6 +233,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   m["surface_height_m"] = bed.surface_height_m;
   m["release_speed_m_s"] = dr.release_speed_m_s;
   m["release_height_above_surface_m"] = dr.release_height_m - bed.surface_height_m;
+  m["first_touch_height_above_surface_m"] = dr.first_touch_height_m - bed.surface_height_m;
   m["lateral_offset_m"] = std::hypot(p.projectile.lateral_offset_x_m, p.projectile.lateral_offset_y_m);
   m["threads"] = sys.threads();
   m["wall_time_s"] = wall_s;

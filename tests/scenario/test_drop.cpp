@@ -101,5 +101,50 @@ TEST(Drop, RefusesAmbiguousOrUnreachableStarts) {
   EXPECT_THROW(drop_projectile(c.sys, 0.05, q, DropStop{}, 1e4), ConfigError);
 }
 
+// Issue #11: the start gap is measured from the first grain the projectile would touch at its
+// lateral offset, not from the mean surface; a grain standing 1 cm proud of the "surface" is met
+// at the requested speed, and a release that would overlap it is refused with that reason.
+TEST(Drop, StartGapIsMeasuredFromTheGrainUnderTheFootprint) {
+  EmptyContainer c(9.81);
+  const double r = 0.005, surface = 0.0;
+  c.sys.particles.add(Vec3(0.03, 0, r), r, sphere_mass_kg(2480, 2 * r), kGrainMaterial, SizeClass::grain);
+  // A sphere of radius 5 cm at lateral offset 0 touches it when |c - x| = 5.5 cm.
+  const double touch = r + std::sqrt(0.055 * 0.055 - 0.03 * 0.03) - 0.05;
+  const auto ft = first_touch_bottom(c.sys, 0, 0, 0.05);
+  ASSERT_TRUE(ft.has_value());
+  EXPECT_NEAR(ft->bottom_height_m, touch, 1e-12);
+  EXPECT_FALSE(first_touch_bottom(c.sys, -0.03, 0, 0.05).has_value());  // 6 cm away: out of reach
+
+  ProjectileSpec p;
+  p.impact_speed_m_s = 0.3;
+  p.start_gap_m = 0.001;
+  DropStop stop;
+  stop.max_time_s = 0.05;
+  const DropResult res = drop_projectile(c.sys, surface, p, stop, 1e4);
+  EXPECT_NEAR(res.release_height_m, touch + 0.001, 1e-12);
+  EXPECT_NEAR(res.first_touch_height_m, touch, 1e-12);
+  EXPECT_EQ(res.samples.front().contacts, 0);  // nothing touches at release
+  ASSERT_TRUE(res.first_contact_s.has_value());
+  // The touch comes after about 1 mm of free fall, at about the requested speed.
+  EXPECT_LT(*res.first_contact_s, 0.005);
+  std::size_t k = 0;
+  while (res.samples[k].contacts == 0) ++k;
+  EXPECT_NEAR(res.samples[k - 1].velocity_down_m_s, 0.3, 2e-3);
+}
+
+TEST(Drop, AReleaseThatOverlapsAGrainIsRefused) {
+  EmptyContainer c(9.81);
+  const double r = 0.005;
+  c.sys.particles.add(Vec3(0, 0, r), r, sphere_mass_kg(2480, 2 * r), kGrainMaterial, SizeClass::grain);
+  ProjectileSpec p;
+  p.drop_height_m = 0.005;  // bottom at z = 5 mm, the grain's top at 10 mm
+  try {
+    drop_projectile(c.sys, 0.0, p, DropStop{}, 1e4);
+    FAIL() << "a release inside a grain was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("overlap grain"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace gravsweep

@@ -79,13 +79,17 @@ TEST_F(ImpactPipeline, DropIsRecordedAndMeasured) {
   const auto tr = results::read_trace(drop_->trace_path);
   ASSERT_GT(tr.size(), 100u);
   EXPECT_NEAR(tr.sample_rate_hz, 1e4, 1e-6);
-  // Starts 5 mm above the surface, in free fall: accel_up reads -g.
-  EXPECT_NEAR(tr.depth_m.front(), -0.005, 1e-9);
+  // Starts 5 mm above the first grain under the projectile (issue #11: not above the mean
+  // surface, which a proud grain may stand above), in free fall: accel_up reads -g.
+  const double touch_m = m["first_touch_height_above_surface_m"].get<double>();
+  EXPECT_GT(touch_m, -0.01);
+  EXPECT_LT(touch_m, 0.01);
+  EXPECT_NEAR(tr.depth_m.front(), -(touch_m + 0.005), 1e-9);
   EXPECT_NEAR(tr.accel_up_m_s2[1], -9.81, 1e-6);
   EXPECT_EQ(tr.contacts.front(), 0);
-  // The paper's metrics: vc close to the requested 1 m/s (the surface is rough at the grain
-  // scale, so first contact comes a little early or late), a positive peak, a depth inside the bed.
-  EXPECT_NEAR(m["vc_m_s"].get<double>(), 1.0, 0.1);
+  // The paper's metrics: vc is the requested 1 m/s (the start gap is measured from the grain
+  // the projectile touches first; sampling at 10 kHz moves it by g / 10 kHz at most).
+  EXPECT_NEAR(m["vc_m_s"].get<double>(), 1.0, 2e-3);
   EXPECT_NEAR(m["t_start_s"].get<double>(), m["first_contact_s"].get<double>(), 1e-3);
   // The projectile penetrates and stays inside the bed. (On a bed this small the paper's end of
   // collision, a < 0.1 g after the filter, may come at a pause after the first grain shock, so
