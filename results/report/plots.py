@@ -179,6 +179,69 @@ def plot_ranking():
     save(fig, "ranking.png")
 
 
+# ---- `gravsweep plot results`: one metric against one parameter from a results table --------
+# xy.csv holds the columns x, y, group (group may be empty); xy.json the labels and the output.
+# Units follow the column names' suffixes and are shown as the paper does (cm, ms, m/s2).
+UNITS = [("_m_s2", 1.0, "m/s2"), ("_m_s", 1.0, "m/s"), ("_kg_m3", 1.0, "kg/m3"), ("_hz", 1.0, "Hz"),
+         ("_m", 100.0, "cm"), ("_s", 1000.0, "ms")]
+NAMES = {"zstop_m": "penetration depth zstop", "tstop_s": "collision duration tstop",
+         "apeak_m_s2": "peak acceleration apeak", "vc_m_s": "collision velocity vc",
+         "impact_speed_m_s": "impact speed", "fill_height_m": "fill height",
+         "gravity_m_s2": "gravity g", "mu_rolling": "rolling friction mu_r"}
+
+
+def scale_of(col):
+    for suffix, sc, unit in UNITS:
+        if col.endswith(suffix):
+            return sc, unit
+    return 1.0, ""
+
+
+def label_of(col):
+    sc, unit = scale_of(col)
+    name = NAMES.get(col, col)
+    return f"{name} ({unit})" if unit else name
+
+
+def plot_xy():
+    import json
+    spec = json.load(open(os.path.join(D, "xy.json")))
+    rows = read(os.path.join(D, "xy.csv"))
+    xs_, ys_ = scale_of(spec["x"])[0], scale_of(spec["y"])[0]
+    groups = []
+    for r in rows:
+        if r["group"] not in groups:
+            groups.append(r["group"])
+    fig, ax = plt.subplots(figsize=(6, 4.2))
+    for k, gname in enumerate(groups):
+        pts = [(num(r["x"]) * xs_, num(r["y"]) * ys_) for r in rows if r["group"] == gname]
+        pts = [p for p in pts if math.isfinite(p[0]) and math.isfinite(p[1])]
+        c = COLORS[k % len(COLORS)]
+        lab = f"{spec['group']} = {gname}" if spec.get("group") else "runs"
+        ax.plot([p[0] for p in pts], [p[1] for p in pts], "o", color=c, alpha=0.35, ms=4,
+                label=f"{lab} (each run)")
+        xs = sorted({p[0] for p in pts})
+        mean = [sum(p[1] for p in pts if p[0] == x) / sum(1 for p in pts if p[0] == x) for x in xs]
+        sd = []
+        for x, m in zip(xs, mean):
+            v = [p[1] for p in pts if p[0] == x]
+            sd.append(math.sqrt(sum((y - m) ** 2 for y in v) / (len(v) - 1)) if len(v) > 1 else 0.0)
+        ax.errorbar(xs, mean, yerr=sd, fmt="-s", color=c, ms=5, capsize=3,
+                    label=f"{lab} (mean +/- std)")
+    ax.set_xlabel(label_of(spec["x"]))
+    ax.set_ylabel(label_of(spec["y"]))
+    if spec.get("title"):
+        ax.set_title(spec["title"], fontsize=10)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(spec["out"], dpi=120)
+    plt.close(fig)
+    written.append(spec["out"])
+
+
+if WHICH == "xy":
+    plot_xy()
 if WHICH in ("all", "errors"):
     plot_errors()
 if WHICH == "all":

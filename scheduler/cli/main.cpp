@@ -29,6 +29,8 @@ constexpr SetupFn kVerbs[] = {
     &gravsweep::cli::setup_status,
     &gravsweep::cli::setup_resume,
     &gravsweep::cli::setup_results,
+    &gravsweep::cli::setup_plot,
+    &gravsweep::cli::setup_export,
     &gravsweep::cli::setup_bench_queue,
 };
 

@@ -19,5 +19,7 @@ void setup_resume(CLI::App& app);
 void setup_results(CLI::App& app);
 void setup_bench_queue(CLI::App& app);
 void setup_pile(CLI::App& app);
+void setup_plot(CLI::App& app);
+void setup_export(CLI::App& app);
 
 }  // namespace gravsweep::cli

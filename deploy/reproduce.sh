@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# The paper's simulation campaign (Sunday et al. 2021; issue #11), run with gravsweep itself.
+#
+#   deploy/reproduce.sh run      submit every part of examples/reproduction/ and run the workers
+#                                (hours on 2 cores; kill it any time, run it again to resume)
+#   deploy/reproduce.sh status   progress with ETA
+#   deploy/reproduce.sh export   the finished drops -> data/reproduction/ (measurement format)
+#   deploy/reproduce.sh figures  Figs. 3, 6, 9, 10 and Table 3 from the campaign and the dataset
+#
+# Environment: GRAVSWEEP_CAMPAIGN (default runs/reproduction/paper.db), GRAVSWEEP_BIN (default
+# build/scheduler/gravsweep), WORKERS (2), THREADS (1).
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+gs="${GRAVSWEEP_BIN:-$root/build/scheduler/gravsweep}"
+db="${GRAVSWEEP_CAMPAIGN:-$root/runs/reproduction/paper.db}"
+data="$root/data/reproduction"
+figs="$root/docs/reproduction"
+[ -x "$gs" ] || { "$root/deploy/install-deps.sh" && "$root/deploy/build.sh"; }
+
+case "${1:-}" in
+  run)
+    mkdir -p "$(dirname "$db")"
+    for spec in "$root"/examples/reproduction/part*.json; do "$gs" submit "$spec" --db "$db"; done
+    "$gs" resume --db "$db"
+    exec nice -n 10 "$gs" work --db "$db" --workers "${WORKERS:-2}" --threads "${THREADS:-1}" --lease 120
+    ;;
+  status)
+    exec "$gs" status --db "$db"
+    ;;
+  export)
+    rm -rf "$data.tmp"
+    "$gs" export --db "$db" --out "$data.tmp" --rate-hz 2000
+    rm -rf "$data" && mv "$data.tmp" "$data"
+    du -sh "$data"
+    ;;
+  figures)
+    mkdir -p "$figs"
+    plot() { "$gs" plot results --db "$db" "$@" || true; }
+    plot --sweep part3_fill_height --x fill_height_m --y zstop_m \
+      --title "Fig. 3: 1 m/s at 1 g, Chrono set" --out "$figs/fig3_zstop_vs_fill.png"
+    plot --sweep part4_rolling_friction --x mu_rolling --y zstop_m \
+      --title "Fig. 6: 1 m/s at 1 g, mu_t = 0" --out "$figs/fig6_zstop_vs_mur.png"
+    for y in apeak_m_s2 zstop_m tstop_s; do
+      plot --where 'sweep~_chrono_' --x vc_m_s --y "$y" --group gravity_m_s2 \
+        --title "Chrono set, 10 cm (1 g) and 21 cm (0.1 m/s2) fills" --out "$figs/fig9_${y}_vs_vc.png"
+    done
+    "$gs" model table3 "$data" | tee "$figs/table3.txt"
+    "$gs" report "$data" --out "$figs/report"
+    ;;
+  *)
+    sed -n '2,12p' "${BASH_SOURCE[0]}"
+    exit 2
+    ;;
+esac

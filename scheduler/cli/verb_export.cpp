@@ -1,0 +1,190 @@
+// `gravsweep export`: a campaign's finished drops as a measurement campaign on disk
+// (shared/formats/measurements.md): trials.csv, traces/<job>.csv at a lower sample rate,
+// scenarios/<job>.json, and results.csv (the campaign's own metrics from the full-rate traces).
+// `gravsweep model rank DIR` then works on the folder without rerunning anything, and it is
+// small enough to keep in git (the reproduction dataset, REPRODUCTION.md).
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "results/io/bed_file.h"
+#include "results/io/trace_file.h"
+#include "results/processing/resample.h"
+#include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/verbs.h"
+#include "scheduler/queue/filter.h"
+#include "scheduler/queue/queue.h"
+#include "scheduler/queue/table.h"
+
+namespace gravsweep::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct ExportOptions {
+  std::string db = "campaign.db";
+  std::string out;
+  std::vector<std::string> where;
+  std::string sweep;
+  double rate_hz = 2000;
+};
+
+/// The columns of trials.csv: the format's required ones, then the DEM provenance.
+const std::vector<std::string> kTrialColumns = {
+    "trial_id",          "trace_file",         "gravity_m_s2",          "impact_velocity_m_s",
+    "fill_height_m",     "projectile_mass_kg", "projectile_diameter_m", "grain_diameter_m",
+    "bulk_density_kg_m3", "sample_rate_hz",    "source",                "contact_start_s",
+    "sweep",             "job_id",             "scenario_file",         "dt_s",
+    "grains",            "lateral_offset_m",   "code_version"};
+
+std::string num(double v) { return std::isfinite(v) ? fmt::format("{}", v) : std::string(); }
+
+/// The bed a drop used: its recorded path, or the bed job's output in this campaign.
+std::optional<results::BedData> bed_of(db::Database& db, const queue::CampaignPaths& paths,
+                                       const results::TraceData& td, const std::string& bed_job) {
+  std::vector<fs::path> candidates{td.bed_file};
+  db::Statement st(db, "SELECT output_path FROM attempts WHERE job_id=? AND outcome='done' ORDER BY attempt DESC");
+  st.bind(1, bed_job);
+  while (st.step())
+    if (!st.is_null(0)) candidates.push_back(paths.abs(st.get_text(0)));
+  for (const auto& p : candidates) {
+    std::error_code ec;
+    if (!p.empty() && fs::exists(p, ec)) return results::read_bed(p);
+  }
+  return std::nullopt;
+}
+
+/// Writes traces/<job>.csv: t_s, accel_m_s2 (decimated with its anti-alias filter), position_m
+/// and velocity_m_s (every k-th sample: they are smooth). Returns the new sample rate.
+double write_trace_csv(const fs::path& path, const results::TraceData& td, double rate_hz) {
+  const std::size_t step = std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(td.sample_rate_hz / rate_hz)));
+  const auto t = results::every_nth(td.t_s, step);
+  const auto a = results::decimate(td.accel_up_m_s2, td.sample_rate_hz, step);
+  const auto z = results::every_nth(td.depth_m, step);
+  const auto v = results::every_nth(td.velocity_down_m_s, step);
+  std::ofstream f(path, std::ios::binary);
+  if (!f) throw std::runtime_error(fmt::format("{}: cannot write", path.string()));
+  f << "t_s,accel_m_s2,position_m,velocity_m_s\n";
+  for (std::size_t i = 0; i < t.size(); ++i)
+    f << fmt::format("{:.6f},{:.6g},{:.7g},{:.6g}\n", t[i], a[i], z[i], v[i]);
+  if (!f) throw std::runtime_error(fmt::format("{}: write error", path.string()));
+  return td.sample_rate_hz / static_cast<double>(step);
+}
+
+std::vector<std::string> trial_row(const std::string& job, const std::string& sweep, const results::TraceData& td,
+                                   const std::optional<results::BedData>& bed, double rate_hz) {
+  const json m = json::parse(td.metrics_json.empty() ? "{}" : td.metrics_json);
+  const results::Trace tr = td.to_trace();
+  const double vc = m.value("vc_m_s", json()).is_number() ? m["vc_m_s"].get<double>() : NAN;
+  double bulk = NAN;
+  if (bed && !bed->report_json.empty()) {
+    const json r = json::parse(bed->report_json);
+    if (r.contains("bulk_density_kg_m3") && r["bulk_density_kg_m3"].is_number()) bulk = r["bulk_density_kg_m3"];
+  }
+  return {job,
+          "traces/" + job + ".csv",
+          num(td.gravity_m_s2),
+          num(vc),
+          num(td.fill_height_m),
+          num(td.projectile_mass_kg),
+          num(td.projectile_diameter_m),
+          num(td.grain_diameter_m),
+          num(bulk),
+          num(rate_hz),
+          "dem",
+          tr.contact_start_s ? num(*tr.contact_start_s) : std::string(),
+          sweep,
+          job,
+          "scenarios/" + job + ".json",
+          num(td.dt_s),
+          m.contains("grains") ? m["grains"].dump() : std::string(),
+          m.contains("lateral_offset_m") ? num(m["lateral_offset_m"].get<double>()) : std::string(),
+          td.code_version};
+}
+
+void write_text_file(const fs::path& p, const std::string& text) {
+  std::ofstream f(p, std::ios::binary);
+  f << text;
+  if (!f) throw std::runtime_error(fmt::format("{}: cannot write", p.string()));
+}
+
+void run_export(const ExportOptions& o) {
+  if (!fs::exists(o.db)) throw UsageError(fmt::format("--db: no campaign database at '{}'", o.db));
+  if (!(o.rate_hz > 0)) throw UsageError(fmt::format("--rate-hz: expected a rate > 0 Hz, found {}", o.rate_hz));
+  db::Database db(o.db);
+  const queue::CampaignPaths paths(o.db);
+  queue::ResultsTable t;
+  try {
+    t = queue::query_results(db, queue::ResultsQuery{o.where, {}, o.sweep, "sweep", -1});
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  const auto col = [&](const std::string& name) {
+    const auto it = std::find(t.columns.begin(), t.columns.end(), name);
+    if (it == t.columns.end()) throw std::runtime_error(fmt::format("{}: results table has no column '{}'", o.db, name));
+    return static_cast<std::size_t>(it - t.columns.begin());
+  };
+  const std::size_t c_job = col("job_id"), c_sweep = col("sweep"), c_kind = col("kind"), c_trace = col("trace_path"),
+                    c_bed = col("bed_job_id");
+  const fs::path out(o.out);
+  fs::create_directories(out / "traces");
+  fs::create_directories(out / "scenarios");
+  queue::TextTable trials, results_csv;
+  trials.header = kTrialColumns;
+  results_csv.header = t.columns;
+  for (const auto& r : t.rows) {
+    if (!r[c_kind].is_string() || r[c_kind].get<std::string>() != "drop" || !r[c_trace].is_string()) continue;
+    const std::string job = r[c_job].get<std::string>();
+    const results::TraceData td = results::read_trace(paths.abs(r[c_trace].get<std::string>()));
+    const auto bed = bed_of(db, paths, td, r[c_bed].is_string() ? r[c_bed].get<std::string>() : std::string());
+    const double rate = write_trace_csv(out / "traces" / (job + ".csv"), td, o.rate_hz);
+    write_text_file(out / "scenarios" / (job + ".json"), json::parse(td.scenario_json).dump(2) + "\n");
+    trials.rows.push_back(trial_row(job, r[c_sweep].get<std::string>(), td, bed, rate));
+    std::vector<std::string> cells;
+    for (const auto& v : r) cells.push_back(v.is_null() ? "" : v.is_string() ? v.get<std::string>() : v.dump());
+    results_csv.rows.push_back(std::move(cells));
+  }
+  // CSV files are written last, each under a temporary name: an interrupted export leaves no
+  // trials.csv that points at missing traces.
+  for (const auto& [name, table] : {std::pair{"results.csv", &results_csv}, std::pair{"trials.csv", &trials}}) {
+    write_text_file(out / (std::string(name) + ".tmp"), queue::render_csv(*table));
+    fs::rename(out / (std::string(name) + ".tmp"), out / name);
+  }
+  fmt::print("{} drops exported to {} (trials.csv, traces/ at {} Hz, scenarios/, results.csv)\n",
+             trials.rows.size(), out.string(), o.rate_hz);
+}
+
+}  // namespace
+
+void setup_export(CLI::App& app) {
+  auto o = std::make_shared<ExportOptions>();
+  auto* sub = app.add_subcommand(
+      "export",
+      "Write a campaign's finished drops as a measurement campaign (shared/formats/measurements.md):\n"
+      "OUT/trials.csv (one row per drop: gravity, impact speed, fill, projectile, grains, sample rate,\n"
+      "source = dem, the engine's first-contact time, sweep, job, code version), OUT/traces/<job>.csv\n"
+      "(t_s, accel_m_s2, position_m, velocity_m_s at --rate-hz after a 4th-order anti-alias low-pass\n"
+      "at 0.4 x the new rate), OUT/scenarios/<job>.json (the scenario of each drop) and OUT/results.csv\n"
+      "(the campaign's results table, metrics from the full-rate traces). The folder is what `gravsweep\n"
+      "measurements import` and `gravsweep model ...` read.\n\n"
+      "Example:\n"
+      "  gravsweep export --db paper.db --out data/reproduction --sweep part1_chrono_1g");
+  sub->add_option("--db", o->db, "campaign database")->capture_default_str();
+  sub->add_option("--out", o->out, "folder to write")->required();
+  sub->add_option("--where", o->where, "filter, e.g. 'gravity_m_s2<1' (repeatable)");
+  sub->add_option("--sweep", o->sweep, "only this sweep");
+  sub->add_option("--rate-hz", o->rate_hz, "sample rate of the exported traces")->capture_default_str();
+  sub->callback([o]() { run_export(*o); });
+}
+
+}  // namespace gravsweep::cli
