@@ -240,6 +240,55 @@ def plot_xy():
     written.append(spec["out"])
 
 
+def plot_trace():
+    """Sunday et al. 2021 Fig. 2 for one record: a, v, z against time, raw and processed."""
+    import json
+    spec = json.load(open(os.path.join(D, "trace.json")))
+    rows = read(os.path.join(D, "trace.csv"))
+    m = spec["metrics"]
+    t = [1000 * num(r["t_s"]) for r in rows]
+    fig, axs = plt.subplots(3, 1, figsize=(7, 8.5), sharex=True)
+    panels = [("accel_raw_m_s2", "accel_m_s2", "acceleration, up (m/s2)", 1.0),
+              ("velocity_raw_m_s", "velocity_m_s", "velocity, down (m/s)", 1.0),
+              ("depth_raw_m", "depth_m", "depth below the surface (cm)", 100.0)]
+    for ax, (raw, proc, lab, sc) in zip(axs, panels):
+        if rows and rows[0].get(raw, "") != "":
+            ax.plot(t, [sc * num(r[raw]) for r in rows], color="0.6", lw=0.7, label="raw record")
+        if proc == "accel_m_s2":
+            plab = "500 Hz Butterworth (paper)"
+        elif spec.get("source") == "dem":
+            plab = "the engine's own (DEM)"
+        else:
+            plab = "integrated from the filtered a"
+        ax.plot(t, [sc * num(r[proc]) for r in rows], color="tab:green", lw=1.4, label=plab)
+        ax.set_ylabel(lab)
+        ax.grid(alpha=0.3)
+        for key, style in (("t_start_s", "--"), ("t_end_s", ":")):
+            if m.get(key) is not None:
+                ax.axvline(1000 * m[key], color="k", ls=style, lw=0.8)
+    if m.get("apeak_m_s2") is not None:
+        axs[0].axhline(m["apeak_m_s2"], color="tab:red", lw=0.8,
+                       label=f"apeak = {m['apeak_m_s2']:.1f} m/s2")
+    if m.get("vc_m_s") is not None:
+        axs[1].axhline(m["vc_m_s"], color="tab:blue", lw=0.8, label=f"vc = {m['vc_m_s']:.3f} m/s")
+    if m.get("zstop_m") is not None:
+        axs[2].axhline(100 * m["zstop_m"], color="tab:purple", lw=0.8,
+                       label=f"zstop = {100 * m['zstop_m']:.2f} cm")
+    if m.get("tstop_s") is not None:
+        axs[2].plot([], [], "k--", lw=0.8, label=f"start / end (tstop = {1000 * m['tstop_s']:.1f} ms)")
+    for ax in axs:
+        ax.legend(fontsize=7, loc="best")
+    axs[2].invert_yaxis()
+    axs[2].set_xlabel("time since release (ms)")
+    axs[0].set_title(spec.get("title", ""), fontsize=9)
+    fig.tight_layout()
+    fig.savefig(spec["out"], dpi=120)
+    plt.close(fig)
+    written.append(spec["out"])
+
+
+if WHICH == "trace":
+    plot_trace()
 if WHICH == "xy":
     plot_xy()
 if WHICH in ("all", "errors"):

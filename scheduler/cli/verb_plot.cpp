@@ -13,7 +13,10 @@
 #include <string>
 #include <vector>
 
+#include "results/io/trace_file.h"
+#include "results/processing/trace.h"
 #include "results/report/report.h"
+#include "scheduler/pipeline/scenario_spec.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/filter.h"
@@ -25,6 +28,7 @@ namespace gravsweep::cli {
 namespace {
 
 namespace fs = std::filesystem;
+using nlohmann::json;
 
 struct PlotResultsOptions {
   std::string db = "campaign.db";
@@ -88,6 +92,64 @@ void run_plot_results(const PlotResultsOptions& o) {
   fmt::print("{} runs plotted: {}\n", usable, out.string());
 }
 
+struct PlotTraceOptions {
+  std::string trace, out;
+};
+
+/// The campaign's processing of a DEM record (as the drop job does): the scenario's filter and
+/// collision-end settings, the floor at the bed's surface height.
+results::ProcessedTrace process_dem_trace(const results::TraceData& td, const std::string& file) {
+  results::MetricOptions mo;
+  try {
+    mo = pipeline::scenario_params(pipeline::validate_scenario(json::parse(td.scenario_json), file)).metric_options;
+  } catch (const std::exception& e) {
+    throw UsageError(fmt::format("{}: the scenario attribute is not a valid scenario ({})", file, e.what()));
+  }
+  mo.fill_height_m = td.surface_height_m;
+  try {
+    return results::process_trace(td.to_trace(), mo);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("{}: cannot process the record: {}", file, e.what()));
+  }
+}
+
+void run_plot_trace(const PlotTraceOptions& o) {
+  if (!fs::exists(o.trace)) throw UsageError(fmt::format("no trace file at '{}'", o.trace));
+  const std::string out_name = o.out.empty() ? (fs::path(o.trace).parent_path() / "fig2.png").string() : o.out;
+  if (fs::path(out_name).extension() != ".png")
+    throw UsageError(fmt::format("--out: expected a file name ending in .png, found '{}'", out_name));
+  results::TraceData td;
+  try {
+    td = results::read_trace(o.trace);
+  } catch (const std::exception& e) {
+    throw UsageError(fmt::format("{}: not a readable gravsweep trace.h5 ({})", o.trace, e.what()));
+  }
+  const results::ProcessedTrace p = process_dem_trace(td, o.trace);
+  ScratchDir tmp;
+  {
+    std::ofstream f(tmp.path / "trace.csv");
+    f << "t_s,accel_raw_m_s2,velocity_raw_m_s,depth_raw_m,accel_m_s2,velocity_m_s,depth_m\n";
+    for (std::size_t i = 0; i < p.t_s.size(); ++i)
+      f << fmt::format("{},{},{},{},{},{},{}\n", p.t_s[i], td.accel_up_m_s2[i], td.velocity_down_m_s[i], td.depth_m[i],
+                       p.accel_up_m_s2[i], p.velocity_down_m_s[i], p.depth_m[i]);
+  }
+  const auto& m = p.metrics;
+  const fs::path out = fs::absolute(out_name);
+  fs::create_directories(out.parent_path());
+  {
+    const json metrics{{"vc_m_s", m.vc_m_s},   {"apeak_m_s2", m.apeak_m_s2}, {"zstop_m", m.zstop_m},
+                       {"tstop_s", m.tstop_s}, {"t_start_s", m.t_start_s},   {"t_end_s", m.t_end_s}};
+    std::ofstream f(tmp.path / "trace.json");
+    f << json{{"out", out.string()}, {"source", "dem"}, {"metrics", metrics},
+              {"title", fmt::format("{}: g = {} m/s2, vc = {:.3f} m/s", o.trace, td.gravity_m_s2, m.vc_m_s)}}
+             .dump();
+  }
+  std::string log;
+  if (results::run_plots(tmp.path.string(), "trace", log) != 0) throw std::runtime_error("plotting failed: " + log);
+  fmt::print("vc {:.3f} m/s, apeak {:.2f} m/s2, zstop {:.2f} cm, tstop {:.1f} ms: {}\n", m.vc_m_s, m.apeak_m_s2,
+             100 * m.zstop_m, 1000 * m.tstop_s, out.string());
+}
+
 }  // namespace
 
 void setup_plot(CLI::App& app) {
@@ -112,6 +174,20 @@ void setup_plot(CLI::App& app) {
   res->add_option("--title", o->title, "figure title");
   res->add_option("--out", o->out, "PNG file to write")->required();
   res->callback([o]() { run_plot_results(*o); });
+
+  auto ot = std::make_shared<PlotTraceOptions>();
+  auto* tr = plot->add_subcommand(
+      "trace",
+      "Sunday et al. 2021 Fig. 2 for one drop: acceleration (raw and after the paper's 500 Hz\n"
+      "Butterworth), velocity and depth against time, with the collision start and end, vc, apeak,\n"
+      "zstop and tstop marked, processed exactly as the campaign processed it (the scenario's filter\n"
+      "and collision-end settings). Default output: fig2.png next to the trace.\n\n"
+      "Examples:\n"
+      "  gravsweep plot trace runs/1g/trace.h5\n"
+      "  gravsweep plot trace campaign.files/traces/<job>.a1.h5 --out fig2.png");
+  tr->add_option("trace", ot->trace, "a trace.h5 of `gravsweep run` or of a campaign")->required();
+  tr->add_option("--out", ot->out, "PNG file to write (default: fig2.png next to the trace)");
+  tr->callback([ot]() { run_plot_trace(*ot); });
 }
 
 }  // namespace gravsweep::cli

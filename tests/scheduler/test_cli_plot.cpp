@@ -68,3 +68,28 @@ TEST(CliPlot, BadInputIsRefusedWithExitCode2) {
   EXPECT_NE(r.err.find("no finished run"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(d.path / "f.png"));
 }
+
+// Issue #15's Fig. 2 for one drop, from a real `gravsweep run` of the tiny scenario.
+TEST(CliPlot, TraceDrawsFig2NextToTheRun) {
+  TempDir d;
+  write_text(d.path / "scenario.json", tiny_base());
+  auto r = run_cli({"run", "scenario.json", "--out", "r", "--threads", "1"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run_cli({"plot", "trace", "r/trace.h5"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("zstop"), std::string::npos) << r.out;
+  const auto png = d.path / "r" / "fig2.png";
+  ASSERT_TRUE(std::filesystem::exists(png));
+  EXPECT_EQ(head_bytes(png, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  EXPECT_GT(std::filesystem::file_size(png), 30000u);
+  // Bad input: a missing file, a file that is not a trace (the bed), a wrong extension.
+  r = run_cli({"plot", "trace", "r/none.h5"}, d.path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("r/none.h5"), std::string::npos) << r.err;
+  r = run_cli({"plot", "trace", "r/bed.h5", "--out", "b.png"}, d.path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("r/bed.h5"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(d.path / "b.png"));
+  r = run_cli({"plot", "trace", "r/trace.h5", "--out", "f.jpg"}, d.path);
+  EXPECT_EQ(r.code, 2);
+}
