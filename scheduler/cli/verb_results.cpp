@@ -11,6 +11,7 @@
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/filter.h"
+#include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
 #include "scheduler/queue/table.h"
 
@@ -44,9 +45,7 @@ std::string cell(const nlohmann::json& v, bool for_table, const std::string& col
 }
 
 void run_results(const ResultsOptions& o) {
-  if (!std::filesystem::exists(o.db)) throw UsageError(fmt::format("--db: no campaign database at '{}'", o.db));
-  db::Database db(o.db);
-  queue::ensure_schema(db);
+  db::Database db = queue::open_campaign(o.db, queue::OpenMode::read);
   // A table shows the swept parameters and the paper's metrics unless asked for more; CSV and JSON
   // exports carry every column.
   const bool summary = o.format == "table" && o.columns.empty() && !o.all;

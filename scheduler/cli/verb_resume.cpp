@@ -7,6 +7,7 @@
 
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
+#include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
 
 namespace gravsweep::cli {
@@ -22,9 +23,7 @@ struct ResumeCliOptions {
 };
 
 void run_resume(const ResumeCliOptions& o) {
-  if (!std::filesystem::exists(o.db)) throw UsageError(fmt::format("--db: no campaign database at '{}'", o.db));
-  db::Database db(o.db);
-  queue::ensure_schema(db);
+  db::Database db = queue::open_campaign(o.db, queue::OpenMode::write);
   queue::ResumeOptions r;
   r.retry_dead = o.dead;
   r.extra_attempts = o.extra_attempts;
@@ -36,8 +35,10 @@ void run_resume(const ResumeCliOptions& o) {
   fmt::print("failed jobs requeued without waiting for their backoff: {}\n", rep.failed_requeued);
   if (o.dead) fmt::print("dead jobs given {} more attempt(s): {}\n", o.extra_attempts, rep.dead_requeued);
   if (!o.keep_orphans) {
-    fmt::print("orphaned files {}: {}\n", o.dry_run ? "found" : "removed", rep.orphans.size());
+    if (!o.dry_run) fmt::print("quarantined files removed: {}\n", rep.purged);
+    fmt::print("orphaned files {}: {}\n", o.dry_run ? "found" : "moved to quarantine", rep.orphans.size());
     for (const auto& f : rep.orphans) fmt::print("  {}\n", f);
+    for (const auto& f : rep.restored) fmt::print("  {} put back: the database refers to it again\n", f);
   }
   if (o.dry_run) fmt::print("(dry run: nothing changed)\n");
 }
@@ -50,8 +51,12 @@ void setup_resume(CLI::App& app) {
       "resume",
       "Repair a campaign after crashes: requeue jobs whose lease expired (their worker died; jobs\n"
       "whose retry budget is spent go dead), requeue failed jobs at once instead of after their\n"
-      "backoff, and remove files no job refers to (outputs of killed attempts). Safe while workers\n"
-      "run: live leases and their files are left alone. Then run `gravsweep work` again.\n\n"
+      "backoff, and move files no job refers to (outputs of killed attempts) to <db stem>.files/\n"
+      "quarantine/; the next resume deletes what an earlier one quarantined. Only files unknown to\n"
+      "the database (one consistent snapshot) and older than it by 5 s move. Safe while workers run:\n"
+      "done outputs, live leases and their files are left alone. Refuses (exit 2) a database that is\n"
+      "not a campaign, or whose files folder misses most of its outputs (a renamed copy without its\n"
+      "folder). Then run `gravsweep work` again.\n\n"
       "Examples:\n"
       "  gravsweep resume --db campaign.db\n"
       "  gravsweep resume --db campaign.db --dead --extra-attempts 2   # also retry dead jobs\n"
@@ -59,7 +64,7 @@ void setup_resume(CLI::App& app) {
   sub->add_option("--db", opt->db, "campaign database")->capture_default_str();
   sub->add_flag("--dead", opt->dead, "also requeue dead jobs (and the drops waiting on a dead bed)");
   sub->add_option("--extra-attempts", opt->extra_attempts, "attempts added to a dead job's budget")->check(CLI::Range(1, 100))->capture_default_str();
-  sub->add_flag("--keep-orphans", opt->keep_orphans, "do not look for orphaned files");
+  sub->add_flag("--keep-orphans", opt->keep_orphans, "do not look for orphaned files (nor check that the folder belongs to the database)");
   sub->add_flag("--dry-run", opt->dry_run, "report only");
   sub->callback([opt]() { run_resume(*opt); });
 }

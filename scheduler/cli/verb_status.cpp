@@ -10,6 +10,7 @@
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/progress.h"
 #include "scheduler/cli/verbs.h"
+#include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
 #include "scheduler/queue/table.h"
 #include "scheduler/queue/worker.h"
@@ -108,9 +109,7 @@ nlohmann::json status_json(const queue::Status& s) {
 }
 
 void run_status(const StatusOptions& o) {
-  if (!std::filesystem::exists(o.db)) throw UsageError(fmt::format("--db: no campaign database at '{}'", o.db));
-  db::Database db(o.db);
-  queue::ensure_schema(db);
+  db::Database db = queue::open_campaign(o.db, queue::OpenMode::read);
   if (o.watch_s > 0) queue::install_stop_signals();
   do {
     const auto t0 = std::chrono::steady_clock::now();

@@ -10,6 +10,7 @@
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/impact.h"
+#include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
 #include "scheduler/sweep/spec.h"
 
@@ -51,8 +52,7 @@ void run_submit(const SubmitOptions& o) {
     }
     return;
   }
-  db::Database db(o.db);
-  queue::ensure_schema(db);
+  db::Database db = queue::open_campaign(o.db, queue::OpenMode::create);
   for (const auto& p : planned) {
     const auto r = queue::submit(db, p.spec, p.jobs);
     fmt::print("sweep {} ({}): {} jobs planned ({} bed, {} {}): {} new, {} already present\n", r.sweep,

@@ -15,6 +15,7 @@
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/impact.h"
+#include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
 #include "scheduler/queue/spawn.h"
 #include "scheduler/queue/worker.h"
@@ -113,7 +114,8 @@ int supervise(const WorkOptions& o, int threads) {
 }
 
 int run_work(const WorkOptions& o) {
-  if (!std::filesystem::exists(o.db)) throw UsageError(fmt::format("--db: no campaign database at '{}' (run `gravsweep submit` first)", o.db));
+  // Refuses what is not a campaign before any worker starts (migrates a version-1 campaign).
+  { db::Database db = queue::open_campaign(o.db, queue::OpenMode::write); }
   if (o.heartbeat_s > 0 && o.heartbeat_s * 2 > o.lease_s)
     throw UsageError(fmt::format("--heartbeat: found {} s, expected at most half of --lease ({} s), or the lease "
                                  "lapses between heartbeats",

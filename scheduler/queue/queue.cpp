@@ -10,6 +10,7 @@
 #include <random>
 #include <set>
 
+#include "scheduler/queue/campaign.h"
 #include "scheduler/sweep/canonical.h"
 
 namespace gravsweep::queue {
@@ -203,21 +204,19 @@ double now_s() {
 }
 
 void ensure_schema(Database& db) {
-  Transaction tx(db);
-  db.exec(kSchemaSql);
-  Statement get(db, "SELECT value FROM queue_meta WHERE key='schema_version'");
-  if (get.step()) {
-    const std::string v = get.get_text(0);
-    if (v != std::to_string(kSchemaVersion))
-      throw db::DbError(fmt::format("database '{}': job queue schema version {} (this gravsweep knows {})", db.path(),
-                                    v, kSchemaVersion),
-                        SQLITE_MISMATCH);
-  } else {
-    Statement put(db, "INSERT INTO queue_meta(key, value) VALUES('schema_version', ?)");
-    put.bind(1, std::to_string(kSchemaVersion));
-    put.run();
+  {
+    Transaction tx(db);
+    db.exec(kSchemaSql);
+    Statement get(db, "SELECT value FROM queue_meta WHERE key='schema_version'");
+    if (!get.step()) {
+      Statement put(db, "INSERT INTO queue_meta(key, value) VALUES('schema_version', ?)");
+      put.bind(1, std::to_string(kSchemaVersion));
+      put.run();
+    }
+    tx.commit();
   }
-  tx.commit();
+  check_campaign(db);
+  migrate_paths(db);
 }
 
 CampaignPaths::CampaignPaths(const fs::path& db_path) {
@@ -229,7 +228,12 @@ CampaignPaths::CampaignPaths(const fs::path& db_path) {
 std::string CampaignPaths::output_rel(const std::string& kind, const std::string& job_id, int attempt) const {
   const std::string dir = kind == "bed" ? "beds" : kind == "drop" ? "traces" : "noop";
   const std::string ext = kind == "noop" ? ".json" : ".h5";
-  return (fs::path(root.filename()) / dir / fmt::format("{}.a{}{}", job_id, attempt, ext)).string();
+  return (fs::path(dir) / fmt::format("{}.a{}{}", job_id, attempt, ext)).string();
+}
+
+fs::path CampaignPaths::abs(const std::string& rel) const {
+  const fs::path p(files_rel(rel));
+  return p.is_absolute() ? p : root / p;
 }
 
 // ---- submit -----------------------------------------------------------------------------------
@@ -601,6 +605,7 @@ void remove_lost_files(const CampaignPaths& paths, const Reclaimed& r) {
 
 ResumeReport resume(Database& db, const CampaignPaths& paths, const ResumeOptions& o) {
   ResumeReport rep;
+  if (o.remove_orphans) check_files_belong(db, paths);
   const double now = now_s();
   Reclaimed lost;
   {
@@ -633,35 +638,10 @@ ResumeReport resume(Database& db, const CampaignPaths& paths, const ResumeOption
   if (!o.dry_run) remove_lost_files(paths, lost);
 
   if (o.remove_orphans) {
-    // Files of done jobs and of live attempts are kept; anything else gravsweep wrote is orphaned.
-    std::set<std::string> keep;
-    std::vector<std::string> live_prefixes;
-    {
-      Statement st(db, "SELECT output_path FROM jobs WHERE state='done' AND output_path IS NOT NULL");
-      while (st.step()) keep.insert(st.get_text(0));
-    }
-    {
-      Statement st(db, "SELECT job_id, attempt, coalesce(output_path, '') FROM attempts WHERE outcome='running'");
-      while (st.step()) {
-        keep.insert(st.get_text(2));
-        live_prefixes.push_back(fmt::format("{}.a{}.", st.get_text(0), st.get_int(1)));
-      }
-    }
-    std::error_code ec;
-    for (const char* dir : {"beds", "traces", "noop", "tmp"}) {
-      const fs::path d = paths.root / dir;
-      if (!fs::exists(d, ec)) continue;
-      for (const auto& e : fs::directory_iterator(d, ec)) {
-        const std::string rel = (fs::path(paths.root.filename()) / dir / e.path().filename()).string();
-        if (keep.count(rel)) continue;
-        const std::string name = e.path().filename().string();
-        bool live = false;
-        for (const auto& p : live_prefixes) live = live || name.rfind(p, 0) == 0;
-        if (live) continue;
-        rep.orphans.push_back(rel);
-        if (!o.dry_run) fs::remove_all(e.path(), ec);
-      }
-    }
+    auto q = quarantine_orphans(db, paths, o.dry_run);
+    rep.orphans = std::move(q.moved);
+    rep.restored = std::move(q.restored);
+    rep.purged = q.purged;
   }
   return rep;
 }

@@ -22,23 +22,26 @@
 
 namespace gravsweep::queue {
 
-inline constexpr int kSchemaVersion = 1;
+inline constexpr int kSchemaVersion = 2;  ///< 2: stored paths relative to the files root
 
 /// Wall-clock seconds since the Unix epoch.
 double now_s();
 
-/// Creates the queue tables if missing (idempotent); checks the schema version.
+/// Creates the queue tables if missing (idempotent); checks the schema version and migrates a
+/// version-1 campaign. Only `submit` (through open_campaign(create)) and tests call it: other verbs
+/// open with open_campaign (scheduler/queue/campaign.h), which never creates a schema.
 void ensure_schema(db::Database& db);
 
-/// Where a campaign keeps its files: <db dir>/<db stem>.files/{beds,traces,noop,tmp}.
+/// Where a campaign keeps its files: <db dir>/<db stem>.files/{beds,traces,noop,tmp,quarantine}.
 struct CampaignPaths {
-  std::filesystem::path db_dir;  ///< paths in the database are relative to this
-  std::filesystem::path root;
+  std::filesystem::path db_dir;
+  std::filesystem::path root;  ///< paths in the database are relative to this (schema version 2)
   explicit CampaignPaths(const std::filesystem::path& db_path);
   [[nodiscard]] std::filesystem::path tmp() const { return root / "tmp"; }
-  /// Relative path of the output of attempt `attempt` of job `job_id` of `kind`.
+  /// Path, relative to the files root, of the output of attempt `attempt` of job `job_id` of `kind`.
   [[nodiscard]] std::string output_rel(const std::string& kind, const std::string& job_id, int attempt) const;
-  [[nodiscard]] std::filesystem::path abs(const std::string& rel) const { return db_dir / rel; }
+  /// The file of a stored path (version-1 forms `<stem>.files/...` are read as relative to root).
+  [[nodiscard]] std::filesystem::path abs(const std::string& rel) const;
 };
 
 // ---- submit ---------------------------------------------------------------------------------
@@ -122,13 +125,18 @@ bool work_remains(db::Database& db);
 struct ResumeOptions {
   bool retry_dead = false;     ///< also requeue dead jobs with `extra_attempts` more tries
   int extra_attempts = 1;
-  bool remove_orphans = true;  ///< delete campaign files no job or live attempt refers to
+  bool remove_orphans = true;  ///< quarantine campaign files no job or live attempt refers to
   bool dry_run = false;
 };
 struct ResumeReport {
   int expired_requeued = 0, expired_dead = 0, failed_requeued = 0, dead_requeued = 0;
-  std::vector<std::string> orphans;  ///< relative paths found (removed unless dry_run)
+  std::vector<std::string> orphans;   ///< paths (relative to the files root) moved to quarantine (found: dry run)
+  std::vector<std::string> restored;  ///< quarantined, then found referenced, and put back
+  std::size_t purged = 0;             ///< files of earlier quarantines removed
 };
+/// Requeues expired leases and failed jobs (and dead ones if asked), then moves orphaned files to
+/// `<root>/quarantine/` after removing what earlier resumes quarantined (see campaign.h). Refuses
+/// (ConfigError) when most files done jobs refer to are missing.
 ResumeReport resume(db::Database& db, const CampaignPaths& paths, const ResumeOptions& o);
 
 /// Deletes files of lost attempts (ignores missing files).

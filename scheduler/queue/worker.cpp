@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "engine/core/error.h"
+#include "scheduler/queue/campaign.h"
 #include "scheduler/sweep/canonical.h"
 
 namespace gravsweep::queue {
@@ -152,7 +153,7 @@ Runner noop_runner() {
 WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
   WorkerReport rep;
   db::Database db(o.db_path.string());
-  ensure_schema(db);
+  check_campaign(db);  // never creates a schema: `work` opened the campaign with open_campaign
   const CampaignPaths paths(o.db_path);
   const WorkerIdentity who = make_identity(o.code_version, o.threads);
   // Renew at least 4 times per lease, and report progress at least every 2 s.
@@ -261,15 +262,27 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     }
     // Output: fsync, rename to its final name, fsync the directory, checksum, record.
     const fs::path final_path = paths.abs(c->output_rel);
-    fs::create_directories(final_path.parent_path());
-    fsync_path(tmp);
-    fs::rename(tmp, final_path);
-    fsync_path(final_path.parent_path());
-    remove_tmp_of(paths.tmp(), prefix);
     Completion done;
-    done.output_rel = c->output_rel;
-    done.sha256 = sweep::sha256_file(final_path);
-    done.bytes = static_cast<std::int64_t>(fs::file_size(final_path));
+    try {
+      fs::create_directories(final_path.parent_path());
+      fsync_path(tmp);
+      fs::rename(tmp, final_path);
+      fsync_path(final_path.parent_path());
+      remove_tmp_of(paths.tmp(), prefix);
+      done.output_rel = c->output_rel;
+      done.sha256 = sweep::sha256_file(final_path);
+      done.bytes = static_cast<std::int64_t>(fs::file_size(final_path));
+    } catch (const std::exception& e) {
+      // The file vanished or the disk is full: this attempt fails, the worker goes on.
+      remove_tmp_of(paths.tmp(), prefix);
+      fs::remove(final_path, ec);
+      const std::string why = fmt::format("job {}: cannot store its output at '{}': {}", c->job_id,
+                                          final_path.string(), e.what());
+      const std::string state = fail(db, *c, why, 1, false, o.backoff_base_s);
+      ++(state == "dead" ? rep.dead : state == "failed" ? rep.failed : rep.fenced_out);
+      std::fprintf(stderr, "worker %d: %s\n", who.pid, why.c_str());
+      continue;
+    }
     done.metrics = out.metrics;
     done.report = out.report;
     done.report["wall_s"] = secs;

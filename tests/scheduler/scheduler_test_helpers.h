@@ -90,6 +90,17 @@ inline int wait_child(pid_t pid, double timeout_s) {
   }
 }
 
+/// The file of a path stored in campaign `stem` of `dir`: relative to `<stem>.files/` (older
+/// campaigns stored `<stem>.files/...`, relative to the database's folder).
+inline std::filesystem::path campaign_file(const std::filesystem::path& dir, const std::string& stem,
+                                           const std::string& stored) {
+  const std::filesystem::path p(stored);
+  if (p.is_absolute()) return p;
+  const std::string first = p.begin()->string();
+  if (first.size() > 6 && first.compare(first.size() - 6, 6, ".files") == 0) return dir / p;
+  return dir / (stem + ".files") / p;
+}
+
 inline std::int64_t sql_int(db::Database& db, const std::string& sql) {
   db::Statement st(db, sql);
   st.step();

@@ -77,7 +77,7 @@ TEST(CliQueue, WorkersRunEverythingRetryAndReportDeadJobs) {
   // Every result's file exists with its recorded checksum size.
   db::Statement st(db, "SELECT trace_path, trace_bytes FROM results");
   while (st.step())
-    EXPECT_EQ(std::filesystem::file_size(d.path / st.get_text(0)), static_cast<std::uintmax_t>(st.get_int(1)));
+    EXPECT_EQ(std::filesystem::file_size(campaign_file(d.path, "c", st.get_text(0))), static_cast<std::uintmax_t>(st.get_int(1)));
   // A job that always fails goes dead after max_attempts; work exits 4.
   write_text(d.path / "dead.json", noop_spec({7.0}, 0.0, 99, 2));
   ASSERT_EQ(run_cli({"submit", "dead.json", "--db", "c.db"}, d.path).code, 0);
@@ -216,7 +216,7 @@ TEST(CliQueue, ResumeAfterEveryWorkerWasKilled) {
   // A file the dead worker left behind, as if it died between its rename and its commit.
   const std::string planned = sql_text(db, "SELECT output_path FROM attempts WHERE outcome='running'");
   ASSERT_FALSE(planned.empty());
-  write_text(d.path / planned, "half");
+  write_text(campaign_file(d.path, "c", planned), "half");
   auto r = run_cli({"status", "--db", "c.db"}, d.path);
   EXPECT_NE(r.out.find("running jobs (1 active, 0 stale leases)"), std::string::npos) << r.out;
   std::this_thread::sleep_for(std::chrono::milliseconds(1200));
@@ -226,7 +226,7 @@ TEST(CliQueue, ResumeAfterEveryWorkerWasKilled) {
   r = run_cli({"resume", "--db", "c.db"}, d.path);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("expired leases: 1 requeued"), std::string::npos) << r.out;
-  EXPECT_FALSE(std::filesystem::exists(d.path / planned)) << "the lost attempt's file must go";
+  EXPECT_FALSE(std::filesystem::exists(campaign_file(d.path, "c", planned))) << "the lost attempt's file must go";
   EXPECT_EQ(sql_text(db, "SELECT outcome FROM attempts WHERE output_path='" + planned + "'"), "lost");
   r = run_cli({"work", "--db", "c.db", "--quiet"}, d.path);
   EXPECT_EQ(r.code, 0) << r.err;

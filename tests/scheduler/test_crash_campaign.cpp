@@ -88,7 +88,7 @@ void crash_campaign(const json& doc, std::int64_t total, std::int64_t with_resul
   {
     db::Statement st(db, "SELECT output_path, output_sha256, output_bytes FROM jobs");
     while (st.step()) {
-      const fs::path p = d.path / st.get_text(0);
+      const fs::path p = campaign_file(d.path, "c", st.get_text(0));
       referenced.insert(fs::weakly_canonical(p).string());
       ASSERT_TRUE(fs::exists(p)) << "missing output " << p;
       EXPECT_EQ(fs::file_size(p), static_cast<std::uintmax_t>(st.get_int(2)));

@@ -1,0 +1,73 @@
+// Opening a campaign safely, and the campaign's files: stored paths, orphans and quarantine.
+//
+// A campaign is `<stem>.db` plus `<stem>.files/`. Paths stored in the database (jobs.output_path,
+// attempts.output_path, results.trace_path) are relative to `<stem>.files/` (schema version 2), so
+// a renamed copy (`c2.db` + `c2.files/`) finds its own files. Version-1 rows (`<stem>.files/...`,
+// relative to the database's folder, or absolute) are read the same way and rewritten by the first
+// verb that writes.
+#pragma once
+#include <filesystem>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "scheduler/db/sqlite.h"
+
+namespace gravsweep::queue {
+
+struct CampaignPaths;
+
+/// What a verb does with the campaign it opens.
+enum class OpenMode {
+  read,    ///< status, results: nothing is written
+  write,   ///< work, resume: an existing campaign, migrated to the current schema if needed
+  create,  ///< submit: a missing or new database gets the schema
+};
+
+/// Opens the campaign database at `db_path`, refusing (ConfigError, exit 2, naming the file) a
+/// file that is not a campaign: missing (except for `create`), empty, not SQLite, or without the
+/// queue tables. `create` also refuses a missing or empty database beside a files folder that
+/// holds files (the database was lost or truncated: a new schema would orphan every output).
+db::Database open_campaign(const std::filesystem::path& db_path, OpenMode mode);
+
+/// Throws ConfigError unless `db` holds the queue tables with a known schema version.
+void check_campaign(db::Database& db);
+
+/// The canonical form of a stored path: relative to the files root. Version-1 forms
+/// (`<any stem>.files/beds/x.h5`, relative or absolute) lose everything up to `.files/`.
+std::string files_rel(const std::string& stored);
+
+/// Rewrites version-1 paths to `files_rel` form and sets schema version 2 (in one transaction).
+void migrate_paths(db::Database& db);
+
+/// Regular files under `dir`, recursively (0 when it does not exist).
+std::size_t count_files(const std::filesystem::path& dir);
+
+// ---- orphans ------------------------------------------------------------------------------------
+
+/// What the database refers to, read in one read transaction.
+struct Referenced {
+  std::set<std::string> done;                ///< files_rel of done jobs' outputs
+  std::set<std::string> live;                ///< files_rel of running attempts' planned outputs
+  std::vector<std::string> live_prefixes;    ///< "<job>.a<k>." of running attempts (tmp files)
+  double taken_at_s = 0;                     ///< wall clock just before the snapshot began
+  [[nodiscard]] bool refers_to(const std::string& rel) const;
+};
+Referenced referenced_files(db::Database& db);
+
+/// Throws ConfigError when most files that done jobs refer to are missing: the database and the
+/// folder beside it do not belong together, and removing "orphans" would destroy the wrong data.
+void check_files_belong(db::Database& db, const CampaignPaths& paths);
+
+struct OrphanReport {
+  std::vector<std::string> moved;      ///< files_rel of files moved to quarantine (or found: dry run)
+  std::vector<std::string> restored;   ///< moved, then found referenced, and put back
+  std::size_t purged = 0;              ///< quarantined files (of earlier resumes) removed
+};
+
+/// Moves files no done job and no live attempt refers to, and older than the snapshot by
+/// `min_age_s`, to `<root>/quarantine/<stamp>/`; files quarantined by an earlier call are removed
+/// first (unless the database refers to them again: then they go back). Nothing moves in a dry run.
+OrphanReport quarantine_orphans(db::Database& db, const CampaignPaths& paths, bool dry_run, double min_age_s = 5.0);
+
+}  // namespace gravsweep::queue
