@@ -79,7 +79,11 @@ int main(int argc, char** argv) {
     return cli::kExitNumerical;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
-    return cli::kExitFailure;
+    // A runtime failure (disk full, say) may leave HDF5 objects of the failed job open; HDF5's own
+    // atexit clean-up then crashes (SIGSEGV in H5_term_library). Everything finished is already
+    // committed and fsynced: leave without running exit handlers.
+    std::fflush(nullptr);
+    _exit(cli::kExitFailure);
   }
   return cli::kExitOk;
 }

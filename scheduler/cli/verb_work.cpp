@@ -1,5 +1,6 @@
 // `gravsweep work`: worker processes that claim and run jobs until none is left.
 #include <fmt/format.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -61,11 +62,19 @@ int supervise(const WorkOptions& o, int threads) {
   sigaddset(&set, SIGTERM);
   sigprocmask(SIG_BLOCK, &set, &old);
   const std::string exe = queue::self_exe();
+  const pid_t supervisor = getpid();
+  const std::string supervisor_env = std::to_string(supervisor);
   std::vector<pid_t> kids;
   for (int i = 0; i < o.workers; ++i) {
     pid_t pid = fork();
     if (pid < 0) throw std::runtime_error("fork failed");
     if (pid == 0) {
+      // Workers die with their supervisor: SIGTERM when it dies (any way, SIGKILL included; kept
+      // across exec), and the worker checks its parent too (queue::run_worker) in case it died
+      // before the prctl.
+      prctl(PR_SET_PDEATHSIG, SIGTERM);
+      if (getppid() != supervisor) _exit(kExitInterrupted);
+      setenv("GRAVSWEEP_SUPERVISOR_PID", supervisor_env.c_str(), 1);
       sigprocmask(SIG_SETMASK, &old, nullptr);
       std::vector<char*> argv{const_cast<char*>(exe.c_str())};
       for (auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
@@ -174,7 +183,7 @@ void setup_work(CLI::App& app) {
     // after every database handle has been closed by run_work's scopes.
     if (code != kExitOk) {
       std::fflush(nullptr);
-      std::exit(code);
+      _exit(code);  // no exit handlers: see main.cpp (HDF5 clean-up after a failed job)
     }
   });
 }

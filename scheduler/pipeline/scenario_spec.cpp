@@ -1,6 +1,10 @@
 #include "scheduler/pipeline/scenario_spec.h"
 
+#include "scheduler/sweep/json_text.h"
+
 #include <fmt/format.h>
+
+#include <unistd.h>
 
 #include <cmath>
 #include <fstream>
@@ -121,6 +125,39 @@ void engine_checks(const json& s, const SystemConfig& cfg, const std::string& dt
   }
 }
 
+/// Machine memory in bytes (physical pages; 0 when unknown).
+double machine_memory_bytes() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  return pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page) : 0.0;
+}
+
+/// Refuses a bed that cannot fit this machine's memory, and time steps too small to finish, before
+/// any work (issue #10 item 10). Grains: random close packing (0.64) of the fill, twice over for
+/// the lattice poured above the fill height; ~2 kB per grain (state, Verlet pairs with contact
+/// history, per-thread force buffers).
+void check_size_and_steps(const json& s, const std::string& source) {
+  constexpr double kMinDt_s = 1e-9, kBytesPerGrain = 2048, kMaxSteps = 1e10;
+  auto num = [&](const char* p) { return s[json::json_pointer(p)].get<double>(); };
+  for (const char* p : {"/dt_s", "/bed/dt_s"})
+    if (!(num(p) >= kMinDt_s))
+      throw SpecError(source, p, fmt::format("{:g}", num(p)),
+                      fmt::format("a time step of at least {:g} s (smaller steps never finish)", kMinDt_s));
+  const double d = num("/grains/diameter_m"), Dc = num("/container/diameter_m"), H = num("/container/fill_height_m");
+  const double grains = 2 * 0.64 * (0.25 * M_PI * Dc * Dc * H) / (M_PI / 6 * d * d * d);
+  const double need = grains * kBytesPerGrain, have = machine_memory_bytes();
+  if (have > 0 && need > 0.8 * have)
+    throw SpecError(source, "/container/fill_height_m",
+                    fmt::format("{:g} m of {:g} m grains in a {:g} m container: about {:.3g} grains, {:.3g} GB", H, d,
+                                Dc, grains, need / 1e9),
+                    fmt::format("a bed that fits this machine's memory ({:.3g} GB; at most about {:.3g} grains)",
+                                have / 1e9, 0.8 * have / kBytesPerGrain));
+  const double steps = num("/stop/max_time_s") / num("/dt_s");
+  if (steps > kMaxSteps)
+    throw SpecError(source, "/dt_s", fmt::format("{:g}", num("/dt_s")),
+                    fmt::format("a time step giving at most {:g} steps over stop.max_time_s ({:g} s)", kMaxSteps,
+                                num("/stop/max_time_s")));
+}
+
 }  // namespace
 
 const std::string& scenario_schema_text() {
@@ -184,6 +221,7 @@ json validate_scenario(const json& scenario, const std::string& source) {
                       (v * v / (2 * g) - gap) / d, v));
   }
   const double dt = num("/dt_s");
+  check_size_and_steps(s, source);
   if (!(num("/output/sample_rate_hz") * dt <= 1.0))
     bad("/output/sample_rate_hz", fmt::format("at most 1/dt_s = {:g} Hz", 1.0 / dt));
   if (!(num("/output/filter_cutoff_hz") < 0.5 * num("/output/sample_rate_hz")))
@@ -198,22 +236,12 @@ json validate_scenario(const json& scenario, const std::string& source) {
 }
 
 json load_scenario(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(fmt::format("{}: cannot open the scenario file", path.string()));
-  std::stringstream ss;
-  ss << in.rdbuf();
+  std::string why;
+  const auto text = sweep::read_text_file(path, why);
+  if (!text) throw ConfigError(fmt::format("{}: cannot read the scenario file ({})", path.string(), why));
   json j;
-  try {
-    j = json::parse(ss.str());
-  } catch (const json::parse_error& e) {
-    // nlohmann reports the byte offset; translate it to line and column.
-    const std::string text = ss.str();
-    std::size_t line = 1, col = 1;
-    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
-      if (text[i] == '\n') { ++line; col = 1; } else { ++col; }
-    }
-    throw ConfigError(fmt::format("{}:{}:{}: not valid JSON: {}", path.string(), line, col, e.what()));
-  }
+  if (const auto err = sweep::parse_json_text(*text, j))
+    throw ConfigError(fmt::format("{}:{}:{}: not valid JSON: {}", path.string(), err->line, err->column, err->what));
   return validate_scenario(j, path.string());
 }
 

@@ -416,10 +416,14 @@ std::optional<Claim> claim(Database& db, const WorkerIdentity& who, const Campai
   }
   {
     Statement st(db,
-                 "SELECT coalesce(j.output_path, '') FROM job_deps d JOIN jobs j ON j.job_id=d.dep_id "
-                 "WHERE d.job_id=? AND j.kind='bed' AND j.state='done'");
+                 "SELECT coalesce(j.output_path, ''), j.job_id, coalesce(j.output_sha256, '') FROM job_deps d "
+                 "JOIN jobs j ON j.job_id=d.dep_id WHERE d.job_id=? AND j.kind='bed' AND j.state='done'");
     st.bind(1, c->job_id);
-    if (st.step()) c->dep_output_rel = st.get_text(0);
+    if (st.step()) {
+      c->dep_output_rel = st.get_text(0);
+      c->dep_job_id = st.get_text(1);
+      c->dep_sha256 = st.get_text(2);
+    }
   }
   c->output_rel = paths.output_rel(c->kind, c->job_id, c->attempt);
   {
@@ -558,6 +562,43 @@ std::string fail(Database& db, const Claim& c, const std::string& error, int exi
   if (state == "dead") cascade_dead(db, c.job_id, now);
   tx.commit();
   return state;
+}
+
+bool bed_mismatch(Database& db, const Claim& c, const std::string& reason) {
+  const double now = now_s();
+  Transaction tx(db);
+  {
+    Statement st(db,
+                 "UPDATE jobs SET state='waiting', deps_pending=1, last_error=?1, lease_owner=NULL, "
+                 "lease_expires=NULL, phase=NULL, detail=NULL, progress=NULL, attempts=max(attempts-1, 0) "
+                 "WHERE job_id=?2 AND lease_token=?3 AND state='running'");
+    st.bind(1, reason).bind(2, c.job_id).bind(3, c.token);
+    st.run();
+    if (db.changes() != 1) return false;
+  }
+  {
+    Statement st(db, "UPDATE attempts SET outcome='failed', ended_at=?1, runtime_s=?1-started_at, exit_code=1, "
+                     "error=?2 WHERE attempt_id=?3");
+    st.bind(1, now).bind(2, reason).bind(3, c.attempt_row);
+    st.run();
+  }
+  {  // the bed is rebuilt once, by whichever drop noticed first
+    Statement st(db,
+                 "UPDATE jobs SET state='queued', output_path=NULL, output_sha256=NULL, output_bytes=NULL, "
+                 "finished_at=NULL, last_error=?1, not_before=0, max_attempts=max(max_attempts, attempts+1) "
+                 "WHERE job_id=?2 AND state='done' AND output_sha256=?3");
+    st.bind(1, reason).bind(2, c.dep_job_id).bind(3, c.dep_sha256);
+    st.run();
+  }
+  {  // its other drops that have not started wait for the new bed
+    Statement st(db,
+                 "UPDATE jobs SET state='waiting', deps_pending=deps_pending+1 WHERE state IN ('queued','failed') "
+                 "AND job_id IN (SELECT job_id FROM job_deps WHERE dep_id=?)");
+    st.bind(1, c.dep_job_id);
+    st.run();
+  }
+  tx.commit();
+  return true;
 }
 
 bool release(Database& db, const Claim& c, const std::string& why) {
@@ -747,6 +788,12 @@ Status status(Database& db, std::size_t max_running) {
                  "SELECT job_id, coalesce(last_error,'') FROM jobs WHERE state='dead' AND "
                  "(last_error IS NULL OR last_error NOT LIKE 'dependency % is dead') ORDER BY finished_at DESC LIMIT 5");
     while (st.step()) s.recent_errors.emplace_back(st.get_text(0), st.get_text(1));
+  }
+  {
+    Statement st(db,
+                 "SELECT DISTINCT job_id, error FROM attempts WHERE kind='drop' AND error LIKE 'bed checksum "
+                 "mismatch%' ORDER BY ended_at DESC LIMIT 20");
+    while (st.step()) s.beds_rebuilt.emplace_back(st.get_text(0), st.get_text(1));
   }
   return s;
 }

@@ -77,6 +77,8 @@ struct Claim {
   std::int64_t attempt_row = 0;    ///< attempts.attempt_id
   std::string output_rel;          ///< where this attempt's output must end up
   std::string dep_output_rel;      ///< the bed file (drop jobs)
+  std::string dep_job_id;          ///< the bed job (drop jobs)
+  std::string dep_sha256;          ///< the bed file's recorded checksum (verified before use)
   double claimed_at = 0;
 };
 
@@ -114,6 +116,11 @@ bool complete(db::Database& db, const Claim& c, const Completion& done);
 /// or "" when fenced out.
 std::string fail(db::Database& db, const Claim& c, const std::string& error, int exit_code, bool permanent,
                  double backoff_base_s = 2.0, double backoff_cap_s = 300.0);
+
+/// The bed a drop was about to use does not match its recorded checksum: the drop's attempt fails
+/// with `reason`, the drop waits again, and the bed job (if still done with that checksum) is
+/// queued to be rebuilt, its other unstarted drops waiting for it. false = fenced out.
+bool bed_mismatch(db::Database& db, const Claim& c, const std::string& reason);
 
 /// Gives the job back (interrupted worker): queued again, the attempt not counted. false = fenced out.
 bool release(db::Database& db, const Claim& c, const std::string& why);
@@ -169,6 +176,7 @@ struct Status {
   std::int64_t active_workers = 0;
   double eta_s = -1;              ///< < 0: unknown (no finished job of some remaining kind)
   std::vector<std::pair<std::string, std::string>> recent_errors;  ///< (job_id, error) of dead jobs
+  std::vector<std::pair<std::string, std::string>> beds_rebuilt;   ///< (bed job_id, why) after a checksum mismatch
 };
 Status status(db::Database& db, std::size_t max_running = 20);
 

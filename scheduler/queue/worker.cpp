@@ -9,6 +9,7 @@
 #include <condition_variable>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <mutex>
@@ -26,6 +27,15 @@ using nlohmann::json;
 namespace {
 
 std::atomic<bool> g_stop{false};
+
+/// True when this worker was started by a `work --workers N` supervisor that is gone.
+bool supervisor_gone() {
+  static const long supervisor = [] {
+    const char* s = std::getenv("GRAVSWEEP_SUPERVISOR_PID");
+    return s ? std::atol(s) : 0L;
+  }();
+  return supervisor > 0 && static_cast<long>(getppid()) != supervisor;
+}
 
 extern "C" void on_stop_signal(int) { g_stop.store(true); }
 
@@ -52,6 +62,7 @@ void heartbeat_loop(const WorkerOptions& o, const Claim& c, JobSignals& sig, dou
   auto next = std::chrono::steady_clock::now();  // first beat at once: the job has started
   std::unique_lock lock(sig.m);
   while (!sig.finished) {
+    if (supervisor_gone()) g_stop.store(true);
     if (g_stop.load()) sig.stop.store(true);
     if (std::chrono::steady_clock::now() >= next) {
       const std::string phase = sig.phase, detail = sig.detail;
@@ -163,6 +174,11 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
   std::unique_ptr<db::Database> beat_db;  // the heartbeat thread's own connection, kept across jobs
   long ran = 0;
   while (!g_stop.load() && (o.max_jobs < 0 || ran < o.max_jobs)) {
+    if (supervisor_gone()) {
+      std::fprintf(stderr, "worker %d: its supervisor is gone; stopping\n", who.pid);
+      g_stop.store(true);
+      break;
+    }
     Reclaimed lost;
     std::optional<Claim> c;
     try {
@@ -206,6 +222,21 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     const auto t0 = std::chrono::steady_clock::now();
     if (o.verbose)
       std::fprintf(stderr, "worker %d: %s job %s attempt %d\n", who.pid, c->kind.c_str(), c->job_id.c_str(), c->attempt);
+    if (!c->dep_output_rel.empty() && !c->dep_sha256.empty()) {
+      // The bed is verified before the drop uses it: a changed bit changes every drop's results.
+      const fs::path bed = paths.abs(c->dep_output_rel);
+      const std::string found = fs::exists(bed, ec) ? sweep::sha256_file(bed) : std::string("missing");
+      if (found != c->dep_sha256) {
+        stop_beat();
+        const std::string why = fmt::format("bed checksum mismatch: '{}' of bed job {} has sha256 {}, recorded {}; the "
+                                            "bed is rebuilt and the drop waits for it",
+                                            bed.string(), c->dep_job_id, found, c->dep_sha256);
+        std::fprintf(stderr, "worker %d: job %s: %s\n", who.pid, c->job_id.c_str(), why.c_str());
+        if (bed_mismatch(db, *c, why)) ++rep.failed;
+        else ++rep.fenced_out;
+        continue;
+      }
+    }
     try {
       if (runner == runners.end())
         throw ConfigError(fmt::format("job {}: no runner for kind '{}' in this build", c->job_id, c->kind));

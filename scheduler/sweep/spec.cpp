@@ -1,5 +1,7 @@
 #include "scheduler/sweep/spec.h"
 
+#include "scheduler/sweep/json_text.h"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -9,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "scheduler/pipeline/json_schema.h"
 #include "scheduler/sweep/canonical.h"
 
 namespace gravsweep::sweep {
@@ -76,6 +79,20 @@ struct Checker {
     }
   }
 };
+
+/// Problems of a no-op job's scenario: (pointer, found, expected). sleep_s and fail_attempts are
+/// what the no-op runner reads; anything else is carried along (an axis may sweep any field).
+std::vector<SpecProblem> noop_problems(const json& s, const std::string& ptr) {
+  std::vector<SpecProblem> out;
+  if (!s.is_object()) return {{ptr, show(s), "an object (the no-op job's scenario)"}};
+  if (s.contains("sleep_s") && (!s["sleep_s"].is_number() || !(s["sleep_s"].get<double>() >= 0) ||
+                                s["sleep_s"].get<double>() > 86400))
+    out.push_back({join(ptr, "sleep_s"), show(s["sleep_s"]), "a number of seconds between 0 and 86400"});
+  if (s.contains("fail_attempts") && (!is_int(s["fail_attempts"]) || s["fail_attempts"].get<double>() < 0 ||
+                                      s["fail_attempts"].get<double>() > 100))
+    out.push_back({join(ptr, "fail_attempts"), show(s["fail_attempts"]), "an integer between 0 and 100"});
+  return out;
+}
 
 std::string pointer_kind(const json& v) {
   if (v.is_number()) return "number";
@@ -219,6 +236,17 @@ std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json
       ck.add(join(ptr, "step"), &a["step"], "a number");
       return std::nullopt;
     }
+    // Repeats number seeds: an integer base value needs integer start and step (reported there).
+    if (base_value && base_value->is_number_integer()) {
+      bool iok = true;
+      for (const char* k : {"start", "step"})
+        if (a.contains(k) && !is_int(a[k])) {
+          ck.add(join(ptr, k), &a[k], fmt::format("an integer like the base value at {} ({})", axis.pointer,
+                                                  base_value->dump()));
+          iok = false;
+        }
+      if (!iok) return std::nullopt;
+    }
     const bool ints = is_int(start) && is_int(step);
     for (long i = 0; i < static_cast<long>(c.get<double>()); ++i) {
       if (ints)
@@ -239,10 +267,7 @@ std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json
         ck.add(vp, &v, fmt::format("a {} like the base value at {} ({})", pointer_kind(*base_value), axis.pointer,
                                    base_value->dump()));
         ok = false;
-      } else if (base_value->is_number_integer() && !is_int(v)) {
-        ck.add(vp, &v, fmt::format("an integer like the base value at {} ({})", axis.pointer, base_value->dump()));
-        ok = false;
-      } else {
+      } else {  // numbers are numbers: 10 in the base and 9.81 on an axis are both numbers
         axis.values[i] = canonicalize(v);
       }
     }
@@ -351,20 +376,16 @@ SweepSpec parse_spec(const json& doc, const std::string& file, const std::filesy
     ck.add("/base", nullptr, "the base scenario: an object, or a file name relative to the spec");
   } else if (doc["base"].is_string()) {
     const std::filesystem::path p = base_dir / doc["base"].get<std::string>();
-    std::ifstream in(p);
-    if (!in) {
-      ck.add("/base", &doc["base"], fmt::format("a readable scenario file (cannot open '{}')", p.string()));
+    std::string why;
+    const auto text = read_text_file(p, why);
+    if (!text) {
+      ck.add("/base", &doc["base"], fmt::format("a readable scenario file ('{}' is {})", p.string(), why));
+    } else if (const auto err = parse_json_text(*text, base)) {
+      ck.add("/base", &doc["base"], fmt::format("a JSON scenario file ('{}': {} at {})", p.string(), err->what, err->where()));
+    } else if (!base.is_object()) {
+      ck.add("/base", &doc["base"], fmt::format("a file holding a JSON object ('{}' holds {})", p.string(), type_name(base)));
     } else {
-      try {
-        base = json::parse(in);
-        have_base = true;
-        if (!base.is_object()) {
-          ck.add("/base", &doc["base"], fmt::format("a file holding a JSON object ('{}' holds {})", p.string(), type_name(base)));
-          have_base = false;
-        }
-      } catch (const json::parse_error& e) {
-        ck.add("/base", &doc["base"], fmt::format("a JSON scenario file ('{}': {})", p.string(), e.what()));
-      }
+      have_base = true;
     }
   } else if (doc["base"].is_object()) {
     base = doc["base"];
@@ -379,6 +400,9 @@ SweepSpec parse_spec(const json& doc, const std::string& file, const std::filesy
       ck.add_text("/base", e.what(), "finite numbers only");
     }
   }
+
+  if (have_base && spec.job_kind == "noop")
+    for (auto& p : noop_problems(spec.base, "/base")) ck.problems.push_back(std::move(p));
 
   std::set<std::string> names, pointers;
   auto add_group = [&](AxisGroup g, const std::string& ptr) {
@@ -442,28 +466,12 @@ SweepSpec parse_spec(const json& doc, const std::string& file, const std::filesy
 }
 
 SweepSpec load_spec(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw SpecError(path.string(), {{"", "no readable file", "a JSON sweep spec file"}});
-  std::stringstream ss;
-  ss << in.rdbuf();
+  std::string why;
+  const auto text = read_text_file(path, why);
+  if (!text) throw SpecError(path.string(), {{"", why, "a JSON sweep spec file"}});
   json doc;
-  try {
-    doc = json::parse(ss.str());
-  } catch (const json::parse_error& e) {
-    // Byte offset -> line:column.
-    std::size_t line = 1, col = 1;
-    const std::string text = ss.str();
-    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
-      if (text[i] == '\n') {
-        ++line;
-        col = 1;
-      } else {
-        ++col;
-      }
-    }
-    throw SpecError(path.string(), {{"", fmt::format("a JSON syntax error at line {}, column {}", line, col),
-                                     fmt::format("valid JSON ({})", e.what())}});
-  }
+  if (const auto err = parse_json_text(*text, doc))
+    throw SpecError(path.string(), {{"", fmt::format("{} at {}", err->what, err->where()), "valid JSON"}});
   return parse_spec(doc, path.string(), path.parent_path());
 }
 
@@ -474,6 +482,21 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
   std::vector<std::size_t> idx(spec.groups.size(), 0);
   std::vector<SpecProblem> problems;
   std::vector<std::size_t> repeats;
+  if (spec.job_kind != "noop" && bed_key) {
+    // A problem of the base itself is reported once, at its pointer under /base.
+    try {
+      (void)bed_key(spec.base);
+    } catch (const pipeline::SpecError& e) {
+      bool swept = false;  // a base value an axis replaces is checked at each point instead
+      for (const auto& g : spec.groups)
+        for (const auto& ax : g.axes) swept = swept || e.pointer().rfind(ax.pointer, 0) == 0;
+      if (!swept)
+        throw SpecError(spec.file.empty() ? spec.name : spec.file,
+                      {{"/base" + e.pointer(), e.found(), e.expected()}});
+    } catch (const std::exception&) {
+      // Not checkable alone (e.g. a field every axis sets): the points report it.
+    }
+  }
   drops.reserve(n);
   for (std::size_t p = 0; p < n; ++p) {
     // Mixed-radix digits of p, last group fastest.
@@ -493,6 +516,11 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
     }
     job.priority = spec.priority;
     if (spec.job_kind == "noop") {
+      for (const auto& np : noop_problems(job.scenario, "/base")) {
+        if (problems.size() >= 20) break;
+        problems.push_back({np.pointer, np.found + " at point " + job.params.dump(), np.expected});
+        repeats.push_back(0);
+      }
       job.kind = "noop";
       job.job_id = job_id("noop", job.scenario);
       drops.push_back(std::move(job));

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -135,4 +136,69 @@ TEST(CrashCampaign, NoopJobsSurviveSigkillToo) {
               {"base", {{"g", 1.5}, {"sleep_s", 0.5}}},
               {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 0.1}, {"stop", 3.0}, {"step", 0.1}}}}}}};
   EXPECT_NO_FATAL_FAILURE(crash_campaign(doc, 30, 30, {"gravity_m_s2", "noop_value"}, 3, 3));
+}
+
+namespace {
+
+/// True while `pid` exists and is not a zombie.
+bool process_alive(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (!std::getline(stat, line)) return false;
+  const auto close = line.rfind(')');
+  return close != std::string::npos && close + 2 < line.size() && line[close + 2] != 'Z';
+}
+
+}  // namespace
+
+TEST(CrashCampaign, SigkilledSupervisorTakesItsWorkersDownAndLosesNothing) {
+  // 3 SIGKILLs of `work --workers 3` mid-campaign: its workers must exit (they would otherwise
+  // pile up beside the restarted supervisor's), and the campaign still ends with every job done once.
+  TempDir d;
+  json doc = {{"sweep", "sup"},
+              {"job", "noop"},
+              {"max_attempts", 6},
+              {"base", {{"g", 1.0}, {"sleep_s", 0.3}}},
+              {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 0.1}, {"stop", 4.0}, {"step", 0.1}}}}}}};
+  write_text(d.path / "spec.json", doc.dump());
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
+  const std::string db_path = (d.path / "c.db").string();
+  const std::vector<std::string> args = {"work", "--db", db_path, "--workers", "3", "--threads", "1", "--lease", "2",
+                                         "--heartbeat", "0.3", "--poll", "0.1", "--backoff", "0.1", "--quiet"};
+  db::Database db(db_path);
+  int orphans_left = 0;
+  for (int kill_no = 0; kill_no < 3; ++kill_no) {
+    const pid_t sup = start_cli(args, d.path / "work.log");
+    const auto t0 = std::chrono::steady_clock::now();
+    while (sql_int(db, "SELECT count(DISTINCT pid) FROM attempts WHERE outcome='running'") < 3 &&
+           std::chrono::steady_clock::now() - t0 < std::chrono::seconds(20))
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    std::vector<pid_t> workers;
+    {
+      db::Statement st(db, "SELECT DISTINCT pid FROM attempts WHERE outcome='running'");
+      while (st.step()) workers.push_back(static_cast<pid_t>(st.get_int(0)));
+    }
+    ASSERT_FALSE(workers.empty());
+    kill(sup, SIGKILL);
+    EXPECT_EQ(wait_child(sup, 10), 128 + SIGKILL);
+    const auto t1 = std::chrono::steady_clock::now();
+    auto alive = [&] { return std::count_if(workers.begin(), workers.end(), process_alive); };
+    while (alive() > 0 && std::chrono::steady_clock::now() - t1 < std::chrono::seconds(5))
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    orphans_left += static_cast<int>(alive());
+    for (pid_t w : workers)
+      if (process_alive(w)) kill(w, SIGKILL);  // do not leave them behind the test
+  }
+  std::printf("supervisor SIGKILLed 3 times: %d worker(s) outlived it by 5 s\n", orphans_left);
+  EXPECT_EQ(orphans_left, 0) << "workers outlived their supervisor";
+  const auto r = run_cli({"work", "--db", "c.db", "--workers", "2", "--quiet", "--lease", "2", "--poll", "0.1"}, d.path);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), 40);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='done'"), 40);
+  db::Statement st(db, "SELECT output_path, output_sha256 FROM jobs");
+  while (st.step()) {
+    const fs::path p = campaign_file(d.path, "c", st.get_text(0));
+    ASSERT_TRUE(fs::exists(p)) << p;
+    EXPECT_EQ(sweep::sha256_file(p), st.get_text(1));
+  }
 }

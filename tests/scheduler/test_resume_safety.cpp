@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "scheduler/db/sqlite.h"
+#include "scheduler/queue/impact.h"
 #include "scheduler/sweep/canonical.h"
 #include "scheduler_test_helpers.h"
 
@@ -234,4 +235,40 @@ TEST(ResumeSafety, VersionOneCampaignIsMigratedAndItsRenamedCopyKeepsItsFiles) {
   EXPECT_EQ(sql_int(c2, "SELECT count(*) FROM results WHERE trace_path LIKE 'noop/%'"), 4);
   EXPECT_EQ(lost_outputs(c2, d.path, "c2"), 0);
   EXPECT_EQ(files_under(d.path / "c2.files" / "noop"), 4u);
+}
+
+TEST(BedChecksum, AFlippedBitInAFinishedBedFailsTheDropAndRebuildsTheBed) {
+  if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
+  TempDir d;
+  json doc = {{"sweep", "flip"},
+              {"base", json::parse(tiny_base())},
+              {"axes", {{{"name", "impact_speed_m_s"}, {"pointer", "/projectile/impact_speed_m_s"}, {"values", {0.4, 0.6}}}}}};
+  write_text(d.path / "spec.json", doc.dump());
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
+  auto r = run_cli({"work", "--db", "c.db", "--max-jobs", "1", "--quiet"}, d.path);  // the bed (priority)
+  ASSERT_EQ(r.code, 0) << r.err;
+  db::Database db((d.path / "c.db").string());
+  ASSERT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE kind='bed' AND state='done'"), 1);
+  const fs::path bed = campaign_file(d.path, "c", sql_text(db, "SELECT output_path FROM jobs WHERE kind='bed'"));
+  {  // one bit, in the middle of the file
+    std::fstream f(bed, std::ios::in | std::ios::out | std::ios::binary);
+    const auto mid = static_cast<std::streamoff>(fs::file_size(bed) / 2);
+    f.seekg(mid);
+    char b = 0;
+    f.get(b);
+    f.seekp(mid);
+    f.put(static_cast<char>(b ^ 0x10));
+  }
+  r = run_cli({"work", "--db", "c.db", "--quiet"}, d.path);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE kind='drop' AND error LIKE 'bed checksum mismatch%'"), 1);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE kind='bed' AND outcome='done'"), 2) << "rebuilt once";
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), 3);
+  // Every drop used the rebuilt bed, whose file matches its new checksum.
+  const fs::path rebuilt = campaign_file(d.path, "c", sql_text(db, "SELECT output_path FROM jobs WHERE kind='bed'"));
+  EXPECT_NE(rebuilt, bed);
+  EXPECT_EQ(sweep::sha256_file(rebuilt), sql_text(db, "SELECT output_sha256 FROM jobs WHERE kind='bed'"));
+  r = run_cli({"status", "--db", "c.db"}, d.path);
+  EXPECT_NE(r.out.find("beds rebuilt after a checksum mismatch"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("bed checksum mismatch"), std::string::npos) << r.out;
 }

@@ -1,0 +1,163 @@
+// The bad-input corpus of sweep specs (issue #10): each case is refused by `gravsweep submit`
+// with exit code 2, a message naming the file and the JSON pointer (or line) of the problem, and
+// nothing written (no database, no files folder). Plus the cases that must be accepted.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "scheduler/queue/impact.h"
+#include "scheduler_test_helpers.h"
+
+using namespace gravsweep;
+using namespace gravsweep::test;
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+json noop_doc() {
+  return {{"sweep", "bad"},
+          {"job", "noop"},
+          {"base", {{"g", 1.0}, {"sleep_s", 0.0}}},
+          {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {1.0, 2.0}}}}}};
+}
+
+json impact_doc() {
+  return {{"sweep", "bad"},
+          {"base", json::parse(tiny_base())},
+          {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/gravity_m_s2"}, {"values", {9.81, 3.71}}}}}};
+}
+
+struct Case {
+  std::string name;
+  std::string text;      ///< the spec file's content
+  std::string where;     ///< the pointer or line the message must name
+  std::string also;      ///< another piece the message must hold ("" = none)
+  bool impact = false;   ///< needs the impact pipeline
+};
+
+std::string with(json doc, const std::string& pointer, const json& value) {
+  doc[json::json_pointer(pointer)] = value;
+  return doc.dump(1);
+}
+
+std::string without(json doc, const std::string& pointer) {
+  const json::json_pointer jp(pointer);
+  doc[jp.parent_pointer()].erase(jp.back());
+  return doc.dump(1);
+}
+
+std::vector<Case> corpus() {
+  std::vector<Case> c;
+  const json n = noop_doc(), im = impact_doc();
+  c.push_back({"syntax error", "{\n  \"sweep\": \"x\",\n  \"base\": {\n}", "line 4", "JSON"});
+  c.push_back({"number out of range", "{\"sweep\": \"x\", \"job\": \"noop\",\n \"base\": {\"g\": 1e999}}", "line 2",
+               "1e999"});
+  c.push_back({"nested 100000 deep", "{\"sweep\": \"x\", \"base\": " + std::string(100000, '[') +
+                                          std::string(100000, ']') + "}",
+               "line 1, column", "deeper than 64"});
+  c.push_back({"not an object", "[1, 2]", "(array)", "an object"});
+  c.push_back({"base is a folder", with(n, "/base", "/tmp"), "/base", "a folder"});
+  c.push_back({"base file missing", with(n, "/base", "no_such_scenario.json"), "/base", "no readable file"});
+  c.push_back({"sweep missing", without(n, "/sweep"), "/sweep", "missing"});
+  c.push_back({"sweep name with a space", with(n, "/sweep", "a b"), "/sweep", "[A-Za-z0-9_.-]+"});
+  c.push_back({"unknown key", with(n, "/axis", json::array()), "/axis", "unknown key"});
+  c.push_back({"unknown job kind", with(n, "/job", "gpu"), "/job", "noop"});
+  c.push_back({"max_attempts 0", with(n, "/max_attempts", 0), "/max_attempts", "between 1 and 100"});
+  c.push_back({"priority a string", with(n, "/priority", "high"), "/priority", "an integer"});
+  c.push_back({"axes not an array", with(n, "/axes", json::object()), "/axes", "an array"});
+  c.push_back({"axis without pointer", without(n, "/axes/0/pointer"), "/axes/0/pointer", "missing"});
+  c.push_back({"pointer not in base", with(n, "/axes/0/pointer", "/h"), "/axes/0/pointer", "present in the base"});
+  c.push_back({"empty values", with(n, "/axes/0/values", json::array()), "/axes/0/values", "non-empty"});
+  c.push_back({"string among numbers", with(n, "/axes/0/values/1", "fast"), "/axes/0/values/1", "a number"});
+  c.push_back({"duplicate values", with(n, "/axes/0/values/1", 1.0), "/axes/0/values/1", "differ"});
+  c.push_back({"invalid column name", with(n, "/axes/0/name", "Gravity"), "/axes/0/name", "column name"});
+  json r = n;
+  r["axes"][0].erase("values");
+  c.push_back({"range negative step", with(r, "/axes/0/range", {{"start", 1}, {"stop", 2}, {"step", -1}}),
+               "/axes/0/range/step", "a positive number"});
+  c.push_back({"range step and num", with(r, "/axes/0/range", {{"start", 1}, {"stop", 2}, {"step", 1}, {"num", 2}}),
+               "/axes/0/range", "exactly one of"});
+  c.push_back({"range stop below start", with(r, "/axes/0/range", {{"start", 2}, {"stop", 1}, {"step", 0.5}}),
+               "/axes/0/range/stop", ">= start"});
+  c.push_back({"too many points", with(r, "/axes/0/range", {{"start", 0}, {"stop", 1}, {"num", 1000001}}),
+               "/axes/0/range/num", "1000000"});
+  json z = n;
+  z["base"]["h"] = 1.0;
+  z["axes"] = {{{"zip", {{{"pointer", "/g"}, {"values", {1.0, 2.0}}}, {{"pointer", "/h"}, {"values", {1.0}}}}}}};
+  c.push_back({"zip of unequal lengths", z.dump(), "/axes/0/zip/1", "as many as"});
+  json twice = n;
+  twice["axes"].push_back({{"name", "g2"}, {"pointer", "/g"}, {"values", {3.0}}});
+  c.push_back({"one field swept twice", twice.dump(), "/axes/1", "swept twice"});
+  c.push_back({"repeats count 0", with(n, "/repeats", {{"pointer", "/g"}, {"count", 0}}), "/repeats/count",
+               "between 1 and 1000000"});
+  c.push_back({"noop sleep_s a string", with(n, "/base/sleep_s", "long"), "/base/sleep_s", "a number of seconds"});
+  c.push_back({"noop sleep_s negative", with(n, "/base/sleep_s", -1), "/base/sleep_s", "between 0 and 86400"});
+  c.push_back({"noop fail_attempts 1.5", with(n, "/base/fail_attempts", 1.5), "/base/fail_attempts", "an integer"});
+  json sleeps = n;
+  sleeps["axes"][0] = {{"name", "sleep_s"}, {"pointer", "/sleep_s"}, {"values", {0.1, -2.0}}};
+  c.push_back({"noop axis value out of range", sleeps.dump(), "/base/sleep_s", "-2"});
+  // Impact scenarios: reported at the base's own pointer.
+  c.push_back({"repeats step 0.5 on an integer seed",
+               with(im, "/repeats", {{"pointer", "/projectile/seed"}, {"count", 3}, {"step", 0.5}}), "/repeats/step",
+               "an integer", true});
+  c.push_back({"gravity a string", with(im, "/base/gravity_m_s2", "high"), "/base/gravity_m_s2", "", true});
+  c.push_back({"seed 2^64", with(im, "/base/bed/seed", json::parse("18446744073709551616")), "/base/bed/seed",
+               "", true});
+  c.push_back({"dt_s 5e-324", with(im, "/base/dt_s", 5e-324), "/base/dt_s", "at least 1e-09", true});
+  json wide = im;
+  wide["base"]["container"]["diameter_m"] = 20;
+  c.push_back({"a 20 m x 20 m fill", with(wide, "/base/container/fill_height_m", 20), "/base/container/fill_height_m",
+               "this machine's memory", true});
+  c.push_back({"unknown scenario field", with(im, "/base/projectile/speed", 1.0), "/base/projectile/speed", "",
+               true});
+  return c;
+}
+
+}  // namespace
+
+TEST(BadSpecs, EveryCaseExitsTwoNamingFileAndFieldAndWritesNothing) {
+  const bool impact = queue::impact_available();
+  int checked = 0;
+  for (const auto& c : corpus()) {
+    if (c.impact && !impact) continue;
+    SCOPED_TRACE(c.name);
+    TempDir d;
+    write_text(d.path / "bad_spec.json", c.text);
+    const auto r = run_cli({"submit", "bad_spec.json", "--db", "c.db"}, d.path);
+    EXPECT_EQ(r.code, 2) << r.out << r.err;
+    EXPECT_NE(r.err.find("bad_spec.json"), std::string::npos) << r.err.substr(0, 600);
+    EXPECT_NE(r.err.find(c.where), std::string::npos) << "expected " << c.where << " in: " << r.err.substr(0, 600);
+    if (!c.also.empty())
+      EXPECT_NE(r.err.find(c.also), std::string::npos) << "expected " << c.also << " in: " << r.err.substr(0, 600);
+    EXPECT_FALSE(fs::exists(d.path / "c.db")) << "a refused spec must not create the database";
+    EXPECT_FALSE(fs::exists(d.path / "c.files"));
+    ++checked;
+  }
+  std::printf("bad-spec corpus: %d cases refused with exit 2, file and pointer/line\n", checked);
+  EXPECT_GE(checked, 25);
+}
+
+TEST(BadSpecs, AnIntegerBaseValueTakesFloatAxisValues) {
+  if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
+  TempDir d;
+  json doc = impact_doc();
+  doc["base"]["gravity_m_s2"] = 10;
+  write_text(d.path / "spec.json", doc.dump());
+  const auto r = run_cli({"submit", "spec.json", "--dry-run"}, d.path);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("2 points"), std::string::npos) << r.out;
+}
+
+TEST(BadSpecs, AScenarioFileOfRunIsCheckedTheSameWay) {
+  TempDir d;
+  write_text(d.path / "deep.json", std::string(5000, '[') + std::string(5000, ']'));
+  auto r = run_cli({"run", "deep.json", "--out", "o"}, d.path);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("deep.json:1:"), std::string::npos) << r.err;
+  r = run_cli({"run", ".", "--out", "o"}, d.path);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_FALSE(fs::exists(d.path / "o"));
+}
