@@ -103,7 +103,7 @@ std::vector<Case> corpus() {
   c.push_back({"repeats step 0.5 on an integer seed",
                with(im, "/repeats", {{"pointer", "/projectile/seed"}, {"count", 3}, {"step", 0.5}}), "/repeats/step",
                "an integer", true});
-  c.push_back({"gravity a string", with(im, "/base/gravity_m_s2", "high"), "/base/gravity_m_s2", "", true});
+  c.push_back({"mass a string", with(im, "/base/projectile/mass_kg", "heavy"), "/base/projectile/mass_kg", "", true});
   c.push_back({"seed 2^64", with(im, "/base/bed/seed", json::parse("18446744073709551616")), "/base/bed/seed",
                "", true});
   c.push_back({"dt_s 5e-324", with(im, "/base/dt_s", 5e-324), "/base/dt_s", "at least 1e-09", true});
