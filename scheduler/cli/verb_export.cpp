@@ -20,6 +20,7 @@
 #include "results/processing/resample.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
+#include "scheduler/queue/campaign.h"
 #include "scheduler/queue/filter.h"
 #include "scheduler/queue/queue.h"
 #include "scheduler/queue/table.h"
@@ -121,7 +122,7 @@ void write_text_file(const fs::path& p, const std::string& text) {
 void run_export(const ExportOptions& o) {
   if (!fs::exists(o.db)) throw UsageError(fmt::format("--db: no campaign database at '{}'", o.db));
   if (!(o.rate_hz > 0)) throw UsageError(fmt::format("--rate-hz: expected a rate > 0 Hz, found {}", o.rate_hz));
-  db::Database db(o.db);
+  db::Database db = queue::open_campaign(o.db, queue::OpenMode::read);  // refuses a non-campaign
   const queue::CampaignPaths paths(o.db);
   queue::ResultsTable t;
   try {

@@ -19,6 +19,7 @@
 #include "scheduler/pipeline/scenario_spec.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
+#include "scheduler/queue/campaign.h"
 #include "scheduler/queue/filter.h"
 #include "scheduler/queue/queue.h"
 #include "scheduler/queue/table.h"
@@ -60,7 +61,7 @@ void run_plot_results(const PlotResultsOptions& o) {
   if (!fs::exists(o.db)) throw UsageError(fmt::format("--db: no campaign database at '{}'", o.db));
   if (o.out.empty() || fs::path(o.out).extension() != ".png")
     throw UsageError(fmt::format("--out: expected a file name ending in .png, found '{}'", o.out));
-  db::Database db(o.db);
+  db::Database db = queue::open_campaign(o.db, queue::OpenMode::read);  // refuses a non-campaign
   std::vector<std::string> cols{o.x, o.y};
   if (!o.group.empty()) cols.push_back(o.group);
   queue::ResultsTable t;
