@@ -28,7 +28,7 @@ std::vector<double> Campaign::gravity_levels() const {
 }
 
 void process_trial(MeasuredTrial& t) {
-  // SOURCE: t.raw.source = t.info.source;
+  t.raw.source = t.info.source;
   const MetricOptions o = metric_options(t.info);
   t.processed = process_trace(t.raw, o);
   // Fit window: inside the collision, two filter edge widths clear of contact and stop.
@@ -208,7 +208,7 @@ Campaign load_campaign_db(db::Database& db) {
       p.velocity_down_m_s.push_back(smp.get_double(3));
       p.depth_m.push_back(smp.get_double(4));
     }
-    // SOURCE: t.raw.source = i.source;
+    t.raw.source = i.source;
     if (t.fit_end > p.t_s.size() || t.fit_begin > t.fit_end)
       throw std::runtime_error(fmt::format("{}: trial '{}': fit window [{}, {}) outside its {} samples",
                                            db.path(), i.trial_id, t.fit_begin, t.fit_end, p.t_s.size()));

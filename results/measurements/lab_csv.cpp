@@ -79,7 +79,7 @@ Trace read_trace_csv(const fs::path& path, const std::string& rel, double declar
   if (ct < 0) throw ParseError{{rel, ln, 0, "missing column 't_s' in the header"}};
   if (ca < 0) throw ParseError{{rel, ln, 0, "missing column 'accel_m_s2' in the header"}};
   Trace tr;
-  // SOURCE: tr.source = TraceSource::lab;
+  tr.source = TraceSource::lab;
   std::vector<int> lines;
   while (next_record(reader, f, ln, rel)) {
     auto get = [&](int c, const char* name) {

@@ -9,14 +9,6 @@
 
 namespace gravsweep::results {
 
-const char* to_string(TraceSource s) { return s == TraceSource::dem ? "dem" : "lab"; }
-
-TraceSource trace_source_of(const std::string& s) {
-  if (s == "lab") return TraceSource::lab;
-  if (s == "dem") return TraceSource::dem;
-  throw std::invalid_argument(fmt::format("trace source '{}': expected 'lab' or 'dem'", s));
-}
-
 const std::vector<TrialField>& trial_fields() {
   // key (JSON, CSV, SQLite), trace.h5 attribute, unit, required in trials.csv, member.
   static const std::vector<TrialField> fields = {
