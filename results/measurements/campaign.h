@@ -18,6 +18,8 @@ class Database;
 
 namespace gravsweep::results {
 
+struct TraceData;
+
 /// A trial with its raw and processed trace.
 struct MeasuredTrial {
   Trial info;
@@ -52,6 +54,8 @@ struct DemTraceRef {
 /// Reads one trace.h5 into a trial (source dem, facts from its attributes via trial_fields(),
 /// processing settings from its scenario's /output), not yet processed.
 MeasuredTrial read_dem_trial(const DemTraceRef& ref);
+/// The same from a trace in memory (the drop job measures its own trace through it).
+MeasuredTrial dem_trial_of(const TraceData& trace, const DemTraceRef& ref);
 /// Reads and processes DEM traces; unreadable or unmeasurable ones (no contact before the time
 /// cap, a rebound) become issues naming the trace, the job and the reason.
 Campaign load_dem_campaign(const std::string& label, const std::vector<DemTraceRef>& refs);

@@ -32,8 +32,9 @@ double attr_of(const TraceData& d, const std::string& name) {
 
 }  // namespace
 
-MeasuredTrial read_dem_trial(const DemTraceRef& ref) {
-  const TraceData d = read_trace(ref.path);
+MeasuredTrial read_dem_trial(const DemTraceRef& ref) { return dem_trial_of(read_trace(ref.path), ref); }
+
+MeasuredTrial dem_trial_of(const TraceData& d, const DemTraceRef& ref) {
   MeasuredTrial t;
   Trial& ti = t.info;
   ti.trial_id = ref.trial_id;

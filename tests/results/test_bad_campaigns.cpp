@@ -19,19 +19,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Cmd {
-  int code;
-  std::string out;
-};
-
-Cmd run(const std::string& args) {
-  const std::string cmd = std::string("'") + GRAVSWEEP_BINARY + "' " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf{};
-  while (p && fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int st = p ? pclose(p) : -1;
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+using Cmd = gravsweep::testing::CliRun;
+Cmd run(const std::string& args, bool merge_stderr = true) {
+  return gravsweep::testing::run_gravsweep(args, merge_stderr);
 }
 
 constexpr const char* kHeader =

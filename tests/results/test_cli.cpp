@@ -17,19 +17,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Run {
-  int code;
-  std::string out;
-};
-
+using Run = gravsweep::testing::CliRun;
 Run run(const std::string& args, bool merge_stderr = false) {
-  const std::string cmd = std::string("'") + GRAVSWEEP_BINARY + "' " + args + (merge_stderr ? " 2>&1" : " 2>/dev/null");
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf{};
-  while (p && fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int st = p ? pclose(p) : -1;
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+  return gravsweep::testing::run_gravsweep(args, merge_stderr);
 }
 
 }  // namespace
