@@ -176,6 +176,15 @@ MeasuredTrial read_row(const fs::path& dir, const std::map<std::string, int>& co
                                    [&](const TrialField& fd) { return name == fd.key; });
     if (!known && i < static_cast<int>(f.size())) ti.attributes[name] = f[i];
   }
+  // An explicit source column (`gravsweep export` writes "dem" for DEM drops as CSV traces).
+  if (!text("source").empty()) {
+    try {
+      ti.source = trace_source_of(text("source"));
+    } catch (const std::invalid_argument& e) {
+      throw ParseError{{"trials.csv", ln, col.at("source") + 1, fmt::format("column 'source': {}", e.what())}};
+    }
+    ti.attributes.erase("source");
+  }
   const std::string& rel = ti.trace_file;
   const fs::path full = resolve_inside(dir, rel, ln, col.at("trace_file") + 1);
   if (fs::path(rel).extension() == ".h5") {
@@ -192,6 +201,14 @@ MeasuredTrial read_row(const fs::path& dir, const std::map<std::string, int>& co
     }
   } else {
     t.raw = read_trace_csv(full, rel, ti.sample_rate_hz, ln, col.at("sample_rate_hz") + 1);
+    t.raw.source = ti.source;
+    if (ti.source == TraceSource::dem && !text("contact_start_s").empty()) {
+      double s0;
+      if (!parse_double(text("contact_start_s"), s0))
+        throw ParseError{{"trials.csv", ln, col.at("contact_start_s") + 1,
+                          fmt::format("column 'contact_start_s': expected a finite number, got '{}'", text("contact_start_s"))}};
+      t.raw.contact_start_s = s0;
+    }
   }
   return t;
 }
