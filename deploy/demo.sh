@@ -4,7 +4,9 @@
 #   1. submit a sweep (2 gravities x 3 speeds x 2 start offsets; bed jobs shared by their drops),
 #   2. run it with 2 worker processes, 3. show status and the result table (and export CSV),
 #   4. compare the collision model with a laboratory campaign (depth-friction-dev, if present):
-#      import, rank the candidate terms, fit base vs base+depth_friction, write the report.
+#      import, rank the candidate terms, fit base vs base+depth_friction, write the report,
+#   5. the same questions of the gravity sweep itself: every finished drop of the campaign
+#      database is a trial (model rank, Table 3, report), and the repeats' means per group.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$root/deploy/install-deps.sh"
@@ -35,4 +37,10 @@ if [ -d "$lab" ]; then
   "$gs" report "$out/lab.db" --out "$out/report"
   echo "   report written to $out/report"
 fi
+echo "== 5. the sweep as a campaign: model rank, table3, report on $db"
+"$gs" results --db "$db" --group-by gravity_m_s2,impact_speed_m_s
+"$gs" model rank "$db"
+"$gs" model table3 "$db"
+"$gs" report "$db" --out "$out/report-sweep"
+echo "   report written to $out/report-sweep"
 echo "demo finished: $out"

@@ -8,6 +8,7 @@ namespace gravsweep::results {
 
 Trace TraceData::to_trace() const {
   Trace t;
+  t.source = TraceSource::dem;
   t.t_s = t_s;
   t.accel_up_m_s2 = accel_up_m_s2;
   t.depth_m = depth_m;

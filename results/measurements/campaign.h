@@ -1,12 +1,15 @@
-// Laboratory (or synthetic) measurement campaigns on disk (shared/formats/measurements.md):
-// <dir>/trials.csv plus one accelerometer record per trial, processed as Sunday et al. 2021
-// Sect. 2.3 does (results/processing/trace.h). Bad rows or traces are reported by file, line and
-// column and do not stop the other trials.
+// Measurement campaigns: trials (results/measurements/trial.h) with their traces, processed as
+// Sunday et al. 2021 Sect. 2.3 does (results/processing/trace.h) through one entry,
+// process_trial(). Readers: lab campaign folders (trials.csv + traces/*.csv, lab_csv.cpp), DEM
+// traces (trace.h5 of `gravsweep run` or of a campaign's drop jobs, dem_trace.cpp), and the
+// SQLite tables written by store_campaign (campaign.cpp). Bad rows or traces are reported by
+// file, line and column and do not stop the other trials.
 #pragma once
-#include <map>
+#include <filesystem>
 #include <string>
 #include <vector>
 
+#include "results/measurements/trial.h"
 #include "results/processing/trace.h"
 
 namespace gravsweep::db {
@@ -15,58 +18,57 @@ class Database;
 
 namespace gravsweep::results {
 
-struct TrialInfo {
-  std::string trial_id;
-  std::string trace_file;
-  double gravity_m_s2 = 0;
-  double impact_velocity_m_s = 0;
-  double fill_height_m = 0;
-  double projectile_mass_kg = 0;
-  double projectile_diameter_m = 0;
-  double grain_diameter_m = 0;
-  double bulk_density_kg_m3 = 0;
-  double sample_rate_hz = 0;
-  double drop_height_m = 0;  ///< 0 when absent; v = sqrt(2 g h) is used when the speed is empty
-  std::map<std::string, std::string> attributes;  ///< other columns, kept as they are
-};
+struct TraceData;
 
-struct Trial {
-  TrialInfo info;
+/// A trial with its raw and processed trace.
+struct MeasuredTrial {
+  Trial info;
   Trace raw;
   ProcessedTrace processed;
   /// Samples used by trace-level fits: inside the collision, clear of the filter's transient.
   std::size_t fit_begin = 0, fit_end = 0;  ///< [begin, end)
 };
 
-/// One problem found while reading: file (relative to the campaign), 1-based line and column
-/// (0 when not applicable) and what was expected.
-struct ImportIssue {
-  std::string file;
-  int line = 0;
-  int column = 0;
-  std::string message;
-  [[nodiscard]] std::string to_string() const;
-};
-
 struct Campaign {
   std::string directory;
-  std::vector<Trial> trials;        ///< the trials read and processed successfully
-  std::vector<ImportIssue> issues;  ///< one per rejected row or trace
-  [[nodiscard]] std::vector<double> gravity_levels() const;  ///< sorted, descending
+  std::vector<MeasuredTrial> trials;  ///< the trials read and processed successfully
+  std::vector<ImportIssue> issues;    ///< one per rejected row, trace or unmeasurable trial
+  [[nodiscard]] std::vector<double> gravity_levels() const;  ///< same_gravity_level(), descending
 };
 
-/// Reads and processes a campaign folder. Throws std::runtime_error only when trials.csv itself
+/// The one processing entry: options from the trial (metric_options), bias removal from the
+/// source, the fit window. Throws std::invalid_argument with the reason.
+void process_trial(MeasuredTrial& t);
+
+/// Reads and processes a lab campaign folder. Throws std::runtime_error only when trials.csv itself
 /// cannot be read or lacks a required column; row- and trace-level problems become issues.
+/// `cutoff_hz` is the filter of trials whose row does not set filter_cutoff_hz.
 Campaign load_campaign(const std::string& directory, double cutoff_hz = 500.0);
+
+/// A DEM trace (trace.h5) and what names it.
+struct DemTraceRef {
+  std::string trial_id;
+  std::string job_id;  ///< empty outside a campaign database
+  std::filesystem::path path;
+};
+/// Reads one trace.h5 into a trial (source dem, facts from its attributes via trial_fields(),
+/// processing settings from its scenario's /output), not yet processed.
+MeasuredTrial read_dem_trial(const DemTraceRef& ref);
+/// The same from a trace in memory (the drop job measures its own trace through it).
+MeasuredTrial dem_trial_of(const TraceData& trace, const DemTraceRef& ref);
+/// Reads and processes DEM traces; unreadable or unmeasurable ones (no contact before the time
+/// cap, a rebound) become issues naming the trace, the job and the reason.
+Campaign load_dem_campaign(const std::string& label, const std::vector<DemTraceRef>& refs);
 
 /// Stores the campaign in the database (tables trials, trial_samples, trial_metrics, created when
 /// missing), replacing earlier rows of the same trial ids. Returns the number of trials stored.
 int store_campaign(db::Database& db, const Campaign& campaign);
 
-/// Turns DEM runs (`gravsweep run` folders holding trace.h5, searched recursively under each root)
-/// into a campaign folder: writes <out_dir>/trials.csv pointing at the traces, so the model verbs
-/// treat simulations exactly as laboratory records. Unreadable traces become issues. Returns the
-/// number of trials written.
+/// Turns DEM runs (`gravsweep run` folders holding trace.h5, and campaign files folders holding
+/// traces/<job>.a<n>.h5, searched recursively under each root) into a campaign folder: copies
+/// (or hard-links) each trace to <out_dir>/traces/<trial>.h5 and writes <out_dir>/trials.csv, so
+/// the model verbs treat simulations exactly as laboratory records. Unreadable traces become
+/// issues. Returns the number of trials written.
 int write_campaign_from_runs(const std::vector<std::string>& roots, const std::string& out_dir,
                              std::vector<ImportIssue>& issues);
 

@@ -1,6 +1,8 @@
 // Collision models, fits, cross-validation, residual analysis and discovery (see model.h).
 #include "results/model/model.h"
 
+#include "results/model/model_internal.h"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -132,7 +134,11 @@ void feature_row(const ModelSpec& s, const Layout& L, int gi, const TermContext&
   }
 }
 
-TermContext context(const Trial& t, std::size_t k) {
+}  // namespace
+
+namespace detail {
+
+TermContext context(const MeasuredTrial& t, std::size_t k) {
   const auto& p = t.processed;
   TermContext c;
   c.z_m = p.depth_m[k];
@@ -146,7 +152,7 @@ TermContext context(const Trial& t, std::size_t k) {
   return c;
 }
 
-TermContext context(const TrialInfo& i) {
+TermContext context(const Trial& i) {
   TermContext c;
   c.g_m_s2 = i.gravity_m_s2;
   c.fill_height_m = i.fill_height_m;
@@ -197,20 +203,26 @@ std::vector<int> fold_of(const Campaign& c, int folds, unsigned seed) {
   std::iota(idx.begin(), idx.end(), 0);
   std::vector<double> key(idx.size());
   for (auto& k : key) k = std::uniform_real_distribution<double>(0, 1)(rng);
+  const std::vector<double> levels = c.gravity_levels();  // descending
+  std::vector<int> level(idx.size(), 0);
+  for (std::size_t i = 0; i < idx.size(); ++i)
+    while (!same_gravity_level(levels[static_cast<std::size_t>(level[i])], c.trials[i].info.gravity_m_s2)) ++level[i];
   std::sort(idx.begin(), idx.end(), [&](int a, int b) {
-    const double ga = c.trials[a].info.gravity_m_s2, gb = c.trials[b].info.gravity_m_s2;
-    return ga != gb ? ga > gb : key[a] < key[b];
+    return level[a] != level[b] ? level[a] < level[b] : key[a] < key[b];
   });
   std::vector<int> f(idx.size());
   for (std::size_t r = 0; r < idx.size(); ++r) f[idx[r]] = static_cast<int>(r % folds);
   return f;
 }
 
-}  // namespace
+}  // namespace detail
+
+using namespace detail;
+
 
 int FittedModel::gravity_index(double g) const {
   for (std::size_t i = 0; i < gravity_levels.size(); ++i)
-    if (std::abs(gravity_levels[i] - g) <= 1e-9 * std::max(1.0, std::abs(g))) return static_cast<int>(i);
+    if (same_gravity_level(gravity_levels[i], g)) return static_cast<int>(i);
   return -1;
 }
 
@@ -258,7 +270,7 @@ FittedModel fit_model(const ModelSpec& spec, const Campaign& c, const std::vecto
   Eigen::Index r = 0;
   std::vector<double> row(static_cast<std::size_t>(L.cols));
   for (int ti : used) {
-    const Trial& t = c.trials[static_cast<std::size_t>(ti)];
+    const MeasuredTrial& t = c.trials[static_cast<std::size_t>(ti)];
     const int gi = m.gravity_index(t.info.gravity_m_s2);
     const double n_t = static_cast<double>(t.fit_end - t.fit_begin);
     // Trials weighted equally; gravity levels put on one scale (residuals in units of g).
@@ -304,7 +316,7 @@ FittedModel fit_model(const ModelSpec& spec, const Campaign& c, const std::vecto
   return m;
 }
 
-double trial_trace_mse(const FittedModel& m, const Trial& t) {
+double trial_trace_mse(const FittedModel& m, const MeasuredTrial& t) {
   double s = 0;
   std::size_t n = 0;
   for (std::size_t k = t.fit_begin; k < t.fit_end; ++k) {
@@ -317,7 +329,7 @@ double trial_trace_mse(const FittedModel& m, const Trial& t) {
   return n ? s / static_cast<double>(n) : NAN;
 }
 
-Prediction predict(const FittedModel& m, const TrialInfo& info) { return predict(m, context(info)); }
+Prediction predict(const FittedModel& m, const Trial& info) { return predict(m, context(info)); }
 
 Prediction predict(const FittedModel& m, const TermContext& c0, double t_max_s) {
   // RK4 on (z, v), z down: dv/dt = g - R/m (Eq. 1), from z = 0, v = vc.
@@ -431,336 +443,6 @@ ErrorSummary summarize(const Campaign& c, const HeldOut& h) {
     e.zstop_rel_pct = e.tstop_rel_pct = e.apeak_rel_pct = NAN;
   }
   return e;
-}
-
-// ---------------------------------------------------------------------------------------------
-// The paper's method: Table 3
-
-namespace {
-
-std::vector<Table3Row> table3_of(const Campaign& c, const std::vector<bool>& mask) {
-  std::vector<Table3Row> rows;
-  for (double g : c.gravity_levels()) {
-    std::vector<const Trial*> ts;
-    for (std::size_t i = 0; i < c.trials.size(); ++i)
-      if (mask[i] && c.trials[i].info.gravity_m_s2 == g) ts.push_back(&c.trials[i]);
-    Table3Row r;
-    r.g_m_s2 = g;
-    r.trials = static_cast<int>(ts.size());
-    if (ts.size() < 3) {
-      rows.push_back(r);
-      continue;
-    }
-    const auto n = static_cast<Eigen::Index>(ts.size());
-    Eigen::MatrixXd X(n, 2), Xl(n, 2);
-    Eigen::VectorXd y(n), yl(n);
-    double mass = 0;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const auto& m = ts[static_cast<std::size_t>(i)]->processed.metrics;
-      const auto& info = ts[static_cast<std::size_t>(i)]->info;
-      mass += info.projectile_mass_kg / static_cast<double>(n);
-      X(i, 0) = 1.0;
-      X(i, 1) = m.vc_m_s * m.vc_m_s;
-      y(i) = m.apeak_m_s2;  // Eq. 2: apeak = f0/m + vc^2/d1 - g
-      const double drop = info.drop_height_m > 0 ? info.drop_height_m : m.vc_m_s * m.vc_m_s / (2 * g);
-      Xl(i, 0) = 1.0;
-      Xl(i, 1) = std::log(drop + m.zstop_m);  // H = drop height + zstop (Fig. 10)
-      yl(i) = std::log(std::max(m.zstop_m, 1e-9));
-    }
-    auto ols = [](const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::Vector2d& beta,
-                  Eigen::Matrix2d& cov) {
-      beta = A.colPivHouseholderQr().solve(b);
-      const double dof = std::max<double>(1.0, static_cast<double>(A.rows()) - 2.0);
-      const double s2 = (b - A * beta).squaredNorm() / dof;
-      cov = s2 * (A.transpose() * A).inverse();
-    };
-    Eigen::Vector2d b, bl;
-    Eigen::Matrix2d cv, cvl;
-    ols(X, y, b, cv);
-    ols(Xl, yl, bl, cvl);
-    r.f0_N = mass * (b(0) + g);
-    r.f0_se_N = mass * std::sqrt(cv(0, 0));
-    r.inv_d1_1_m = b(1);
-    r.inv_d1_se_1_m = std::sqrt(cv(1, 1));
-    if (r.f0_N > 0 && r.inv_d1_1_m > 0) {
-      // Eq. 5: vt = sqrt(d1 f0 / m); delta method with the covariance of (f0, 1/d1).
-      r.vt_m_s = std::sqrt(r.f0_N / (mass * r.inv_d1_1_m));
-      const double var = 0.25 * r.vt_m_s * r.vt_m_s *
-                         (std::pow(r.f0_se_N / r.f0_N, 2) + std::pow(r.inv_d1_se_1_m / r.inv_d1_1_m, 2) -
-                          2 * mass * cv(0, 1) / (r.f0_N * r.inv_d1_1_m));
-      r.vt_se_m_s = std::sqrt(std::max(0.0, var));
-    }
-    r.alpha = bl(1);
-    r.alpha_se = std::sqrt(cvl(1, 1));
-    rows.push_back(r);
-  }
-  return rows;
-}
-
-}  // namespace
-
-std::vector<Table3Row> table3(const Campaign& c) {
-  return table3_of(c, std::vector<bool>(c.trials.size(), true));
-}
-
-Prediction predict_paper(const Table3Row& row, double m, double vc) {
-  Prediction p;
-  const double g = row.g_m_s2, f0 = row.f0_N, inv_d1 = row.inv_d1_1_m;
-  p.apeak_m_s2 = f0 / m + vc * vc * inv_d1 - g;  // Eq. 2
-  if (!(f0 > m * g) || !(inv_d1 > 0)) return p;
-  const double d1 = 1.0 / inv_d1;
-  p.zstop_m = 0.5 * d1 * std::log(1.0 + m * vc * vc / (d1 * (f0 - m * g)));           // Eq. 3
-  p.tstop_s = std::atan(vc * std::sqrt(m / (d1 * (f0 - m * g)))) /
-              std::sqrt((f0 / m - g) / d1);                                            // Eq. 4
-  p.stopped = true;
-  return p;
-}
-
-HeldOut cross_validate_paper(const Campaign& c, int folds, unsigned seed) {
-  HeldOut h;
-  h.trace_mse.assign(c.trials.size(), NAN);
-  h.pred.assign(c.trials.size(), Prediction{});
-  const auto f = fold_of(c, folds, seed);
-  for (int k = 0; k < folds; ++k) {
-    std::vector<bool> mask(c.trials.size());
-    for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = f[i] != k;
-    const auto rows = table3_of(c, mask);
-    for (std::size_t i = 0; i < mask.size(); ++i) {
-      if (mask[i]) continue;
-      const auto& t = c.trials[i];
-      for (const auto& r : rows)
-        if (r.g_m_s2 == t.info.gravity_m_s2)
-          h.pred[i] = predict_paper(r, t.info.projectile_mass_kg, t.processed.metrics.vc_m_s);
-      // Trace residual of Eq. 1 with the Table 3 f0, d1 (per gravity level).
-      for (const auto& r : rows)
-        if (r.g_m_s2 == t.info.gravity_m_s2) {
-          double s = 0;
-          std::size_t n = 0;
-          for (std::size_t q = t.fit_begin; q < t.fit_end; ++q, ++n) {
-            const double v = t.processed.velocity_down_m_s[q];
-            const double a_model = r.f0_N / t.info.projectile_mass_kg + r.inv_d1_1_m * v * v - r.g_m_s2;
-            s += std::pow(t.processed.accel_up_m_s2[q] - a_model, 2);
-          }
-          if (n) h.trace_mse[i] = s / static_cast<double>(n);
-        }
-    }
-  }
-  return h;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Residuals along axes
-
-std::vector<AxisResidual> residual_axes(const FittedModel& m, const Campaign& c) {
-  struct S {
-    double r, w;
-    double x[6];
-    int trial;
-  };
-  static const char* names[6] = {"depth_m", "speed_m_s", "time_since_contact_s",
-                                 "gravity_m_s2", "impact_velocity_m_s", "fill_height_m"};
-  std::vector<S> s;
-  for (std::size_t ti = 0; ti < c.trials.size(); ++ti) {
-    const auto& t = c.trials[ti];
-    const double n = static_cast<double>(t.fit_end - t.fit_begin);
-    for (std::size_t k = t.fit_begin; k < t.fit_end; ++k) {
-      const TermContext ctx = context(t, k);
-      const double g = t.info.gravity_m_s2;
-      const double a_model = m.force(ctx) / t.info.projectile_mass_kg - g;
-      S q;
-      q.r = (t.processed.accel_up_m_s2[k] - a_model) / g;
-      q.w = 1.0 / n;
-      q.x[0] = ctx.z_m;
-      q.x[1] = ctx.v_m_s;
-      q.x[2] = ctx.t_since_contact_s;
-      q.x[3] = g;
-      q.x[4] = t.info.impact_velocity_m_s;
-      q.x[5] = t.info.fill_height_m;
-      q.trial = static_cast<int>(ti);
-      s.push_back(q);
-    }
-  }
-  std::vector<AxisResidual> out;
-  if (s.empty()) return out;
-  double W = 0, M = 0;
-  for (const auto& q : s) W += q.w, M += q.w * q.r;
-  M /= W;
-  double V = 0;
-  for (const auto& q : s) V += q.w * (q.r - M) * (q.r - M);
-  for (int a = 0; a < 6; ++a) {
-    AxisResidual ar;
-    ar.axis = names[a];
-    std::vector<std::size_t> idx(s.size());
-    std::iota(idx.begin(), idx.end(), 0);
-    std::sort(idx.begin(), idx.end(), [&](std::size_t i, std::size_t j) { return s[i].x[a] < s[j].x[a]; });
-    const int nb = 6;
-    double acc_w = 0;
-    std::size_t pos = 0;
-    double between = 0;
-    std::vector<double> half_even, half_odd;  // bin means over even- and odd-numbered trials
-    for (int b = 0; b < nb && pos < idx.size(); ++b) {
-      const double target = W * (b + 1) / nb;
-      double bw = 0, br = 0, bx = 0;
-      double hw[2] = {0, 0}, hr[2] = {0, 0};
-      const std::size_t pos0 = pos;
-      const double x_first = s[idx[pos]].x[a];
-      while (pos < idx.size() && (acc_w < target || b == nb - 1)) {
-        const auto& q = s[idx[pos]];
-        bw += q.w, br += q.w * q.r, bx += q.w * q.x[a];
-        acc_w += q.w;
-        ++pos;
-        // keep equal axis values together (trial-level axes)
-        while (pos < idx.size() && s[idx[pos]].x[a] == s[idx[pos - 1]].x[a] && a >= 3) {
-          const auto& q2 = s[idx[pos]];
-          bw += q2.w, br += q2.w * q2.r, bx += q2.w * q2.x[a];
-          acc_w += q2.w;
-          ++pos;
-        }
-      }
-      (void)x_first;
-      if (bw <= 0) continue;
-      for (std::size_t k = pos0; k < pos; ++k) {
-        const auto& q = s[idx[k]];
-        hw[q.trial % 2] += q.w, hr[q.trial % 2] += q.w * q.r;
-      }
-      if (hw[0] > 0 && hw[1] > 0) {
-        half_even.push_back(hr[0] / hw[0]);
-        half_odd.push_back(hr[1] / hw[1]);
-      }
-      ar.bin_center.push_back(bx / bw);
-      ar.bin_mean_r_over_g.push_back(br / bw);
-      between += bw * std::pow(br / bw - M, 2);
-    }
-    ar.eta2 = V > 0 ? between / V : 0;
-    // Split-half reproducibility: the bin profile of the even-numbered trials against that of the
-    // odd-numbered ones (disjoint sets of trials), Pearson r over the bins.
-    if (half_even.size() >= 3) {
-      const double n = static_cast<double>(half_even.size());
-      double me = 0, mo = 0;
-      for (std::size_t i = 0; i < half_even.size(); ++i) me += half_even[i] / n, mo += half_odd[i] / n;
-      double see = 0, soo = 0, seo = 0;
-      for (std::size_t i = 0; i < half_even.size(); ++i) {
-        see += (half_even[i] - me) * (half_even[i] - me);
-        soo += (half_odd[i] - mo) * (half_odd[i] - mo);
-        seo += (half_even[i] - me) * (half_odd[i] - mo);
-      }
-      ar.split_half_r = see > 0 && soo > 0 ? seo / std::sqrt(see * soo) : 0;
-    }
-    if (a < 3) {
-      // Within-trial slope of r against the axis; sign test over trials.
-      std::vector<double> sx(c.trials.size()), sy(c.trials.size()), sxx(c.trials.size()),
-          sxy(c.trials.size()), sn(c.trials.size());
-      for (const auto& q : s) {
-        const auto t = static_cast<std::size_t>(q.trial);
-        sx[t] += q.x[a], sy[t] += q.r, sxx[t] += q.x[a] * q.x[a], sxy[t] += q.x[a] * q.r, sn[t] += 1;
-      }
-      for (std::size_t t = 0; t < c.trials.size(); ++t) {
-        if (sn[t] < 3) continue;
-        const double den = sn[t] * sxx[t] - sx[t] * sx[t];
-        if (den <= 0) continue;
-        const double slope = (sn[t] * sxy[t] - sx[t] * sy[t]) / den;
-        (slope > 0 ? ar.trials_positive : ar.trials_negative)++;
-      }
-      const int n = ar.trials_positive + ar.trials_negative;
-      const int k = std::max(ar.trials_positive, ar.trials_negative);
-      ar.slope_sign_trials_p = std::min(1.0, 2.0 * binom_tail_half(k, n));
-    }
-    out.push_back(ar);
-  }
-  return out;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Discovery
-
-namespace {
-
-bool structured(const std::vector<AxisResidual>& axes, std::string& where) {
-  const AxisResidual* best = nullptr;
-  for (const auto& a : axes) {
-    if (a.axis == "gravity_m_s2" || a.axis == "impact_velocity_m_s" || a.axis == "fill_height_m") {
-      if (a.eta2 >= 0.25 && (!best || a.eta2 > best->eta2)) best = &a;
-      continue;
-    }
-    const bool monotone = a.eta2 >= 0.15 && a.slope_sign_trials_p < 1e-4;
-    const bool reproducible = a.eta2 >= 0.05 && a.split_half_r >= 0.9;
-    if ((monotone || reproducible) && (!best || a.eta2 > best->eta2)) best = &a;
-  }
-  if (!best) return false;
-  std::string bins;
-  for (std::size_t i = 0; i < best->bin_center.size(); ++i)
-    bins += fmt::format("{}{:.3g}:{:+.3f}", i ? ", " : "", best->bin_center[i], best->bin_mean_r_over_g[i]);
-  where = fmt::format("residual varies with {} (eta^2 = {:.2f}, split-half r = {:.2f}; mean residual/g by bin: {})",
-                      best->axis, best->eta2, best->split_half_r, bins);
-  return true;
-}
-
-}  // namespace
-
-Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds, double alpha,
-                   double min_improvement, int max_rounds) {
-  Discovery d;
-  d.baseline = baseline.name();
-  ModelSpec current = baseline;
-  d.residual_before = residual_axes(fit_model(current, c), c);
-  for (int round = 0; round < max_rounds; ++round) {
-    const HeldOut h0 = cross_validate(current, c, folds, 1, false);
-    std::vector<Candidate> cands;
-    for (const auto& term : term_registry()) {
-      bool present = false;
-      for (const auto& t : current.terms) present = present || t.term->name == term.name;
-      if (present) continue;
-      ModelSpec s = current;
-      s.terms.push_back({&term, term.per_gravity, 1.0});
-      const HeldOut h1 = cross_validate(s, c, folds, 1, false);
-      Candidate cd;
-      cd.term = term.name;
-      double sum = 0;
-      std::vector<double> rel_all;
-      for (std::size_t i = 0; i < c.trials.size(); ++i) {
-        if (!std::isfinite(h0.trace_mse[i]) || !std::isfinite(h1.trace_mse[i]) || h0.trace_mse[i] <= 0) continue;
-        const double rel = (h0.trace_mse[i] - h1.trace_mse[i]) / h0.trace_mse[i];
-        rel_all.push_back(rel);
-        sum += rel;
-        ++cd.trials;
-        if (rel > 0) ++cd.trials_better;
-      }
-      cd.mean_rel_improvement = cd.trials ? sum / cd.trials : 0;
-      cd.p_value = signed_rank_p(rel_all);
-      cands.push_back(cd);
-    }
-    const double level = alpha / std::max<std::size_t>(1, cands.size());
-    for (auto& cd : cands) cd.significant = cd.p_value < level && cd.mean_rel_improvement >= min_improvement;
-    std::sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) {
-      if (a.significant != b.significant) return a.significant;
-      return a.mean_rel_improvement > b.mean_rel_improvement;
-    });
-    d.rounds.push_back(cands);
-    if (cands.empty() || !cands.front().significant) break;
-    const TermInfo& win = find_term(cands.front().term);
-    current.terms.push_back({&win, win.per_gravity, 1.0});
-    d.added.push_back(win.name);
-  }
-  d.residual_after = residual_axes(fit_model(current, c), c);
-  std::string where;
-  const bool left = structured(d.residual_after, where);
-  d.structure_left = left;
-  if (d.added.empty()) {
-    d.verdict = left ? "structure left that no candidate explains: " + where
-                     : "no missing effect found: no candidate term improves the held-out trials "
-                       "significantly and the residuals show no structure";
-  } else {
-    const auto& first = d.rounds.front().front();
-    const TermInfo& w = find_term(first.term);
-    d.verdict = fmt::format(
-        "missing effect: {} ({}); held-out trace error down {:.0f} % on average, better on {} of {} "
-        "trials (signed-rank test over trials p = {:.1e}); references: {}",
-        w.name, w.meaning, 100 * first.mean_rel_improvement, first.trials_better, first.trials,
-        first.p_value, w.references);
-    for (std::size_t i = 1; i < d.added.size(); ++i) d.verdict += "; then " + d.added[i];
-    if (left) d.verdict += "; structure left that no candidate explains: " + where;
-  }
-  return d;
 }
 
 }  // namespace gravsweep::results

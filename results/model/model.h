@@ -48,14 +48,14 @@ FittedModel fit_model(const ModelSpec& spec, const Campaign& c, const std::vecto
 FittedModel fit_model(const ModelSpec& spec, const Campaign& c);
 
 /// Mean squared acceleration residual (m/s2)^2 of a trial's fit window (a_meas - a_model).
-double trial_trace_mse(const FittedModel& m, const Trial& t);
+double trial_trace_mse(const FittedModel& m, const MeasuredTrial& t);
 
 struct Prediction {
   double zstop_m = NAN, tstop_s = NAN, apeak_m_s2 = NAN;
   bool stopped = false;
 };
 /// Integrates m dv/dt = m g - R from the trial's impact speed (RK4) to the stop.
-Prediction predict(const FittedModel& m, const TrialInfo& info);
+Prediction predict(const FittedModel& m, const Trial& info);
 Prediction predict(const FittedModel& m, const TermContext& trial, double t_max_s = 10.0);
 
 /// Per-trial held-out results of grouped K-fold cross-validation (whole trials held out).

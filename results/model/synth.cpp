@@ -41,8 +41,11 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
   const FittedModel tm = truth_model(truth, o.gravity_m_s2, o.mass_kg, o.diameter_m);
   std::ofstream csv(fs::path(dir) / "trials.csv");
   if (!csv) throw std::runtime_error(fmt::format("{}: cannot write trials.csv", dir));
-  csv << "trial_id,trace_file,gravity_m_s2,impact_velocity_m_s,fill_height_m,projectile_mass_kg,"
-         "projectile_diameter_m,grain_diameter_m,bulk_density_kg_m3,sample_rate_hz\n";
+  // The required columns of the trial record, in the order of its field table (trial.h).
+  std::string header;
+  for (const auto& f : trial_fields())
+    if (f.csv_required) header += (header.empty() ? "" : ",") + std::string(f.key);
+  csv << header << "\n";
   int id = 0;
   for (std::size_t gi = 0; gi < o.gravity_m_s2.size(); ++gi) {
     const double g = o.gravity_m_s2[gi];

@@ -174,6 +174,8 @@ void validate(const Trace& tr) {
   if (!tr.velocity_down_m_s.empty() && tr.velocity_down_m_s.size() != n)
     throw std::invalid_argument(fmt::format("velocity_m_s has {} samples but t_s has {}",
                                             tr.velocity_down_m_s.size(), n));
+  if (tr.source == TraceSource::dem && (tr.velocity_down_m_s.empty() || tr.depth_m.empty()))
+    throw std::invalid_argument("a DEM trace carries its own velocity and depth; this one has none");
   if (n < 8)
     throw std::invalid_argument(fmt::format("trace too short: {} samples, at least 8 expected", n));
   for (std::size_t i = 0; i < n; ++i) {
@@ -186,6 +188,14 @@ void validate(const Trace& tr) {
 }
 
 }  // namespace
+
+const char* to_string(TraceSource s) { return s == TraceSource::dem ? "dem" : "lab"; }
+
+TraceSource trace_source_of(const std::string& s) {
+  if (s == "lab") return TraceSource::lab;
+  if (s == "dem") return TraceSource::dem;
+  throw std::invalid_argument(fmt::format("trace source '{}': expected 'lab' or 'dem'", s));
+}
 
 std::vector<double> butterworth_lowpass(const std::vector<double>& x, double sample_rate_hz,
                                         double cutoff_hz, int order) {
@@ -249,9 +259,11 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
   const std::size_t head = std::max<std::size_t>(1, ipk / 3);
   std::vector<double> h(af.begin(), af.begin() + static_cast<std::ptrdiff_t>(head));
   std::nth_element(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(h.size() / 2), h.end());
-  // Simulated traces (they carry their own velocity and depth) have no sensor: no bias removal.
-  const bool simulated = !trace.velocity_down_m_s.empty() && !trace.depth_m.empty();
-  double bias = simulated ? 0.0 : h[h.size() / 2] + g;
+  // The source decides the bias: a lab record has a sensor (its bias is removed), a DEM record has
+  // none, whatever columns either carries. Own velocity and depth are used when present.
+  const bool sensor = trace.source == TraceSource::lab;
+  const bool own_kinematics = !trace.velocity_down_m_s.empty() && !trace.depth_m.empty();
+  double bias = sensor ? h[h.size() / 2] + g : 0.0;
 
   const double end_level = o.end_threshold_g * g;
   // Edge width: a zero-phase Butterworth spreads (and rings around) a step over about fs/fc
@@ -281,7 +293,7 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
     std::vector<double> v_pass, z_pass;
     const std::vector<double>* speed = nullptr;
     double vc_pass = 0;
-    if (simulated) {
+    if (own_kinematics) {
       speed = &trace.velocity_down_m_s;
       vc_pass = interp_at(t, trace.velocity_down_m_s, m.t_start_s);
     } else if (o.impact_velocity_m_s) {
@@ -337,7 +349,7 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
       b_sum += static_cast<double>(n_rest) * mean_of(af, rest_begin, n);
       w_sum += static_cast<double>(n_rest);
     }
-    if (w_sum > 0 && !simulated) bias = b_sum / w_sum;
+    if (w_sum > 0 && sensor) bias = b_sum / w_sum;
     out.free_fall_samples = n_ff;
     out.rest_samples = n_rest;
   }
@@ -349,7 +361,7 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
   // Velocity and depth: the trace's own when present (DEM), else integrated from the impact speed.
   out.velocity_down_m_s.assign(n, 0.0);
   out.depth_m.assign(n, 0.0);
-  if (!trace.velocity_down_m_s.empty() && !trace.depth_m.empty()) {
+  if (own_kinematics) {
     out.velocity_down_m_s = trace.velocity_down_m_s;
     out.depth_m = trace.depth_m;
     m.vc_m_s = interp_at(t, out.velocity_down_m_s, m.t_start_s);

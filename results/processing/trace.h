@@ -11,9 +11,14 @@
 #include <string>
 #include <vector>
 
+#include "results/processing/trace_source.h"
+
 namespace gravsweep::results {
 
 struct Trace {
+  /// Lab: a sensor record (its constant bias is removed from free fall and rest). DEM: no sensor,
+  /// no bias, own velocity and depth required. Never inferred from the columns present.
+  TraceSource source = TraceSource::lab;
   std::vector<double> t_s;
   std::vector<double> accel_up_m_s2;
   /// Optional (DEM traces have them; lab records usually not): same length as t_s when present.

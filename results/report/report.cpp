@@ -51,11 +51,16 @@ void write_report_data(const std::string& dir, const Campaign& c,
   {
     auto f = open_out(D / "trials.csv");
     f << "trial_id,gravity_m_s2,vc_m_s,fill_height_m,drop_height_m,apeak_m_s2,zstop_m,tstop_s,rebound\n";
+    const std::vector<double> levels = c.gravity_levels();
     for (const auto& t : c.trials) {
       const auto& m = t.processed.metrics;
+      // The level's value (same_gravity_level), so the plots group as the fits do.
+      double level = t.info.gravity_m_s2;
+      for (double g : levels)
+        if (same_gravity_level(g, level)) level = g;
       const double drop = t.info.drop_height_m > 0 ? t.info.drop_height_m
                                                    : m.vc_m_s * m.vc_m_s / (2 * t.info.gravity_m_s2);
-      f << fmt::format("{},{},{},{},{},{},{},{},{}\n", t.info.trial_id, t.info.gravity_m_s2, m.vc_m_s,
+      f << fmt::format("{},{},{},{},{},{},{},{},{}\n", t.info.trial_id, level, m.vc_m_s,
                        t.info.fill_height_m, drop, m.apeak_m_s2, m.zstop_m, m.tstop_s, m.rebound ? 1 : 0);
     }
   }
@@ -98,7 +103,7 @@ void write_report_data(const std::string& dir, const Campaign& c,
       double vmax = 0, mass = 0, H = 0, Dm = 0;
       int n = 0;
       for (const auto& t : c.trials)
-        if (t.info.gravity_m_s2 == r.g_m_s2) {
+        if (same_gravity_level(t.info.gravity_m_s2, r.g_m_s2)) {
           vmax = std::max(vmax, t.processed.metrics.vc_m_s);
           mass += t.info.projectile_mass_kg, H += t.info.fill_height_m, Dm += t.info.projectile_diameter_m;
           ++n;

@@ -5,14 +5,16 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <string>
 
 #include "results/measurements/campaign.h"
 #include "results/report/table.h"
+#include "scheduler/cli/campaign_input.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
-#include "scheduler/db/sqlite.h"
+#include "db/sqlite.h"
 
 namespace gravsweep::cli {
 
@@ -22,7 +24,9 @@ struct ImportOptions {
   std::string dir;
   std::string db = "campaign.db";
   std::string format = "table";
+  std::vector<std::string> where;
   double cutoff_hz = 500.0;
+  bool keep_going = false;
 };
 
 }  // namespace
@@ -33,16 +37,27 @@ void setup_measurements(CLI::App& app) {
   auto o = std::make_shared<ImportOptions>();
   auto* imp = sub->add_subcommand(
       "import",
-      "Read DIR/trials.csv and DIR/traces/*.csv, filter each trace (2nd-order Butterworth,\n"
-      "500 Hz, zero phase), remove the sensor bias from the free-fall and rest segments,\n"
-      "integrate a into v and z from the reported impact speed, find the collision start and\n"
-      "end (0.1 g, with the speed below 10 % of vc), and store trials, processed samples and\n"
-      "metrics (vc, apeak, zstop, tstop) in the SQLite file (tables trials, trial_samples,\n"
-      "trial_metrics). A bad row or trace is reported by file:line:column and does not stop the\n"
-      "others (exit code 4 then).\n\n"
-      "Example:\n"
-      "  gravsweep measurements import ../shared/data/measurements/depth-friction-dev --db lab.db");
-  imp->add_option("dir", o->dir, "campaign folder (holds trials.csv and traces/)")->required();
+      "Read a campaign and store it in SQLite (tables trials, trial_samples, trial_metrics): a lab\n"
+      "campaign folder (DIR/trials.csv and DIR/traces/*.csv, RFC 4180 CSV, optional UTF-8 BOM), a\n"
+      "campaign database from `submit`/`work` (every finished drop job is a trial, read from\n"
+      "<campaign>.files/traces/), or an SQLite file of an earlier import. Each trace is filtered\n"
+      "(2nd-order Butterworth, 500 Hz or the scenario's cut-off, zero phase); a lab record's sensor\n"
+      "bias is removed from its free-fall and rest segments and a is integrated into v and z from\n"
+      "the reported impact speed (a DEM trace has no sensor and carries its own v and z); then the\n"
+      "collision start and end (0.1 g, with the speed below 10 % of vc) and the metrics (vc, apeak,\n"
+      "zstop, tstop). Bad input (a row, a trace, a declared sample rate the timestamps contradict, a\n"
+      "gap in a record, a trace_file outside the campaign folder) is listed by file:line:column and\n"
+      "nothing is written (exit code 2) unless --keep-going stores the good trials (exit code 4).\n"
+      "DEM trials that cannot be measured (no contact, a rebound) are listed with the reason.\n\n"
+      "Examples:\n"
+      "  gravsweep measurements import ../shared/data/measurements/depth-friction-dev --db lab.db\n"
+      "  gravsweep measurements import campaign.db --db trials.db --where 'gravity_m_s2<2'");
+  imp->add_option("dir", o->dir,
+                  "lab campaign folder (trials.csv and traces/), campaign database from `submit`/`work`, or "
+                  "imported SQLite file")
+      ->required();
+  imp->add_option("--where", o->where, "filter the trials, grammar of `gravsweep results` (e.g. 'gravity_m_s2<1')");
+  imp->add_flag("--keep-going", o->keep_going, "store the good trials even when some are bad input (exit code 4)");
   imp->add_option("--db", o->db, "SQLite file to store into (created if missing)")->capture_default_str();
   imp->add_option("--cutoff", o->cutoff_hz, "low-pass cut-off, Hz")->capture_default_str();
   imp->add_option("--format", o->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
@@ -50,10 +65,12 @@ void setup_measurements(CLI::App& app) {
   auto runs_out = std::make_shared<std::string>();
   auto* fr = sub->add_subcommand(
       "from-runs",
-      "Make a measurement campaign from DEM runs: finds every trace.h5 written by `gravsweep run`\n"
-      "under the given folders and writes OUT/trials.csv pointing at them (gravity, impact speed\n"
-      "from the trace, fill height, projectile, sampling rate, code version), so that `measurements\n"
-      "import`, `model rank`, `model fit` and `report` treat simulations like laboratory records.\n\n"
+      "Make a measurement campaign folder from DEM runs: finds every trace.h5 written by `gravsweep\n"
+      "run` and every campaign trace (<campaign>.files/traces/<job>.a<n>.h5) under the given folders,\n"
+      "links (or copies) them into OUT/traces/ and writes OUT/trials.csv (gravity, impact speed from\n"
+      "the trace, fill height, projectile, sampling rate, the scenario's filter settings, code\n"
+      "version), so that `measurements import`, `model rank`, `model fit` and `report` treat\n"
+      "simulations like laboratory records. (They also read a campaign database directly.)\n\n"
       "Example:\n"
       "  gravsweep measurements from-runs runs/ --out runs-campaign && gravsweep model rank runs-campaign");
   fr->add_option("runs", *runs, "run folders (searched recursively) or trace.h5 files")->required();
@@ -63,7 +80,8 @@ void setup_measurements(CLI::App& app) {
     const int n = results::write_campaign_from_runs(*runs, *runs_out, issues);
     for (const auto& is : issues) std::fprintf(stderr, "error: %s\n", is.to_string().c_str());
     fmt::print("{} DEM trials written to {}/trials.csv\n", n, *runs_out);
-    if (n == 0) throw UsageError("no readable trace.h5 under the given folders");
+    if (n == 0)
+      throw UsageError("no readable trace.h5 (run folders) or <campaign>.files/traces/*.h5 under the given folders");
     if (!issues.empty()) {
       std::fflush(stdout);
       std::exit(kExitIncomplete);
@@ -71,28 +89,37 @@ void setup_measurements(CLI::App& app) {
   });
 
   imp->callback([o]() {
-    results::Campaign c;
-    try {
-      c = results::load_campaign(o->dir, o->cutoff_hz);
-    } catch (const std::runtime_error& e) {
-      throw UsageError(e.what());
-    }
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (fs::exists(o->db) && fs::equivalent(o->db, o->dir, ec))
+      throw UsageError(fmt::format("--db '{}': the campaign read; another file expected", o->db));
+    auto in = load_campaign_input(o->dir, o->where, o->cutoff_hz);
+    describe_input(o->dir, in);
+    const results::Campaign& c = in.campaign;
+    std::size_t bad = 0;
+    for (const auto& is : c.issues) bad += is.kind == results::ImportIssue::Kind::bad_input;
+    if (bad > 0 && !o->keep_going)
+      throw UsageError(fmt::format("{}: {} trial{} with bad input (listed above); nothing written to {} "
+                                   "(--keep-going stores the others)",
+                                   o->dir, bad, bad == 1 ? "" : "s", o->db));
+    if (c.trials.empty())
+      throw UsageError(fmt::format("{}: no usable trials; nothing written to {}", o->dir, o->db));
     int stored = 0;
     {
       db::Database db(o->db);
       stored = results::store_campaign(db, c);
     }
-    results::Table t({"trial_id", "gravity_m_s2", "vc_m_s", "apeak_m_s2", "zstop_mm", "tstop_ms",
+    results::Table t({"trial_id", "source", "gravity_m_s2", "vc_m_s", "apeak_m_s2", "zstop_mm", "tstop_ms",
                       "bias_m_s2", "rebound"});
     for (const auto& tr : c.trials) {
       const auto& m = tr.processed.metrics;
-      t.add({tr.info.trial_id, results::num(tr.info.gravity_m_s2), results::num(m.vc_m_s),
-             results::num(m.apeak_m_s2), results::num(1e3 * m.zstop_m), results::num(1e3 * m.tstop_s),
-             results::num(tr.processed.bias_m_s2, 3), m.rebound ? "yes" : "no"});
+      t.add({tr.info.trial_id, results::to_string(tr.info.source), results::num(tr.info.gravity_m_s2),
+             results::num(m.vc_m_s), results::num(m.apeak_m_s2), results::num(1e3 * m.zstop_m),
+             results::num(1e3 * m.tstop_s), results::num(tr.processed.bias_m_s2, 3), m.rebound ? "yes" : "no"});
     }
     t.print(o->format);
-    for (const auto& is : c.issues) std::fprintf(stderr, "error: %s/%s\n", o->dir.c_str(), is.to_string().c_str());
-    std::fprintf(stderr, "%d trials stored in %s, %zu rejected\n", stored, o->db.c_str(), c.issues.size());
+    std::fprintf(stderr, "%d trials stored in %s (read from %s: %s), %zu not usable\n", stored, o->db.c_str(),
+                 o->dir.c_str(), in.kind.c_str(), c.issues.size());
     if (!c.issues.empty()) {  // finished, but some trials failed: exit code 4
       std::fflush(stdout);
       std::exit(kExitIncomplete);

@@ -15,6 +15,7 @@
 #include "results/model/synth.h"
 #include "results/report/report.h"
 #include "results/report/table.h"
+#include "scheduler/cli/campaign_input.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
 
@@ -24,28 +25,30 @@ namespace {
 
 using results::num;
 
+constexpr const char* kDirHelp =
+    "campaign database from `submit`/`work` (every finished drop is a trial), SQLite file from "
+    "`measurements import`, or lab campaign folder";
+constexpr const char* kWhereHelp =
+    "filter the trials, grammar of `gravsweep results` (e.g. 'gravity_m_s2<1'); repeatable";
+
 struct ModelOptions {
   std::string dir;
   std::string model = "base+depth_friction";
   std::string baseline = "base";
   std::string format = "table";
   std::string plot;
+  std::vector<std::string> where;
   int folds = 6;
   double alpha = 0.01;
   double min_improvement = 0.03;
 };
 
-results::Campaign load(const std::string& dir) {
-  try {
-    auto c = results::load_campaign_any(dir);
-    for (const auto& is : c.issues) std::fprintf(stderr, "warning: skipped %s/%s\n", dir.c_str(), is.to_string().c_str());
-    if (c.trials.size() < 6)
-      throw UsageError(fmt::format("{}: only {} usable trials; at least 6 are needed", dir, c.trials.size()));
-    return c;
-  } catch (const std::runtime_error& e) {
-    if (dynamic_cast<const UsageError*>(&e)) throw;
-    throw UsageError(e.what());
-  }
+results::Campaign load(const std::string& dir, const std::vector<std::string>& where) {
+  auto in = load_campaign_input(dir, where);
+  describe_input(dir, in);
+  if (in.campaign.trials.size() < 6)
+    throw UsageError(fmt::format("{}: only {} usable trials; at least 6 are needed", dir, in.campaign.trials.size()));
+  return std::move(in.campaign);
 }
 
 results::ModelSpec spec_of(const std::string& s) {
@@ -127,11 +130,13 @@ void setup_model(CLI::App& app) {
       "table3",
       "The paper's method (Sunday et al. 2021 Sect. 4): per gravity level fit Eq. 2 to apeak(vc),\n"
       "print f0, 1/d1, vt (Eq. 5) and alpha (zstop ~ H^alpha) with standard errors, as Table 3.\n\n"
-      "Example:\n  gravsweep model table3 ../shared/data/measurements/depth-friction-dev");
-  t3->add_option("dir", o3->dir, "campaign folder, or an SQLite file from `measurements import`")->required();
+      "Examples:\n  gravsweep model table3 ../shared/data/measurements/depth-friction-dev\n"
+      "  gravsweep model table3 campaign.db --where 'impact_speed_m_s>=0.5'");
+  t3->add_option("dir", o3->dir, kDirHelp)->required();
+  t3->add_option("--where", o3->where, kWhereHelp);
   t3->add_option("--format", o3->format, "table, csv or json")->capture_default_str();
   t3->callback([o3]() {
-    const auto c = load(o3->dir);
+    const auto c = load(o3->dir, o3->where);
     results::Table t({"gravity_m_s2", "trials", "f0_N", "f0_se_N", "inv_d1_1_m", "inv_d1_se_1_m", "vt_m_s",
                       "vt_se_m_s", "alpha", "alpha_se"});
     for (const auto& r : results::table3(c))
@@ -151,7 +156,8 @@ void setup_model(CLI::App& app) {
       "  gravsweep model fit ../shared/data/measurements/depth-friction-dev --model base+depth_friction\n"
       "  gravsweep model fit DIR --model spec.json --plot fall.png --format csv\n"
       "The figure of the error falling is written to --plot (default error_falls.png).");
-  fit->add_option("dir", of->dir, "campaign folder, or an SQLite file from `measurements import`")->required();
+  fit->add_option("dir", of->dir, kDirHelp)->required();
+  fit->add_option("--where", of->where, kWhereHelp);
   fit->add_option("--model", of->model, "model: 'base+depth_friction' or a JSON spec file")->capture_default_str();
   fit->add_option("--baseline", of->baseline, "the 'before' model")->capture_default_str();
   fit->add_option("--folds", of->folds, "cross-validation folds (whole trials)")->check(CLI::Range(2, 100))->capture_default_str();
@@ -162,7 +168,7 @@ void setup_model(CLI::App& app) {
   fit->add_option("--format", of->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
   fit->callback([of, no_plot]() {
     if (*no_plot) of->plot.clear();
-    const auto c = load(of->dir);
+    const auto c = load(of->dir, of->where);
     const auto base = spec_of(of->baseline);
     const auto spec = spec_of(of->model);
     const auto fm = results::fit_model(spec, c);
@@ -202,11 +208,12 @@ void setup_model(CLI::App& app) {
       "with eta^2 (share of residual variance the binning explains) and a sign test over trials\n"
       "of the within-trial slope.\n\n"
       "Example:\n  gravsweep model residuals ../shared/data/measurements/depth-friction-dev --model base");
-  res->add_option("dir", ores->dir, "campaign folder, or an SQLite file from `measurements import`")->required();
+  res->add_option("dir", ores->dir, kDirHelp)->required();
+  res->add_option("--where", ores->where, kWhereHelp);
   res->add_option("--model", ores->model, "model: 'base' or a JSON spec file")->capture_default_str();
   res->add_option("--format", ores->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
   res->callback([ores]() {
-    const auto c = load(ores->dir);
+    const auto c = load(ores->dir, ores->where);
     const auto fm = results::fit_model(spec_of(ores->model), c);
     results::Table t({"trial_id", "gravity_m_s2", "vc_m_s", "fill_height_m", "trace_rms_m_s2", "dzstop_mm",
                       "dtstop_ms", "dapeak_m_s2"});
@@ -293,16 +300,18 @@ void setup_model(CLI::App& app) {
       "a Wilcoxon signed-rank test over trials (not samples), Bonferroni over candidates. Adds the winner and\n"
       "repeats while a term is significant, then says which effect is missing, 'no missing\n"
       "effect found', or 'structure left that no candidate explains' with where it lies.\n\n"
-      "Example:\n  gravsweep model rank ../shared/data/measurements/depth-friction-dev");
+      "Examples:\n  gravsweep model rank ../shared/data/measurements/depth-friction-dev\n"
+      "  gravsweep model rank campaign.db          # the drops of `gravsweep submit` + `work`");
   rank->alias("discover");
-  rank->add_option("dir", orank->dir, "campaign folder, or an SQLite file from `measurements import`")->required();
+  rank->add_option("dir", orank->dir, kDirHelp)->required();
+  rank->add_option("--where", orank->where, kWhereHelp);
   rank->add_option("--baseline", orank->baseline, "starting model")->capture_default_str();
   rank->add_option("--folds", orank->folds, "cross-validation folds")->check(CLI::Range(2, 100))->capture_default_str();
   rank->add_option("--alpha", orank->alpha, "family-wise significance level")->capture_default_str();
   rank->add_option("--min-improvement", orank->min_improvement, "minimum mean relative improvement")->capture_default_str();
   rank->add_option("--format", orank->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
   rank->callback([orank]() {
-    const auto c = load(orank->dir);
+    const auto c = load(orank->dir, orank->where);
     const auto base = spec_of(orank->baseline);
     const auto d = results::discover(c, base, orank->folds, orank->alpha, orank->min_improvement);
     if (orank->format == "table") fmt::print("Where {} fails (residual a_meas - a_model in units of g):\n", d.baseline);

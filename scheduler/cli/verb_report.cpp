@@ -7,10 +7,12 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "results/model/model.h"
 #include "results/report/report.h"
 #include "results/report/table.h"
+#include "scheduler/cli/campaign_input.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
 
@@ -19,6 +21,7 @@ namespace gravsweep::cli {
 namespace {
 struct ReportOptions {
   std::string dir, out = "report", baseline = "base", model;
+  std::vector<std::string> where;
   int folds = 6;
 };
 }  // namespace
@@ -32,21 +35,22 @@ void setup_report(CLI::App& app) {
       "model lines), residual_vs_depth_speed.png (coloured by gravity), fig10_zstop_vs_H.png,\n"
       "ranking.png and error_falls.png, plus the CSV files behind them. Without --model the\n"
       "missing effect is searched for (as `gravsweep model rank`) and the winner is added.\n\n"
-      "Example:\n"
-      "  gravsweep report ../shared/data/measurements/depth-friction-dev --out report-dev");
-  sub->add_option("dir", o->dir, "campaign folder, or an SQLite file from `measurements import`")->required();
+      "Examples:\n"
+      "  gravsweep report ../shared/data/measurements/depth-friction-dev --out report-dev\n"
+      "  gravsweep report campaign.db --out report-sweep    # the drops of `submit` + `work`");
+  sub->add_option("dir", o->dir,
+                  "campaign database from `submit`/`work` (every finished drop is a trial), SQLite file from "
+                  "`measurements import`, or lab campaign folder")
+      ->required();
+  sub->add_option("--where", o->where, "filter the trials, grammar of `gravsweep results` (e.g. 'gravity_m_s2<1')");
   sub->add_option("--out", o->out, "report folder")->capture_default_str();
   sub->add_option("--baseline", o->baseline, "the 'before' model")->capture_default_str();
   sub->add_option("--model", o->model, "the 'after' model (default: baseline + discovered terms)");
   sub->add_option("--folds", o->folds, "cross-validation folds")->check(CLI::Range(2, 100))->capture_default_str();
   sub->callback([o]() {
-    results::Campaign c;
-    try {
-      c = results::load_campaign_any(o->dir);
-    } catch (const std::runtime_error& e) {
-      throw UsageError(e.what());
-    }
-    for (const auto& is : c.issues) std::fprintf(stderr, "warning: skipped %s/%s\n", o->dir.c_str(), is.to_string().c_str());
+    auto in = load_campaign_input(o->dir, o->where);
+    describe_input(o->dir, in);
+    const results::Campaign& c = in.campaign;
     if (c.trials.size() < 6) throw UsageError(fmt::format("{}: only {} usable trials", o->dir, c.trials.size()));
     results::ModelSpec base, after;
     try {
@@ -78,10 +82,12 @@ void setup_report(CLI::App& app) {
     // Summary page.
     namespace fs = std::filesystem;
     std::ofstream md(fs::path(o->out) / "summary.md");
-    md << fmt::format("# Model vs measurements: {}\n\n", o->dir);
+    md << fmt::format("# Model vs measurements: {} ({})\n\n", o->dir, in.kind);
     md << fmt::format("{} trials, gravity levels:", c.trials.size());
     for (double g : c.gravity_levels()) md << fmt::format(" {} m/s2", g);
-    md << fmt::format(". {} rejected.\n\n## Verdict\n\n{}\n\n", c.issues.size(), d.verdict);
+    md << fmt::format(". {} not usable{}\n\n", c.issues.size(), c.issues.empty() ? "." : ":");
+    for (const auto& is : c.issues) md << fmt::format("- {}\n", is.to_string());
+    md << fmt::format("{}## Verdict\n\n{}\n\n", c.issues.empty() ? "" : "\n", d.verdict);
     md << fmt::format("## Where {} fails\n\nResidual a_meas - a_model (in g) by quantile bins of each axis; eta2 is the share "
                       "of the residual variance the bins explain, the sign test counts trials whose within-trial slope "
                       "is up or down.\n\n```\n", d.baseline);

@@ -3,11 +3,13 @@
 
 #include <cmath>
 #include <filesystem>
+#include <algorithm>
 #include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "results/measurements/trial.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/filter.h"
@@ -27,6 +29,7 @@ struct ResultsOptions {
   std::string sort;
   std::string format = "table";
   std::string out;
+  std::vector<std::string> group_by;
   long limit = -1;
   bool full = false;
   bool all = false;
@@ -44,8 +47,148 @@ std::string cell(const nlohmann::json& v, bool for_table, const std::string& col
   return s;
 }
 
+/// stdout, or --out (temporary name, then renamed).
+void write_text(const ResultsOptions& o, const std::string& text, std::size_t n, const char* what) {
+  if (o.out.empty()) {
+    fmt::print("{}", text);
+    return;
+  }
+  const std::string tmp = o.out + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    if (!f) throw std::runtime_error(fmt::format("--out: cannot write '{}'", tmp));
+    f << text;
+    if (!f) throw std::runtime_error(fmt::format("--out: write error on '{}'", tmp));
+  }
+  std::filesystem::rename(tmp, o.out);
+  fmt::print(stderr, "{} {} written to {}\n", n, what, o.out);
+}
+
+/// `--group-by a,b`: per group of equal keys (gravity columns grouped by results::same_gravity_level,
+/// the rule of every verb) the mean, sample standard deviation and count of each metric.
+struct Group {
+  std::vector<nlohmann::json> key;
+  std::size_t rows = 0;
+  std::vector<std::vector<double>> values;  ///< per metric, the non-null numbers
+};
+
+bool same_key(const nlohmann::json& a, const nlohmann::json& b, const std::string& col) {
+  if (a.is_number() && b.is_number()) {
+    const double x = a.get<double>(), y = b.get<double>();
+    return col.rfind("gravity", 0) == 0 ? results::same_gravity_level(x, y) : x == y;
+  }
+  return a == b;
+}
+
+std::vector<std::string> metric_columns(db::Database& db) {
+  std::vector<std::string> m;
+  db::Statement st(db, "SELECT name FROM results_columns WHERE role='metric' AND sql_type IN ('REAL','INTEGER') "
+                       "ORDER BY position");
+  while (st.step()) m.push_back(st.get_text(0));
+  return m;
+}
+
+std::string group_text(const ResultsOptions& o, db::Database& db, std::size_t& n_groups) {
+  std::vector<std::string> metrics = o.columns;
+  if (metrics.empty()) {
+    metrics = metric_columns(db);
+    if (o.format == "table" && !o.all) {
+      std::vector<std::string> paper;
+      for (const char* m : {"vc_m_s", "apeak_m_s2", "zstop_m", "tstop_s"})
+        if (std::find(metrics.begin(), metrics.end(), m) != metrics.end()) paper.emplace_back(m);
+      metrics = paper;
+    }
+  }
+  std::vector<std::string> cols = o.group_by;
+  cols.insert(cols.end(), metrics.begin(), metrics.end());
+  queue::ResultsTable t;
+  try {
+    t = queue::query_results(db, queue::ResultsQuery{o.where, cols, o.sweep, "", -1});
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  const std::size_t nk = o.group_by.size();
+  std::vector<Group> groups;
+  for (const auto& r : t.rows) {
+    Group* g = nullptr;
+    for (auto& x : groups) {
+      bool eq = true;
+      for (std::size_t k = 0; k < nk && eq; ++k) eq = same_key(x.key[k], r[k], o.group_by[k]);
+      if (eq) g = &x;
+    }
+    if (!g) {
+      groups.push_back({std::vector<nlohmann::json>(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(nk)), 0,
+                        std::vector<std::vector<double>>(metrics.size())});
+      g = &groups.back();
+    }
+    ++g->rows;
+    for (std::size_t m = 0; m < metrics.size(); ++m)
+      if (r[nk + m].is_number()) g->values[m].push_back(r[nk + m].get<double>());
+  }
+  std::stable_sort(groups.begin(), groups.end(), [&](const Group& a, const Group& b) {
+    for (std::size_t k = 0; k < nk; ++k) {
+      if (same_key(a.key[k], b.key[k], o.group_by[k])) continue;
+      if (a.key[k].is_number() && b.key[k].is_number()) return a.key[k].get<double>() < b.key[k].get<double>();
+      return a.key[k].dump() < b.key[k].dump();
+    }
+    return false;
+  });
+  auto stats = [](const std::vector<double>& v) {
+    double mean = 0, ss = 0;
+    for (double x : v) mean += x;
+    mean = v.empty() ? NAN : mean / static_cast<double>(v.size());
+    for (double x : v) ss += (x - mean) * (x - mean);
+    const double sd = v.size() > 1 ? std::sqrt(ss / static_cast<double>(v.size() - 1)) : NAN;
+    return std::pair<double, double>{mean, sd};
+  };
+  n_groups = groups.size();
+  if (o.format == "json") {
+    nlohmann::json arr = nlohmann::json::array();
+    for (const auto& g : groups) {
+      nlohmann::json obj = nlohmann::json::object(), ms = nlohmann::json::object();
+      for (std::size_t k = 0; k < nk; ++k) obj[o.group_by[k]] = g.key[k];
+      obj["rows"] = g.rows;
+      for (std::size_t m = 0; m < metrics.size(); ++m) {
+        const auto [mean, sd] = stats(g.values[m]);
+        ms[metrics[m]] = {{"mean", std::isfinite(mean) ? nlohmann::json(mean) : nlohmann::json(nullptr)},
+                          {"std", std::isfinite(sd) ? nlohmann::json(sd) : nlohmann::json(nullptr)},
+                          {"count", g.values[m].size()}};
+      }
+      obj["metrics"] = std::move(ms);
+      arr.push_back(std::move(obj));
+    }
+    return arr.dump(2) + "\n";
+  }
+  queue::TextTable tt;
+  tt.header = o.group_by;
+  tt.header.emplace_back("rows");
+  for (const auto& m : metrics)
+    for (const char* s : {"_mean", "_std", "_count"}) tt.header.push_back(m + s);
+  const bool table = o.format == "table";
+  for (const auto& g : groups) {
+    std::vector<std::string> cells;
+    for (std::size_t k = 0; k < nk; ++k) cells.push_back(cell(g.key[k], table, o.group_by[k], o.full));
+    cells.push_back(std::to_string(g.rows));
+    for (std::size_t m = 0; m < metrics.size(); ++m) {
+      const auto [mean, sd] = stats(g.values[m]);
+      cells.push_back(std::isfinite(mean) ? cell(mean, table, "", o.full) : (table ? "-" : ""));
+      cells.push_back(std::isfinite(sd) ? cell(sd, table, "", o.full) : (table ? "-" : ""));
+      cells.push_back(std::to_string(g.values[m].size()));
+    }
+    tt.rows.push_back(std::move(cells));
+  }
+  return table ? queue::render_table(tt) + fmt::format("({} group{})\n", groups.size(), groups.size() == 1 ? "" : "s")
+               : queue::render_csv(tt);
+}
+
 void run_results(const ResultsOptions& o) {
   db::Database db = queue::open_campaign(o.db, queue::OpenMode::read);
+  if (!o.group_by.empty()) {
+    std::size_t n = 0;
+    const std::string text = group_text(o, db, n);
+    write_text(o, text, n, "groups");
+    return;
+  }
   // A table shows the swept parameters and the paper's metrics unless asked for more; CSV and JSON
   // exports carry every column.
   const bool summary = o.format == "table" && o.columns.empty() && !o.all;
@@ -81,19 +224,7 @@ void run_results(const ResultsOptions& o) {
       text += fmt::format("({} more columns: --all, --columns a,b,... or --format csv)\n", more);
     }
   }
-  if (o.out.empty()) {
-    fmt::print("{}", text);
-  } else {
-    const std::string tmp = o.out + ".tmp";
-    {
-      std::ofstream f(tmp, std::ios::binary);
-      if (!f) throw std::runtime_error(fmt::format("--out: cannot write '{}'", tmp));
-      f << text;
-      if (!f) throw std::runtime_error(fmt::format("--out: write error on '{}'", tmp));
-    }
-    std::filesystem::rename(tmp, o.out);
-    fmt::print(stderr, "{} rows written to {}\n", t.rows.size(), o.out);
-  }
+  write_text(o, text, t.rows.size(), "rows");
 }
 
 }  // namespace
@@ -112,12 +243,19 @@ void setup_results(CLI::App& app) {
       "  gravsweep results --db campaign.db\n"
       "  gravsweep results --db campaign.db --where 'gravity_m_s2<1' --format csv --out low_g.csv\n"
       "  gravsweep results --db campaign.db --where 'gravity_m_s2>=1 and speed_m_s=2' --format json\n"
-      "  gravsweep results --db campaign.db --columns gravity_m_s2,apeak_m_s2 --sort gravity_m_s2");
+      "  gravsweep results --db campaign.db --columns gravity_m_s2,apeak_m_s2 --sort gravity_m_s2\n"
+      "  gravsweep results --db campaign.db --group-by gravity_m_s2,impact_speed_m_s\n\n"
+      "--group-by: one row per group of equal values (gravity levels equal to a relative 1e-6), with\n"
+      "the number of rows and each metric's mean, sample standard deviation and count of values (the\n"
+      "paper's error bars over repeats); the table shows vc, apeak, zstop and tstop unless --all or\n"
+      "--columns names the metrics; CSV and JSON carry every numeric metric.");
   sub->add_option("--db", opt->db, "campaign database")->capture_default_str();
   sub->add_option("--where", opt->where, "filter, e.g. 'gravity_m_s2<1' (repeatable)");
   sub->add_option("--columns", opt->columns, "columns to show, comma separated")->delimiter(',');
   sub->add_option("--sweep", opt->sweep, "only this sweep");
   sub->add_option("--sort", opt->sort, "order by this column");
+  sub->add_option("--group-by", opt->group_by, "group by these columns, comma separated: mean, std, count per metric")
+      ->delimiter(',');
   sub->add_option("--limit", opt->limit, "at most this many rows");
   sub->add_option("--format", opt->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
   sub->add_option("--out", opt->out, "write to this file (temporary name, then renamed) instead of stdout");

@@ -11,6 +11,7 @@
 #include "engine/scenario/paper_params.h"
 #include "results/io/bed_file.h"
 #include "results/io/trace_file.h"
+#include "results/measurements/campaign.h"
 #include "results/processing/trace.h"
 #include "scheduler/pipeline/scenario_spec.h"
 
@@ -197,13 +198,14 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   td.bed_file = std::filesystem::absolute(bed_in).string();
   td.code_version = GRAVSWEEP_VERSION;
 
-  // Sect. 2.3: Butterworth 500 Hz, start = end of free fall, end = a below 0.1 g (and speed below
-  // 10 % of vc, MetricOptions::end_speed_fraction).
-  results::MetricOptions mo = p.metric_options;
-  mo.fill_height_m = bed.surface_height_m;  // the floor lies this far below the mean surface
+  // Sect. 2.3 through the one processing entry (results::process_trial): the trial's facts from
+  // the trace (fill height = the measured surface height) and the scenario's /output settings,
+  // exactly as a campaign reading this trace back measures it.
   json m;
   try {
-    const results::Metrics r = results::compute_metrics(td.to_trace(), mo);
+    results::MeasuredTrial trial = results::dem_trial_of(td, {"", "", trace_out});
+    results::process_trial(trial);
+    const results::Metrics& r = trial.processed.metrics;
     m = json{{"vc_m_s", r.vc_m_s},     {"apeak_m_s2", r.apeak_m_s2}, {"zstop_m", r.zstop_m},
              {"tstop_s", r.tstop_s},   {"t_start_s", r.t_start_s},   {"t_end_s", r.t_end_s},
              {"rebound", r.rebound},   {"note", r.note}};

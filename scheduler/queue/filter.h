@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "scheduler/db/sqlite.h"
+#include "db/sqlite.h"
 
 namespace gravsweep::queue {
 

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "scheduler/db/sqlite.h"
+#include "db/sqlite.h"
 #include "scheduler/sweep/spec.h"
 
 namespace gravsweep::queue {

@@ -1,5 +1,9 @@
 // Helpers for the results/ tests: temporary folders and the shared dev campaign.
 #pragma once
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -22,6 +26,21 @@ struct TempDir {
   TempDir& operator=(const TempDir&) = delete;
   [[nodiscard]] std::string str() const { return path.string(); }
 };
+
+/// The exit code and output of the real `gravsweep` binary (stderr too when merge_stderr).
+struct CliRun {
+  int code;
+  std::string out;
+};
+inline CliRun run_gravsweep(const std::string& args, bool merge_stderr) {
+  const std::string cmd = std::string("'") + GRAVSWEEP_BINARY + "' " + args + (merge_stderr ? " 2>&1" : " 2>/dev/null");
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf{};
+  while (p && fgets(buf.data(), buf.size(), p)) out += buf.data();
+  const int st = p ? pclose(p) : -1;
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
 
 /// ../shared/data/measurements/depth-friction-dev relative to the source tree.
 inline std::string dev_campaign() {

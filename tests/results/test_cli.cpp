@@ -17,19 +17,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Run {
-  int code;
-  std::string out;
-};
-
+using Run = gravsweep::testing::CliRun;
 Run run(const std::string& args, bool merge_stderr = false) {
-  const std::string cmd = std::string("'") + GRAVSWEEP_BINARY + "' " + args + (merge_stderr ? " 2>&1" : " 2>/dev/null");
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf{};
-  while (p && fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int st = p ? pclose(p) : -1;
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+  return gravsweep::testing::run_gravsweep(args, merge_stderr);
 }
 
 }  // namespace
@@ -48,7 +38,10 @@ TEST(Cli, ImportReportsBadTraceAndExitsIncomplete) {
   const std::string c = d.str() + "/c";
   ASSERT_EQ(run("synth --out '" + c + "' --gravity 9.81 --speeds 0.5,1.0 --repeats 1").code, 0);
   std::ofstream(c + "/traces/S002.csv") << "t_s,accel_m_s2\n0,-9.81\n0.001,abc\n";
-  const auto r = run("measurements import '" + c + "' --db '" + d.str() + "/x.db'", true);
+  const auto refused = run("measurements import '" + c + "' --db '" + d.str() + "/x.db'", true);
+  EXPECT_EQ(refused.code, 2) << refused.out;  // bad input: nothing written unless --keep-going
+  EXPECT_FALSE(fs::exists(d.path / "x.db"));
+  const auto r = run("measurements import '" + c + "' --db '" + d.str() + "/x.db' --keep-going", true);
   EXPECT_EQ(r.code, 4) << r.out;
   EXPECT_NE(r.out.find("traces/S002.csv:3:2"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("S001"), std::string::npos) << r.out;  // the other trial went through

@@ -7,41 +7,13 @@
 #include <numbers>
 #include <random>
 
+#include "poncelet.h"
 #include "results/processing/trace.h"
 
 using namespace gravsweep::results;
+using gravsweep::testing::Poncelet;
 
 namespace {
-
-struct Poncelet {
-  double g = 9.81, m = 1.0, f0 = 25.0, inv_d1 = 25.0, v0 = 0.8;
-  double A() const { return f0 / m - g; }
-  double d1() const { return 1.0 / inv_d1; }
-  // force-laws.md 2.3-A (Murdoch-type): closed forms.
-  double zstop() const { return 0.5 * d1() * std::log(1.0 + v0 * v0 / (A() * d1())); }
-  double tstop() const { return std::sqrt(d1() / A()) * std::atan(v0 / std::sqrt(A() * d1())); }
-  double apeak() const { return A() + v0 * v0 / d1(); }
-  /// Upward acceleration tc seconds after contact (free fall before, rest after).
-  double accel_up(double tc) const {
-    if (tc < 0) return -g;
-    if (tc >= tstop()) return 0.0;
-    double v, z;
-    state(tc, v, z);
-    return A() + v * v * inv_d1;
-  }
-  /// Exact velocity (down) and depth tc seconds after contact (free fall before; tc <= tstop).
-  void state(double tc, double& v, double& z) const {
-    if (tc < 0) {
-      v = v0 + g * tc;
-      z = v0 * tc + 0.5 * g * tc * tc;
-      return;
-    }
-    const double th0 = std::atan(v0 / std::sqrt(A() * d1()));
-    const double ph = th0 - tc * std::sqrt(A() / d1());
-    v = std::sqrt(A() * d1()) * std::tan(ph);
-    z = d1() * std::log(std::cos(ph) / std::cos(th0));
-  }
-};
 
 Trace sample(const Poncelet& p, double fs, double t_contact, double noise_g, double bias_g,
              unsigned seed) {
@@ -138,6 +110,7 @@ TEST(Metrics, PaperTable3ExperimentRowAt1g) {
 TEST(Metrics, UsesTraceVelocityAndDepthWhenPresent) {
   Poncelet p;
   Trace tr = sample(p, 10000, 0.01, 0.0, 0.0, 1);
+  tr.source = TraceSource::dem;
   for (double t : tr.t_s) {
     const double tc = std::clamp(t - 0.01, -1.0, p.tstop());
     double v, z;
@@ -200,6 +173,7 @@ TEST(Metrics, SimulatedTracesGetNoBiasAndShortDipsDoNotEndTheCollision) {
   // sensor bias (simulations have none).
   Poncelet p;
   Trace tr = sample(p, 10000, 0.01, 0.0, 0.0, 1);
+  tr.source = TraceSource::dem;
   for (std::size_t i = 0; i < tr.t_s.size(); ++i) {
     const double t = tr.t_s[i];
     const double tc = std::clamp(t - 0.01, -1.0, p.tstop());
@@ -226,6 +200,7 @@ TEST(Metrics, ALullBetweenBurstsDoesNotEndTheCollision) {
   const double g = 9.81, fs = 10000, dt = 1.0 / fs, v0 = 0.75, burst = 40.0;
   const double t_contact = 0.02, t_lull = t_contact + 0.005, t_resume = t_lull + 0.015;
   Trace tr;
+  tr.source = TraceSource::dem;
   double v = v0 - g * t_contact, z = -(v0 * t_contact - 0.5 * g * t_contact * t_contact);
   double t_rest = -1, z_rest = 0;
   for (int i = 0; i * dt < 0.2; ++i) {
@@ -269,6 +244,7 @@ namespace {
 /// contact lasts only t_contact seconds.
 Trace dem_record(const Poncelet& p, double fs, double t_contact) {
   Trace tr;
+  tr.source = TraceSource::dem;
   const double T = t_contact + p.tstop() + 0.08;
   for (int i = 0; i * (1.0 / fs) < T; ++i) {
     const double t = i / fs, tc = std::min(t - t_contact, p.tstop());

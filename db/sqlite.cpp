@@ -1,4 +1,4 @@
-#include "scheduler/db/sqlite.h"
+#include "db/sqlite.h"
 
 #include <fmt/format.h>
 

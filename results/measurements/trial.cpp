@@ -1,0 +1,83 @@
+// The one trial record and its field table (see trial.h).
+#include "results/measurements/trial.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace gravsweep::results {
+
+const std::vector<TrialField>& trial_fields() {
+  // key (JSON, CSV, SQLite), trace.h5 attribute, unit, required in trials.csv, member.
+  static const std::vector<TrialField> fields = {
+      {"trial_id", nullptr, "", true, nullptr, &Trial::trial_id},
+      {"trace_file", nullptr, "", true, nullptr, &Trial::trace_file},
+      {"gravity_m_s2", "gravity_m_s2", "m/s2", true, &Trial::gravity_m_s2, nullptr},
+      {"impact_velocity_m_s", nullptr, "m/s", true, &Trial::impact_velocity_m_s, nullptr},
+      {"fill_height_m", "fill_height_m", "m", true, &Trial::fill_height_m, nullptr},
+      {"projectile_mass_kg", "projectile_mass_kg", "kg", true, &Trial::projectile_mass_kg, nullptr},
+      {"projectile_diameter_m", "projectile_diameter_m", "m", true, &Trial::projectile_diameter_m, nullptr},
+      {"grain_diameter_m", "grain_diameter_m", "m", true, &Trial::grain_diameter_m, nullptr},
+      {"bulk_density_kg_m3", nullptr, "kg/m3", true, &Trial::bulk_density_kg_m3, nullptr},
+      {"sample_rate_hz", "sample_rate_hz", "Hz", true, &Trial::sample_rate_hz, nullptr},
+      {"drop_height_m", nullptr, "m", false, &Trial::drop_height_m, nullptr},
+      {"filter_cutoff_hz", nullptr, "Hz", false, &Trial::filter_cutoff_hz, nullptr},
+      {"end_threshold_g", nullptr, "1", false, &Trial::end_threshold_g, nullptr},
+      {"end_speed_fraction", nullptr, "1", false, &Trial::end_speed_fraction, nullptr},
+      {"job_id", nullptr, "", false, nullptr, &Trial::job_id},
+      {"code_version", nullptr, "", false, nullptr, &Trial::code_version},
+  };
+  return fields;
+}
+
+void to_json(nlohmann::json& j, const Trial& t) {
+  j = nlohmann::json::object();
+  j["source"] = to_string(t.source);
+  for (const auto& f : trial_fields()) {
+    if (f.number) j[f.key] = t.*f.number;
+    else j[f.key] = t.*f.text;
+  }
+  j["attributes"] = t.attributes;
+}
+
+void from_json(const nlohmann::json& j, Trial& t) {
+  t = Trial{};
+  if (j.contains("source")) t.source = trace_source_of(j.at("source").get<std::string>());
+  for (const auto& f : trial_fields()) {
+    if (!j.contains(f.key) || j.at(f.key).is_null()) continue;
+    if (f.number) t.*f.number = j.at(f.key).get<double>();
+    else t.*f.text = j.at(f.key).get<std::string>();
+  }
+  if (j.contains("attributes") && j.at("attributes").is_object())
+    t.attributes = j.at("attributes").get<std::map<std::string, std::string>>();
+}
+
+MetricOptions metric_options(const Trial& t) {
+  MetricOptions o;
+  o.gravity_m_s2 = t.gravity_m_s2;
+  o.cutoff_hz = t.filter_cutoff_hz;
+  o.end_threshold_g = t.end_threshold_g;
+  o.end_speed_fraction = t.end_speed_fraction;
+  o.impact_velocity_m_s = t.impact_velocity_m_s;
+  o.fill_height_m = t.fill_height_m;
+  o.grain_diameter_m = t.grain_diameter_m;
+  o.projectile_diameter_m = t.projectile_diameter_m;
+  return o;
+}
+
+bool same_gravity_level(double a, double b) {
+  return std::abs(a - b) <= 1e-6 * std::max(std::abs(a), std::abs(b));
+}
+
+std::vector<double> gravity_levels_of(const std::vector<double>& gs) {
+  std::vector<double> levels;
+  for (double g : gs)
+    if (std::none_of(levels.begin(), levels.end(), [&](double x) { return same_gravity_level(x, g); }))
+      levels.push_back(g);
+  std::sort(levels.rbegin(), levels.rend());
+  return levels;
+}
+
+}  // namespace gravsweep::results

@@ -1,0 +1,79 @@
+// The one trial record: what is known about one impact before its trace is processed, whether a
+// laboratory record (trials.csv, shared/formats/measurements.md) or a DEM drop (trace.h5 of
+// `gravsweep run` or of a campaign's drop job). Every representation of these fields (CSV header,
+// SQLite column of the imported `trials` table, HDF5 attribute of trace.h5, JSON key) comes from
+// the one table trial_fields(); nothing else lists them.
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "results/processing/trace.h"
+#include "results/processing/trace_source.h"
+
+namespace gravsweep::results {
+
+struct Trial {
+  std::string trial_id;
+  TraceSource source = TraceSource::lab;
+  std::string trace_file;             ///< relative to the campaign folder (lab) or absolute (dem)
+  double gravity_m_s2 = 0;
+  double impact_velocity_m_s = 0;     ///< downward speed at first contact
+  double fill_height_m = 0;
+  double projectile_mass_kg = 0;
+  double projectile_diameter_m = 0;
+  double grain_diameter_m = 0;
+  double bulk_density_kg_m3 = 0;
+  double sample_rate_hz = 0;          ///< declared; checked against the timestamps
+  double drop_height_m = 0;           ///< 0 when absent; v = sqrt(2 g h) when the speed is empty
+  // Processing settings (Sunday et al. 2021 Sect. 2.3): the scenario's /output settings for a DEM
+  // drop, the import's --cutoff and the paper's values for a lab record.
+  double filter_cutoff_hz = 500.0;
+  double end_threshold_g = 0.1;
+  double end_speed_fraction = 0.1;
+  // Provenance.
+  std::string job_id;                 ///< campaign drop job (dem), empty otherwise
+  std::string code_version;           ///< gravsweep version that wrote a DEM trace
+  std::map<std::string, std::string> attributes;  ///< other trials.csv columns, kept as they are
+};
+
+/// One problem found while reading: file (relative to the campaign), 1-based line and column
+/// (0 when not applicable) and what was expected.
+struct ImportIssue {
+  std::string file;
+  int line = 0;
+  int column = 0;
+  std::string message;
+  /// bad_input: the campaign's files are wrong (import refuses them); unmeasurable: a valid DEM
+  /// trace whose metrics cannot be found (no contact before the time cap, a rebound).
+  enum class Kind { bad_input, unmeasurable } kind = Kind::bad_input;
+  [[nodiscard]] std::string to_string() const;
+};
+
+/// One field of Trial and its names everywhere. A field is numeric (`number`) or text (`text`).
+struct TrialField {
+  const char* key;         ///< JSON key, CSV header and SQLite column (one name: units in it)
+  const char* hdf5_attr;   ///< attribute of /trace in trace.h5 that holds it, nullptr if none
+  const char* unit;        ///< SI unit ("" for text)
+  bool csv_required;       ///< required column of trials.csv (measurements.md)
+  double Trial::*number;   ///< nullptr for text fields
+  std::string Trial::*text;
+};
+/// The table, in the order of trials.csv's required columns first.
+const std::vector<TrialField>& trial_fields();
+
+void to_json(nlohmann::json& j, const Trial& t);
+void from_json(const nlohmann::json& j, Trial& t);
+
+/// The processing options of a trial: the one place MetricOptions are made from trial facts.
+MetricOptions metric_options(const Trial& t);
+
+/// The one gravity-level rule of every verb: two gravities are one level when they agree to
+/// a relative 1e-6 (a level typed as 1.62 and computed as 1.6200000001 are one level).
+bool same_gravity_level(double a_m_s2, double b_m_s2);
+/// The distinct levels of a list of gravities, sorted descending (the first value of each level).
+std::vector<double> gravity_levels_of(const std::vector<double>& g_m_s2);
+
+}  // namespace gravsweep::results

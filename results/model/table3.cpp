@@ -1,0 +1,131 @@
+// Collision models (see model.h): the paper's method, Table 3 (Sect. 4, Eqs. 2-5).
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+#include "results/model/model.h"
+#include "results/model/model_internal.h"
+
+namespace gravsweep::results {
+
+using namespace detail;
+
+// ---------------------------------------------------------------------------------------------
+// The paper's method: Table 3
+
+namespace {
+
+std::vector<Table3Row> table3_of(const Campaign& c, const std::vector<bool>& mask) {
+  std::vector<Table3Row> rows;
+  for (double g : c.gravity_levels()) {
+    std::vector<const MeasuredTrial*> ts;
+    for (std::size_t i = 0; i < c.trials.size(); ++i)
+      if (mask[i] && same_gravity_level(c.trials[i].info.gravity_m_s2, g)) ts.push_back(&c.trials[i]);
+    Table3Row r;
+    r.g_m_s2 = g;
+    r.trials = static_cast<int>(ts.size());
+    if (ts.size() < 3) {
+      rows.push_back(r);
+      continue;
+    }
+    const auto n = static_cast<Eigen::Index>(ts.size());
+    Eigen::MatrixXd X(n, 2), Xl(n, 2);
+    Eigen::VectorXd y(n), yl(n);
+    double mass = 0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const auto& m = ts[static_cast<std::size_t>(i)]->processed.metrics;
+      const auto& info = ts[static_cast<std::size_t>(i)]->info;
+      mass += info.projectile_mass_kg / static_cast<double>(n);
+      X(i, 0) = 1.0;
+      X(i, 1) = m.vc_m_s * m.vc_m_s;
+      y(i) = m.apeak_m_s2;  // Eq. 2: apeak = f0/m + vc^2/d1 - g
+      const double drop = info.drop_height_m > 0 ? info.drop_height_m : m.vc_m_s * m.vc_m_s / (2 * g);
+      Xl(i, 0) = 1.0;
+      Xl(i, 1) = std::log(drop + m.zstop_m);  // H = drop height + zstop (Fig. 10)
+      yl(i) = std::log(std::max(m.zstop_m, 1e-9));
+    }
+    auto ols = [](const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::Vector2d& beta,
+                  Eigen::Matrix2d& cov) {
+      beta = A.colPivHouseholderQr().solve(b);
+      const double dof = std::max<double>(1.0, static_cast<double>(A.rows()) - 2.0);
+      const double s2 = (b - A * beta).squaredNorm() / dof;
+      cov = s2 * (A.transpose() * A).inverse();
+    };
+    Eigen::Vector2d b, bl;
+    Eigen::Matrix2d cv, cvl;
+    ols(X, y, b, cv);
+    ols(Xl, yl, bl, cvl);
+    r.f0_N = mass * (b(0) + g);
+    r.f0_se_N = mass * std::sqrt(cv(0, 0));
+    r.inv_d1_1_m = b(1);
+    r.inv_d1_se_1_m = std::sqrt(cv(1, 1));
+    if (r.f0_N > 0 && r.inv_d1_1_m > 0) {
+      // Eq. 5: vt = sqrt(d1 f0 / m); delta method with the covariance of (f0, 1/d1).
+      r.vt_m_s = std::sqrt(r.f0_N / (mass * r.inv_d1_1_m));
+      const double var = 0.25 * r.vt_m_s * r.vt_m_s *
+                         (std::pow(r.f0_se_N / r.f0_N, 2) + std::pow(r.inv_d1_se_1_m / r.inv_d1_1_m, 2) -
+                          2 * mass * cv(0, 1) / (r.f0_N * r.inv_d1_1_m));
+      r.vt_se_m_s = std::sqrt(std::max(0.0, var));
+    }
+    r.alpha = bl(1);
+    r.alpha_se = std::sqrt(cvl(1, 1));
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+}  // namespace
+
+std::vector<Table3Row> table3(const Campaign& c) {
+  return table3_of(c, std::vector<bool>(c.trials.size(), true));
+}
+
+Prediction predict_paper(const Table3Row& row, double m, double vc) {
+  Prediction p;
+  const double g = row.g_m_s2, f0 = row.f0_N, inv_d1 = row.inv_d1_1_m;
+  p.apeak_m_s2 = f0 / m + vc * vc * inv_d1 - g;  // Eq. 2
+  if (!(f0 > m * g) || !(inv_d1 > 0)) return p;
+  const double d1 = 1.0 / inv_d1;
+  p.zstop_m = 0.5 * d1 * std::log(1.0 + m * vc * vc / (d1 * (f0 - m * g)));           // Eq. 3
+  p.tstop_s = std::atan(vc * std::sqrt(m / (d1 * (f0 - m * g)))) /
+              std::sqrt((f0 / m - g) / d1);                                            // Eq. 4
+  p.stopped = true;
+  return p;
+}
+
+HeldOut cross_validate_paper(const Campaign& c, int folds, unsigned seed) {
+  HeldOut h;
+  h.trace_mse.assign(c.trials.size(), NAN);
+  h.pred.assign(c.trials.size(), Prediction{});
+  const auto f = fold_of(c, folds, seed);
+  for (int k = 0; k < folds; ++k) {
+    std::vector<bool> mask(c.trials.size());
+    for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = f[i] != k;
+    const auto rows = table3_of(c, mask);
+    for (std::size_t i = 0; i < mask.size(); ++i) {
+      if (mask[i]) continue;
+      const auto& t = c.trials[i];
+      for (const auto& r : rows)
+        if (r.g_m_s2 == t.info.gravity_m_s2)
+          h.pred[i] = predict_paper(r, t.info.projectile_mass_kg, t.processed.metrics.vc_m_s);
+      // Trace residual of Eq. 1 with the Table 3 f0, d1 (per gravity level).
+      for (const auto& r : rows)
+        if (r.g_m_s2 == t.info.gravity_m_s2) {
+          double s = 0;
+          std::size_t n = 0;
+          for (std::size_t q = t.fit_begin; q < t.fit_end; ++q, ++n) {
+            const double v = t.processed.velocity_down_m_s[q];
+            const double a_model = r.f0_N / t.info.projectile_mass_kg + r.inv_d1_1_m * v * v - r.g_m_s2;
+            s += std::pow(t.processed.accel_up_m_s2[q] - a_model, 2);
+          }
+          if (n) h.trace_mse[i] = s / static_cast<double>(n);
+        }
+    }
+  }
+  return h;
+}
+
+}  // namespace gravsweep::results

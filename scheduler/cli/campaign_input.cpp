@@ -1,0 +1,168 @@
+#include "scheduler/cli/campaign_input.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+
+#include "db/sqlite.h"
+#include "scheduler/cli/exit_codes.h"
+#include "scheduler/queue/filter.h"
+#include "scheduler/queue/queue.h"
+
+namespace gravsweep::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+bool has_table(db::Database& db, const char* name) {
+  db::Statement q(db, "SELECT 1 FROM sqlite_master WHERE type='table' AND name=?");
+  q.bind(1, name);
+  return q.step();
+}
+
+/// Every finished drop of a campaign database (filtered on its results table) as a DEM trial.
+CampaignInput load_queue_campaign(const std::string& path, db::Database& db, const std::vector<std::string>& where) {
+  CampaignInput in;
+  in.kind = "campaign database (submit/work)";
+  queue::ResultsQuery q;
+  q.where = where;
+  q.columns = {"job_id", "kind", "trace_path"};
+  queue::ResultsTable t;
+  try {
+    t = queue::query_results(db, q);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("{}: {}", path, e.what()));
+  }
+  const queue::CampaignPaths paths(path);
+  std::vector<results::DemTraceRef> refs;
+  for (const auto& r : t.rows) {
+    if (r[1] != "drop" || !r[2].is_string()) continue;
+    const std::string job = r[0].get<std::string>();
+    refs.push_back({job, job, paths.abs(r[2].get<std::string>())});
+  }
+  {
+    db::Statement st(db, "SELECT state, count(*) FROM jobs WHERE kind='drop' AND state != 'done' GROUP BY state ORDER BY state");
+    while (st.step()) in.note += fmt::format("{}{} drop jobs {}", in.note.empty() ? "" : ", ", st.get_int(1), st.get_text(0));
+    if (!in.note.empty()) in.note += " (not finished: not trials yet; `gravsweep work` runs them)";
+  }
+  in.campaign = results::load_dem_campaign(path, refs);
+  return in;
+}
+
+/// A trial as the row --where sees outside a campaign database: its fields and its metrics.
+nlohmann::json row_of(const results::MeasuredTrial& t) {
+  nlohmann::json j = t.info;
+  j.erase("attributes");
+  for (const auto& [k, v] : t.info.attributes) j[k] = v;
+  const auto& m = t.processed.metrics;
+  j["vc_m_s"] = m.vc_m_s;
+  j["apeak_m_s2"] = m.apeak_m_s2;
+  j["zstop_m"] = m.zstop_m;
+  j["tstop_s"] = m.tstop_s;
+  j["rebound"] = m.rebound;
+  return j;
+}
+
+bool holds(const nlohmann::json& v, const queue::Condition& c) {
+  if (c.op == "~") return v.is_string() ? v.get<std::string>().find(c.value.get<std::string>()) != std::string::npos
+                                        : v.dump().find(c.value.get<std::string>()) != std::string::npos;
+  auto cmp = [&](auto a, auto b) {
+    if (c.op == "<") return a < b;
+    if (c.op == "<=") return a <= b;
+    if (c.op == ">") return a > b;
+    if (c.op == ">=") return a >= b;
+    if (c.op == "=") return a == b;
+    return a != b;
+  };
+  if ((v.is_number() || v.is_boolean()) && (c.value.is_number() || c.value.is_boolean()))
+    return cmp(v.is_boolean() ? double(v.get<bool>()) : v.get<double>(),
+               c.value.is_boolean() ? double(c.value.get<bool>()) : c.value.get<double>());
+  const std::string a = v.is_string() ? v.get<std::string>() : v.dump();
+  const std::string b = c.value.is_string() ? c.value.get<std::string>() : c.value.dump();
+  return cmp(a, b);
+}
+
+void filter_in_memory(const std::string& path, CampaignInput& in, const std::vector<std::string>& where) {
+  if (where.empty()) return;
+  std::vector<std::pair<std::string, std::vector<queue::Condition>>> conds;
+  try {
+    for (const auto& w : where) conds.emplace_back(w, queue::parse_where(w));
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("{}: {}", path, e.what()));
+  }
+  auto& trials = in.campaign.trials;
+  const std::size_t before = trials.size();
+  std::vector<results::MeasuredTrial> kept;
+  for (auto& t : trials) {
+    const nlohmann::json row = row_of(t);
+    bool ok = true;
+    for (const auto& [w, cs] : conds)
+      for (const auto& c : cs) {
+        if (!row.contains(c.column)) {
+          std::string list;
+          for (auto it = row.begin(); it != row.end(); ++it) list += (list.empty() ? "" : ", ") + it.key();
+          throw UsageError(fmt::format("{}: --where '{}': found column '{}', expected one of: {}", path, w, c.column, list));
+        }
+        ok = ok && holds(row.at(c.column), c);
+      }
+    if (ok) kept.push_back(std::move(t));
+  }
+  trials = std::move(kept);
+  in.filtered_out = before - trials.size();
+}
+
+}  // namespace
+
+CampaignInput load_campaign_input(const std::string& path, const std::vector<std::string>& where, double cutoff_hz) {
+  CampaignInput in;
+  try {
+    if (fs::is_directory(path)) {
+      in.kind = "lab campaign folder";
+      in.campaign = results::load_campaign(path, cutoff_hz);
+    } else if (fs::is_regular_file(path)) {
+      if (fs::file_size(path) == 0)
+        throw UsageError(fmt::format("{}: an empty file: a campaign database, an imported SQLite file or a lab "
+                                     "campaign folder expected",
+                                     path));
+      db::Database db(path, 30000, true);
+      if (has_table(db, "jobs") && has_table(db, "results")) return load_queue_campaign(path, db, where);
+      if (!has_table(db, "trials"))
+        throw UsageError(fmt::format("{}: neither a campaign database (tables jobs, results) nor an imported "
+                                     "SQLite file (table trials)",
+                                     path));
+      in.kind = "imported SQLite file";
+      in.campaign = results::load_campaign_db(db);
+    } else {
+      throw UsageError(fmt::format("{}: no such file or folder: a campaign database, an imported SQLite file or "
+                                   "a lab campaign folder expected",
+                                   path));
+    }
+  } catch (const UsageError&) {
+    throw;
+  } catch (const db::DbError& e) {
+    throw UsageError(fmt::format("{}: not an SQLite campaign ({})", path, e.what()));
+  } catch (const std::runtime_error& e) {
+    throw UsageError(e.what());
+  }
+  filter_in_memory(path, in, where);
+  return in;
+}
+
+void describe_input(const std::string& path, const CampaignInput& in) {
+  const auto& c = in.campaign;
+  std::fprintf(stderr, "reading %s: %s, %zu trials", path.c_str(), in.kind.c_str(), c.trials.size());
+  if (in.filtered_out) std::fprintf(stderr, " (%zu left out by --where)", in.filtered_out);
+  if (!c.issues.empty()) std::fprintf(stderr, ", %zu not usable", c.issues.size());
+  std::fprintf(stderr, "\n");
+  if (!in.note.empty()) std::fprintf(stderr, "note: %s\n", in.note.c_str());
+  for (const auto& is : c.issues) {
+    const bool dem = is.kind == results::ImportIssue::Kind::unmeasurable;
+    const std::string where = dem || fs::path(is.file).is_absolute() ? is.to_string() : path + "/" + is.to_string();
+    std::fprintf(stderr, "%s: %s\n", dem ? "not measurable" : "skipped", where.c_str());
+  }
+}
+
+}  // namespace gravsweep::cli

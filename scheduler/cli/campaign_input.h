@@ -1,0 +1,30 @@
+// What the model verbs (`model rank|fit|residuals|table3`, `report`, `measurements import`) read:
+// a campaign database from `submit`/`work` (every finished drop job is a trial, its trace.h5 read
+// from the campaign's files folder), an SQLite file from `measurements import`, or a lab campaign
+// folder (trials.csv + traces/). `--where` filters the trials with the grammar of `gravsweep
+// results` (scheduler/queue/filter.h): on the results table of a campaign database, on the trial
+// fields (results/measurements/trial.h) and metrics otherwise.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "results/measurements/campaign.h"
+
+namespace gravsweep::cli {
+
+struct CampaignInput {
+  results::Campaign campaign;
+  std::string kind;  ///< "campaign database (submit/work)", "imported SQLite file", "lab campaign folder"
+  std::size_t filtered_out = 0;  ///< trials left out by --where
+  std::string note;              ///< e.g. drop jobs not finished
+};
+
+/// Reads `path`; throws UsageError for what is not a campaign or a bad --where.
+CampaignInput load_campaign_input(const std::string& path, const std::vector<std::string>& where,
+                                  double cutoff_hz = 500.0);
+
+/// Prints to stderr what was read ("<path>: <kind>, n trials") and every trial left out with its
+/// reason (unmeasurable or bad input).
+void describe_input(const std::string& path, const CampaignInput& in);
+
+}  // namespace gravsweep::cli
