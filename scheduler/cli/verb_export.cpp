@@ -17,6 +17,8 @@
 
 #include "results/io/bed_file.h"
 #include "results/io/trace_file.h"
+#include "results/measurements/campaign.h"
+#include "results/measurements/trial.h"
 #include "results/processing/resample.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
@@ -40,13 +42,17 @@ struct ExportOptions {
   double rate_hz = 2000;
 };
 
-/// The columns of trials.csv: the format's required ones, then the DEM provenance.
-const std::vector<std::string> kTrialColumns = {
-    "trial_id",          "trace_file",         "gravity_m_s2",          "impact_velocity_m_s",
-    "fill_height_m",     "projectile_mass_kg", "projectile_diameter_m", "grain_diameter_m",
-    "bulk_density_kg_m3", "sample_rate_hz",    "source",                "contact_start_s",
-    "sweep",             "job_id",             "scenario_file",         "dt_s",
-    "grains",            "lateral_offset_m",   "code_version"};
+/// Columns of trials.csv after the trial record's own (results::trial_fields()): the DEM
+/// provenance that the record does not carry.
+const std::vector<std::string> kDemColumns = {"source", "contact_start_s", "sweep", "scenario_file",
+                                              "dt_s", "grains", "lateral_offset_m"};
+
+std::vector<std::string> trials_header() {
+  std::vector<std::string> h;
+  for (const auto& f : results::trial_fields()) h.emplace_back(f.key);
+  h.insert(h.end(), kDemColumns.begin(), kDemColumns.end());
+  return h;
+}
 
 std::string num(double v) { return std::isfinite(v) ? fmt::format("{}", v) : std::string(); }
 
@@ -82,35 +88,31 @@ double write_trace_csv(const fs::path& path, const results::TraceData& td, doubl
   return td.sample_rate_hz / static_cast<double>(step);
 }
 
-std::vector<std::string> trial_row(const std::string& job, const std::string& sweep, const results::TraceData& td,
-                                   const std::optional<results::BedData>& bed, double rate_hz) {
-  const json m = json::parse(td.metrics_json.empty() ? "{}" : td.metrics_json);
-  const results::Trace tr = td.to_trace();
-  const double vc = m.value("vc_m_s", json()).is_number() ? m["vc_m_s"].get<double>() : NAN;
-  double bulk = NAN;
+/// One trials.csv row: the trial record of the drop (read_dem_trial: the same facts and
+/// processing settings the model verbs use), pointing at the exported trace and its rate.
+std::vector<std::string> trial_row(const std::string& job, const std::string& sweep, const fs::path& trace_path,
+                                   const results::TraceData& td, const std::optional<results::BedData>& bed,
+                                   double rate_hz) {
+  results::Trial ti = results::read_dem_trial({job, job, trace_path}).info;
+  ti.trace_file = "traces/" + job + ".csv";
+  ti.sample_rate_hz = rate_hz;
+  ti.bulk_density_kg_m3 = NAN;
   if (bed && !bed->report_json.empty()) {
-    const json r = json::parse(bed->report_json);
-    if (r.contains("bulk_density_kg_m3") && r["bulk_density_kg_m3"].is_number()) bulk = r["bulk_density_kg_m3"];
+    const json r = json::parse(bed->report_json, nullptr, false);
+    if (r.is_object() && r.contains("bulk_density_kg_m3") && r["bulk_density_kg_m3"].is_number())
+      ti.bulk_density_kg_m3 = r["bulk_density_kg_m3"];
   }
-  return {job,
-          "traces/" + job + ".csv",
-          num(td.gravity_m_s2),
-          num(vc),
-          num(td.fill_height_m),
-          num(td.projectile_mass_kg),
-          num(td.projectile_diameter_m),
-          num(td.grain_diameter_m),
-          num(bulk),
-          num(rate_hz),
-          "dem",
-          tr.contact_start_s ? num(*tr.contact_start_s) : std::string(),
-          sweep,
-          job,
-          "scenarios/" + job + ".json",
-          num(td.dt_s),
-          m.contains("grains") ? m["grains"].dump() : std::string(),
-          m.contains("lateral_offset_m") ? num(m["lateral_offset_m"].get<double>()) : std::string(),
-          td.code_version};
+  std::vector<std::string> row;
+  for (const auto& f : results::trial_fields()) row.push_back(f.number ? num(ti.*f.number) : ti.*f.text);
+  const json m = json::parse(td.metrics_json.empty() ? "{}" : td.metrics_json, nullptr, false);
+  const auto metric = [&](const char* k) {
+    return m.is_object() && m.contains(k) && m[k].is_number() ? m[k].dump() : std::string();
+  };
+  const results::Trace tr = td.to_trace();
+  for (std::string v : {std::string("dem"), tr.contact_start_s ? num(*tr.contact_start_s) : std::string(), sweep,
+                        "scenarios/" + job + ".json", num(td.dt_s), metric("grains"), metric("lateral_offset_m")})
+    row.push_back(std::move(v));
+  return row;
 }
 
 void write_text_file(const fs::path& p, const std::string& text) {
@@ -141,16 +143,17 @@ void run_export(const ExportOptions& o) {
   fs::create_directories(out / "traces");
   fs::create_directories(out / "scenarios");
   queue::TextTable trials, results_csv;
-  trials.header = kTrialColumns;
+  trials.header = trials_header();
   results_csv.header = t.columns;
   for (const auto& r : t.rows) {
     if (!r[c_kind].is_string() || r[c_kind].get<std::string>() != "drop" || !r[c_trace].is_string()) continue;
     const std::string job = r[c_job].get<std::string>();
-    const results::TraceData td = results::read_trace(paths.abs(r[c_trace].get<std::string>()));
+    const fs::path trace_path = paths.abs(r[c_trace].get<std::string>());
+    const results::TraceData td = results::read_trace(trace_path);
     const auto bed = bed_of(db, paths, td, r[c_bed].is_string() ? r[c_bed].get<std::string>() : std::string());
     const double rate = write_trace_csv(out / "traces" / (job + ".csv"), td, o.rate_hz);
     write_text_file(out / "scenarios" / (job + ".json"), json::parse(td.scenario_json).dump(2) + "\n");
-    trials.rows.push_back(trial_row(job, r[c_sweep].get<std::string>(), td, bed, rate));
+    trials.rows.push_back(trial_row(job, r[c_sweep].get<std::string>(), trace_path, td, bed, rate));
     std::vector<std::string> cells;
     for (const auto& v : r) cells.push_back(v.is_null() ? "" : v.is_string() ? v.get<std::string>() : v.dump());
     results_csv.rows.push_back(std::move(cells));

@@ -14,9 +14,9 @@
 #include <vector>
 
 #include "results/io/trace_file.h"
+#include "results/measurements/campaign.h"
 #include "results/processing/trace.h"
 #include "results/report/report.h"
-#include "scheduler/pipeline/scenario_spec.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/campaign.h"
@@ -97,18 +97,13 @@ struct PlotTraceOptions {
   std::string trace, out;
 };
 
-/// The campaign's processing of a DEM record (as the drop job does): the scenario's filter and
-/// collision-end settings, the floor at the bed's surface height.
-results::ProcessedTrace process_dem_trace(const results::TraceData& td, const std::string& file) {
-  results::MetricOptions mo;
+/// The campaign's processing of a DEM record: the one processing entry of the model verbs and
+/// the drop job (read_dem_trial + process_trial: the scenario's filter and collision-end settings).
+results::ProcessedTrace process_dem_trace(const std::string& file) {
   try {
-    mo = pipeline::scenario_params(pipeline::validate_scenario(json::parse(td.scenario_json), file)).metric_options;
-  } catch (const std::exception& e) {
-    throw UsageError(fmt::format("{}: the scenario attribute is not a valid scenario ({})", file, e.what()));
-  }
-  mo.fill_height_m = td.surface_height_m;
-  try {
-    return results::process_trace(td.to_trace(), mo);
+    results::MeasuredTrial t = results::read_dem_trial({fs::path(file).stem().string(), "", file});
+    results::process_trial(t);
+    return t.processed;
   } catch (const std::invalid_argument& e) {
     throw UsageError(fmt::format("{}: cannot process the record: {}", file, e.what()));
   }
@@ -125,7 +120,7 @@ void run_plot_trace(const PlotTraceOptions& o) {
   } catch (const std::exception& e) {
     throw UsageError(fmt::format("{}: not a readable gravsweep trace.h5 ({})", o.trace, e.what()));
   }
-  const results::ProcessedTrace p = process_dem_trace(td, o.trace);
+  const results::ProcessedTrace p = process_dem_trace(o.trace);
   ScratchDir tmp;
   {
     std::ofstream f(tmp.path / "trace.csv");

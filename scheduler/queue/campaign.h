@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "scheduler/db/sqlite.h"
+#include "db/sqlite.h"
 
 namespace gravsweep::queue {
 
