@@ -73,6 +73,7 @@ void force_loop(ForceContext& c) {
     const int t = omp_get_thread_num();
     // Thread 0 accumulates straight into the particles' force and torque arrays (one buffer pair
     // per extra thread; the sum below keeps the order gravity + thread 0 + thread 1 + ...).
+    // Nothing reads force_N / torque_N_m between here and the sum.
     Vec3* F = t == 0 ? p.force_N.data() : c.thread_force[t].data();
     Vec3* T = t == 0 ? p.torque_N_m.data() : c.thread_torque[t].data();
     std::fill(F, F + n, Vec3::Zero());
@@ -184,9 +185,12 @@ void force_loop(ForceContext& c) {
     const int nt = omp_get_num_threads();
 #pragma omp for schedule(static)
     for (std::size_t i = 0; i < n; ++i) {
-      Vec3 f = p.force_N[i];
-      if (inv_m[i] > 0) f += M[i] * c.gravity_m_s2;
-      Vec3 tq = p.torque_N_m[i];
+      // The same expression as with a buffer for thread 0 (gravity first, then each thread's
+      // sum): contraction into FMAs and rounding stay those of the former layout.
+      Vec3 f = inv_m[i] > 0 ? Vec3(M[i] * c.gravity_m_s2) : Vec3::Zero();
+      Vec3 tq = Vec3::Zero();
+      f += p.force_N[i];
+      tq += p.torque_N_m[i];
       for (int tt = 1; tt < nt; ++tt) {
         f += c.thread_force[tt][i];
         tq += c.thread_torque[tt][i];
