@@ -5,12 +5,13 @@
 #
 # Installs Debian's lammps + openmpi-bin when `lmp` is missing (apt-get; needs root), converts
 # the gravsweep bed (DIR/bed.h5 of `gravsweep run`) into a LAMMPS data file, writes the LAMMPS
-# input deck of the same contact model and container (bench-lammps/in.bed; the differences
+# input deck of the same contact model and container (build/bench-lammps/in.bed; the differences
 # between the two models are written in the deck), then runs the codes interleaved, ROUNDS times
 # (default 3): gravsweep 1 and 2 threads (`gravsweep bench --bed`), LAMMPS serial and
 # `mpirun -np 2`. Prints every figure, the medians and the ratios LAMMPS / gravsweep.
 # Metric: ns per particle-step = 1e9 x wall time / (steps x grains), STEPS timed steps (default
-# 2000) at dt = 1 us after WARMUP steps (default 500; LAMMPS starts without contact histories).
+# 2000) at dt = 1 us after WARMUP steps for LAMMPS (default 500; it starts without contact
+# histories); `gravsweep bench` warms up 50 steps itself.
 # Timings need an otherwise idle machine; the load average is printed with the results.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -19,7 +20,7 @@ rounds="${2:-3}"
 steps="${3:-2000}"
 warmup="${4:-500}"
 gravsweep="${GRAVSWEEP:-$root/build/scheduler/gravsweep}"
-work="${BENCH_LAMMPS_DIR:-$root/bench-lammps}"
+work="${BENCH_LAMMPS_DIR:-${GRAVSWEEP_BUILD_DIR:-$root/build}/bench-lammps}"  # data file, deck, logs
 mkdir -p "$work"
 
 if ! command -v lmp >/dev/null || ! command -v mpirun >/dev/null; then
