@@ -22,16 +22,23 @@ struct ContactGeometry {
   bool wall;              ///< body 2 is a fixed wall
 };
 
-/// Per-contact state that survives from step to step (and across neighbour-list rebuilds).
-/// One fixed layout for all laws; a law uses the fields it needs.
+/// Per-contact state that survives from step to step (and across neighbour-list rebuilds): the
+/// part every law and model uses, 48 bytes, stored for every listed pair.
 struct ContactHistory {
   Vec3 shear_m = Vec3::Zero();     ///< tangential spring (Chrono delta_t / pkdgrav S)
-  Vec3 n_old = Vec3::Zero();       ///< normal of the previous step (pkdgrav frame rotation)
-  Vec3 roll_rad = Vec3::Zero();    ///< rolling spring angle phi_R (Zhang 2017)
-  double twist_rad = 0;            ///< twisting spring angle phi_Q (Zhang 2017)
   double duration_s = 0;           ///< time since first touch (Chrono contact_duration)
   double gate_s = 0;               ///< Chrono's rolling/spinning activation time t_collision
   bool active = false;             ///< false: no history yet (new contact)
+};
+
+/// The history of the rotating contact frame (pkdgrav's n_old and Zhang's rolling and twisting
+/// springs), 56 bytes. Stored beside ContactHistory only when the law or the rolling model declares
+/// `uses_frame_history` (hooke, zhang); the others get a scratch record that nothing reads.
+/// The force loop resets it together with a new contact's ContactHistory.
+struct FrameHistory {
+  Vec3 n_old = Vec3::Zero();       ///< normal of the previous step (pkdgrav frame rotation)
+  Vec3 roll_rad = Vec3::Zero();    ///< rolling spring angle phi_R (Zhang 2017)
+  double twist_rad = 0;            ///< twisting spring angle phi_Q (Zhang 2017)
 };
 
 /// Law-wide switches, shared by all pairs.

@@ -17,6 +17,8 @@ struct HertzChrono {
   static constexpr const char* description =
       "Chrono::Multicore SMC Hertz law (E, nu, COR -> kn, kt, gn, gt), MultiStep tangential "
       "history projected onto the tangent plane with Coulomb back-solve";
+  /// Needs FrameHistory stored per contact (contact.h).
+  static constexpr bool uses_frame_history = false;
 
   /// Chrono's damping factor -2 sqrt(5/6) beta with beta = ln e / sqrt(ln^2 e + pi^2) >= 0.
   static double damping_factor(double cor) {
@@ -62,7 +64,7 @@ struct HertzChrono {
   }
 
   GRAVSWEEP_INLINE static void evaluate(const ContactGeometry& g, const PairCoefficients& c,
-                       const ContactOptions& opt, ContactHistory& h, double dt_s,
+                       const ContactOptions& opt, ContactHistory& h, FrameHistory& /*fh*/, double dt_s,
                        ContactForce& out) {
     const Vec3& n = g.n;
     const double delta = g.overlap_m;

@@ -17,6 +17,8 @@ struct HookePkdgrav {
   static constexpr const char* description =
       "pkdgrav SSDEM linear spring-dashpot (kN, kT = 2/7 kN by default, damping from eps_n and "
       "eps_t), tangential spring rotated with the contact frame, reset on slip";
+  /// Needs FrameHistory stored per contact (contact.h).
+  static constexpr bool uses_frame_history = true;
 
   /// C = 2 |ln e| sqrt(k mu / (pi^2 + ln^2 e)) = prefactor * sqrt(k mu)  (dem-physics.md 2.1).
   static double damping_prefactor(double cor) {
@@ -69,7 +71,7 @@ struct HookePkdgrav {
   }
 
   GRAVSWEEP_INLINE static void evaluate(const ContactGeometry& g, const PairCoefficients& c,
-                       const ContactOptions& /*opt*/, ContactHistory& h, double dt_s,
+                       const ContactOptions& /*opt*/, ContactHistory& h, FrameHistory& fh, double dt_s,
                        ContactForce& out) {
     const Vec3& n = g.n;
     // Lever arms to the contact plane (2.1); a wall is a sphere of infinite radius.
@@ -97,21 +99,21 @@ struct HookePkdgrav {
     if (!h.active) {
       h = ContactHistory{};
       h.active = true;
-      h.n_old = n;
+      fh.n_old = n;
     } else {
       h.duration_s += dt_s;
-      const Vec3 nbar_raw = h.n_old + n;
+      const Vec3 nbar_raw = fh.n_old + n;
       const double nb = nbar_raw.norm();
       if (nb > 0) {
         const Vec3 nbar = nbar_raw / nb;
         const Vec3 w_sum = g.wall ? g.w1 : Vec3(g.w1 + g.w2);
         const double angle = 0.5 * dt_s * w_sum.dot(nbar);
         const Quat twist(Eigen::AngleAxisd(angle, nbar));
-        const Quat tilt = Quat::FromTwoVectors(h.n_old, n);
+        const Quat tilt = Quat::FromTwoVectors(fh.n_old, n);
         rot = tilt * twist;
         h.shear_m = rot * h.shear_m;
       }
-      h.n_old = n;
+      fh.n_old = n;
     }
     h.shear_m += u_T * dt_s;
     Vec3 FT1 = c.kt_N_m * h.shear_m + cT * u_T;

@@ -73,6 +73,15 @@ ForceFunction select_force_function(std::string_view law, std::string_view rolli
   return f;
 }
 
+bool uses_frame_history(std::string_view law, std::string_view rolling) {
+  bool uses = false;
+  std::apply([&](auto... l) { ((law == decltype(l)::name ? (uses |= decltype(l)::uses_frame_history, 0) : 0), ...); },
+             ContactLaws{});
+  std::apply([&](auto... r) { ((rolling == decltype(r)::name ? (uses |= decltype(r)::uses_frame_history, 0) : 0), ...); },
+             RollingModels{});
+  return uses;
+}
+
 void prepare_contact_law(std::string_view law, PairTable& pairs) {
   std::apply([&](auto... l) {
     ((law == decltype(l)::name ? (pairs.for_each([](PairCoefficients& c) { decltype(l)::prepare(c); }), 0) : 0), ...);

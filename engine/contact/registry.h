@@ -18,6 +18,9 @@ namespace gravsweep {
 /// that list the valid names.
 ForceFunction select_force_function(std::string_view law, std::string_view rolling);
 
+/// True when the law or the rolling model keeps a FrameHistory per contact (contact.h).
+bool uses_frame_history(std::string_view law, std::string_view rolling);
+
 /// Lets the named law cache its per-pair constants (PairCoefficients::damping_n, damping_t).
 void prepare_contact_law(std::string_view law, PairTable& pairs);
 

@@ -37,6 +37,13 @@ class VerletList {
   std::vector<std::uint32_t> offset;
   std::vector<std::uint32_t> neighbor_;
   std::vector<ContactHistory> history;
+  /// Beside history, only when frame histories are kept (set_frame_history); else empty.
+  std::vector<FrameHistory> frame_history;
+
+  /// Keep a FrameHistory per pair (the law or rolling model uses_frame_history). Switching it on
+  /// gives every listed pair an empty record.
+  void set_frame_history(bool keep);
+  [[nodiscard]] bool keeps_frame_history() const { return keep_frame_; }
 
   /// Forget everything (after particles were added: indices changed).
   void clear();
@@ -52,8 +59,9 @@ class VerletList {
  private:
   std::vector<Vec3> position_at_build_;
   double skin_m_ = 0;
+  bool keep_frame_ = false;
   long long builds_ = 0;
-  // Scratch reused across builds.
+  // Scratch of one build (released at its end).
   std::vector<std::uint32_t> cell_start_, cell_particles_, particle_cell_;
   std::vector<std::uint32_t> count_;
 };

@@ -14,9 +14,11 @@ struct RollingSunday {
   static constexpr const char* description =
       "Chrono/Sunday 2020 constant-magnitude rolling (mu_r F_n R) and spinning (mu_t r_c F_n) "
       "torques with activation gate and 1e-4 speed thresholds";
+  /// Needs FrameHistory stored per contact (contact.h).
+  static constexpr bool uses_frame_history = false;
 
   GRAVSWEEP_INLINE static void apply(const ContactGeometry& g, const PairCoefficients& c, const ContactOptions& opt,
-                    ContactHistory& h, double /*dt_s*/, ContactForce& out) {
+                    ContactHistory& h, FrameHistory& /*fh*/, double /*dt_s*/, ContactForce& out) {
     if (h.duration_s <= h.gate_s) return;  // activation gate: mu_r = mu_t = 0 early in a contact
     const Vec3& n = g.n;
     const double Fn = out.normal_force_N;  // signed damped normal force

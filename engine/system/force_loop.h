@@ -21,7 +21,8 @@ struct ForceContext {
   Particles& p;
   const std::vector<Wall>& walls;
   VerletList& nlist;
-  std::vector<ContactHistory>& wall_history;
+  std::vector<ContactHistory>& wall_history;        ///< [candidate]
+  std::vector<FrameHistory>& wall_frame_history;   ///< [candidate], or empty
   const std::vector<std::uint32_t>& wall_candidates;  ///< particle * walls + wall
   const PairTable& pairs;
   const ContactOptions& options;
@@ -44,6 +45,8 @@ inline constexpr double kMaxOverlapFraction = 0.5;
 
 template <class Law, class Rolling>
 void force_loop(ForceContext& c) {
+  // Frame histories are stored only when a model reads them; the others get a scratch record.
+  constexpr bool kFrames = Law::uses_frame_history || Rolling::uses_frame_history;
   Particles& p = c.p;
   const std::size_t n = p.size();
   const std::size_t n_walls = c.walls.size();
@@ -57,6 +60,8 @@ void force_loop(ForceContext& c) {
   const std::uint32_t* off = c.nlist.offset.data();
   const std::uint32_t* nbr = c.nlist.neighbor_.data();
   ContactHistory* hist = c.nlist.history.data();
+  FrameHistory* frames = kFrames ? c.nlist.frame_history.data() : nullptr;
+  FrameHistory* wall_frames = kFrames ? c.wall_frame_history.data() : nullptr;
   const double dt = c.dt_s;
   long long contacts = 0, wall_contacts = 0;
   double energy = 0;
@@ -66,14 +71,18 @@ void force_loop(ForceContext& c) {
 #pragma omp parallel num_threads(c.threads) reduction(+ : contacts, wall_contacts, energy)
   {
     const int t = omp_get_thread_num();
-    Vec3* F = c.thread_force[t].data();
-    Vec3* T = c.thread_torque[t].data();
+    // Thread 0 accumulates straight into the particles' force and torque arrays (one buffer pair
+    // per extra thread; the sum below keeps the order gravity + thread 0 + thread 1 + ...).
+    // Nothing reads force_N / torque_N_m between here and the sum.
+    Vec3* F = t == 0 ? p.force_N.data() : c.thread_force[t].data();
+    Vec3* T = t == 0 ? p.torque_N_m.data() : c.thread_torque[t].data();
     std::fill(F, F + n, Vec3::Zero());
     std::fill(T, T + n, Vec3::Zero());
     long long my_bad_i = -1, my_bad_j = -1;
     double my_ratio = 0;
     ContactForce out;
     ContactGeometry g;
+    FrameHistory scratch;
 #pragma omp for schedule(static) nowait
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3 xi = X[i];
@@ -110,8 +119,10 @@ void force_loop(ForceContext& c) {
           my_bad_j = j;
         }
         const PairCoefficients& pc = c.pairs(mat[i], mat[j]);
-        Law::evaluate(g, pc, c.options, h, dt, out);
-        Rolling::apply(g, pc, c.options, h, dt, out);
+        FrameHistory& fh = kFrames ? frames[k] : scratch;
+        if (!h.active) fh = FrameHistory{};  // a new contact starts with empty springs
+        Law::evaluate(g, pc, c.options, h, fh, dt, out);
+        Rolling::apply(g, pc, c.options, h, fh, dt, out);
         F[i] -= out.force_on_2;
         F[j] += out.force_on_2;
         T[i] += out.torque_1;
@@ -126,7 +137,7 @@ void force_loop(ForceContext& c) {
       for (std::size_t k = 0; k < n_cand; ++k) {
         const std::uint32_t code = c.wall_candidates[k];
         const std::size_t i = code / n_walls, w = code % n_walls;
-        ContactHistory& h = c.wall_history[code];
+        ContactHistory& h = c.wall_history[k];
         WallTouch touch;
         if (!touch_wall(c.walls[w], X[i], R[i], touch)) {
           if (h.active) h.active = false;
@@ -151,8 +162,10 @@ void force_loop(ForceContext& c) {
           my_bad_j = -2 - static_cast<long long>(w);
         }
         const PairCoefficients& pc = c.pairs(mat[i], c.walls[w].material);
-        Law::evaluate(g, pc, c.options, h, dt, out);
-        Rolling::apply(g, pc, c.options, h, dt, out);
+        FrameHistory& fh = kFrames ? wall_frames[k] : scratch;
+        if (!h.active) fh = FrameHistory{};
+        Law::evaluate(g, pc, c.options, h, fh, dt, out);
+        Rolling::apply(g, pc, c.options, h, fh, dt, out);
         F[i] -= out.force_on_2;
         T[i] += out.torque_1;
         ++wall_contacts;
@@ -172,9 +185,13 @@ void force_loop(ForceContext& c) {
     const int nt = omp_get_num_threads();
 #pragma omp for schedule(static)
     for (std::size_t i = 0; i < n; ++i) {
+      // The same expression as with a buffer for thread 0 (gravity first, then each thread's
+      // sum): contraction into FMAs and rounding stay those of the former layout.
       Vec3 f = inv_m[i] > 0 ? Vec3(M[i] * c.gravity_m_s2) : Vec3::Zero();
       Vec3 tq = Vec3::Zero();
-      for (int tt = 0; tt < nt; ++tt) {
+      f += p.force_N[i];
+      tq += p.torque_N_m[i];
+      for (int tt = 1; tt < nt; ++tt) {
         f += c.thread_force[tt][i];
         tq += c.thread_torque[tt][i];
       }

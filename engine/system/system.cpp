@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "engine/contact/registry.h"
@@ -25,16 +26,14 @@ void System::invalidate() {
   have_step_checks_ = false;
   have_forces_ = false;
   nlist_.clear();
+  wall_candidates_.clear();
   wall_history_.clear();
+  wall_frame_history_.clear();
 }
 
 void System::particles_appended() {
-  const std::size_t n = particles.size(), nw = walls.size();
-  nlist_.extend(n);
-  if (nw > 0 && wall_history_.size() % nw == 0 && wall_history_.size() / nw <= n)
-    wall_history_.resize(n * nw, ContactHistory{});
-  else
-    wall_history_.clear();
+  nlist_.extend(particles.size());
+  // Wall candidate codes (particle * walls + wall) of the existing particles are unchanged.
   initialized_ = false;  // thread buffers follow the new size
   rebuild_due_ = true;
   have_step_checks_ = false;
@@ -48,18 +47,24 @@ void System::remove_particles(const std::vector<bool>& remove) {
   for (std::size_t i = 0; i < n; ++i)
     if (!remove[i]) new_index[i] = next++;
   nlist_.remap(new_index);
-  const std::size_t nw = walls.size();
-  if (wall_history_.size() == n * nw) {
-    std::vector<ContactHistory> wh;
-    wh.reserve(static_cast<std::size_t>(next) * nw);
-    for (std::size_t i = 0; i < n; ++i)
-      if (!remove[i])
-        for (std::size_t w = 0; w < nw; ++w) wh.push_back(wall_history_[i * nw + w]);
-    wall_history_ = std::move(wh);
+  // Renumber the wall candidates; the order is kept because new indices are monotone.
+  const std::size_t nw = wall_count_at_build_;
+  std::size_t kept = 0;
+  const bool frames = !wall_frame_history_.empty();
+  for (std::size_t k = 0; k < wall_candidates_.size(); ++k) {
+    const std::size_t i = wall_candidates_[k] / nw, w = wall_candidates_[k] % nw;
+    if (i >= n || new_index[i] < 0) continue;
+    wall_candidates_[kept] = static_cast<std::uint32_t>(static_cast<std::size_t>(new_index[i]) * nw + w);
+    wall_history_[kept] = wall_history_[k];
+    if (frames) wall_frame_history_[kept] = wall_frame_history_[k];
+    ++kept;
   }
+  wall_candidates_.resize(kept);
+  wall_history_.resize(kept);
+  if (frames) wall_frame_history_.resize(kept);
   particles.remove_if(remove);
   initialized_ = false;  // thread buffers and checks follow the new size; histories are kept
-  rebuild_due_ = true;   // wall candidates hold particle indices
+  rebuild_due_ = true;   // wall candidates are rebuilt (their histories carried over)
   have_step_checks_ = false;
 }
 
@@ -118,19 +123,30 @@ void System::initialize() {
     config_.skin_m = std::isfinite(rmin) ? 0.2 * rmin : 1e-3;
   }
   const int nt = threads();
-  thread_force_.assign(nt, std::vector<Vec3>(particles.size(), Vec3::Zero()));
-  thread_torque_.assign(nt, std::vector<Vec3>(particles.size(), Vec3::Zero()));
-  if (wall_history_.size() != particles.size() * walls.size())
-    wall_history_.assign(particles.size() * walls.size(), ContactHistory{});
+  // Thread 0 writes into particles.force_N / torque_N_m: buffers for the other threads only.
+  thread_force_.assign(nt, {});
+  thread_torque_.assign(nt, {});
+  for (int t = 1; t < nt; ++t) {
+    thread_force_[t].assign(particles.size(), Vec3::Zero());
+    thread_torque_[t].assign(particles.size(), Vec3::Zero());
+  }
+  const bool frames = uses_frame_history(config_.contact_law, config_.rolling_model);
   if (nlist_.offset.size() != particles.size() + 1) nlist_.clear();
+  nlist_.set_frame_history(frames);
+  if (wall_count_at_build_ != walls.size() || wall_history_.size() != wall_candidates_.size()) {
+    wall_candidates_.clear();  // walls changed without invalidate(): their histories end
+    wall_history_.clear();
+  }
+  wall_frame_history_.resize(frames ? wall_history_.size() : 0);
   initialized_ = true;
   rebuild_neighbors();
 }
 
 void System::rebuild_neighbors() {
   nlist_.build(particles, config_.skin_m, threads());
-  wall_candidates_.clear();
   const std::size_t nw = walls.size();
+  std::vector<std::uint32_t> cand;
+  cand.reserve(wall_candidates_.size() + 16);
   for (std::size_t i = 0; i < particles.size(); ++i) {
     if (particles.inv_mass_1_kg[i] == 0) continue;
     for (std::size_t w = 0; w < nw; ++w) {
@@ -138,14 +154,28 @@ void System::rebuild_neighbors() {
       WallTouch touch;
       // A wall is a candidate when the particle, grown by the skin, touches it.
       if (touch_wall(walls[w], particles.position_m[i], reach, touch))
-        wall_candidates_.push_back(static_cast<std::uint32_t>(i * nw + w));
+        cand.push_back(static_cast<std::uint32_t>(i * nw + w));
     }
   }
-  // Histories of pairs no longer within reach end now (they cannot be touching).
-  std::vector<char> keep(wall_history_.size(), 0);
-  for (auto c : wall_candidates_) keep[c] = 1;
-  for (std::size_t k = 0; k < wall_history_.size(); ++k)
-    if (!keep[k]) wall_history_[k].active = false;
+  // Carry the histories of pairs still within reach over (both code lists are increasing); the
+  // others end now (they cannot be touching).
+  const bool frames = nlist_.keeps_frame_history();
+  std::vector<ContactHistory> hist(cand.size());
+  std::vector<FrameHistory> frame(frames ? cand.size() : 0);
+  if (wall_count_at_build_ == nw) {
+    std::size_t a = 0;
+    for (std::size_t b = 0; b < cand.size() && a < wall_candidates_.size(); ++b) {
+      while (a < wall_candidates_.size() && wall_candidates_[a] < cand[b]) ++a;
+      if (a < wall_candidates_.size() && wall_candidates_[a] == cand[b]) {
+        hist[b] = wall_history_[a];
+        if (frames && a < wall_frame_history_.size()) frame[b] = wall_frame_history_[a];
+      }
+    }
+  }
+  wall_candidates_ = std::move(cand);
+  wall_history_ = std::move(hist);
+  wall_frame_history_ = std::move(frame);
+  wall_count_at_build_ = nw;
   rebuild_due_ = false;
 }
 
@@ -160,6 +190,7 @@ void System::force_pass(bool displacement_checked) {
                    walls,
                    nlist_,
                    wall_history_,
+                   wall_frame_history_,
                    wall_candidates_,
                    pairs_,
                    config_.options,
@@ -252,9 +283,11 @@ int System::contact_count(ParticleIndex i) const {
   for (std::size_t a = 0; a < n; ++a)
     for (std::uint32_t k = nlist_.offset[a]; k < nlist_.offset[a + 1]; ++k)
       if ((a == i || nlist_.neighbor_[k] == i) && nlist_.history[k].active) ++count;
-  const std::size_t nw = walls.size();
-  for (std::size_t w = 0; w < nw && i * nw + w < wall_history_.size(); ++w)
-    if (wall_history_[i * nw + w].active) ++count;
+  const std::size_t nw = wall_count_at_build_;
+  const auto first = std::lower_bound(wall_candidates_.begin(), wall_candidates_.end(),
+                                      static_cast<std::uint32_t>(i * nw));
+  for (auto it = first; it != wall_candidates_.end() && *it < (i + 1) * nw; ++it)
+    if (wall_history_[static_cast<std::size_t>(it - wall_candidates_.begin())].active) ++count;
   return count;
 }
 
@@ -263,7 +296,9 @@ double System::bytes_per_particle() const {
   const std::size_t per_particle_state =
       7 * sizeof(Vec3) + 4 * sizeof(double) + sizeof(std::uint8_t) + sizeof(SizeClass);
   std::size_t bytes = particles.size() * per_particle_state + nlist_.bytes() +
-                      wall_history_.capacity() * sizeof(ContactHistory);
+                      wall_candidates_.capacity() * sizeof(std::uint32_t) +
+                      wall_history_.capacity() * sizeof(ContactHistory) +
+                      wall_frame_history_.capacity() * sizeof(FrameHistory);
   for (const auto& v : thread_force_) bytes += v.capacity() * sizeof(Vec3);
   for (const auto& v : thread_torque_) bytes += v.capacity() * sizeof(Vec3);
   return static_cast<double>(bytes) / static_cast<double>(n);

@@ -106,7 +106,6 @@ class System {
   VerletList nlist_;
   std::unique_ptr<Integrator> integrator_;
   ForceFunction force_fn_ = nullptr;
-  std::vector<ContactHistory> wall_history_;  ///< [particle * walls + wall]
   std::vector<std::vector<Vec3>> thread_force_, thread_torque_;
   std::vector<int> contact_count_;
   StepStats stats_;
@@ -116,8 +115,13 @@ class System {
   bool have_forces_ = false;
 
   /// Particle-wall pairs within reach (radius + skin) of the wall at the last list build; only
-  /// these are tested each step. Encoded as particle * walls + wall.
+  /// these are tested each step. Encoded as particle * walls + wall, in increasing order; the
+  /// contact histories of these pairs are stored beside them (sparse: a grain away from every
+  /// wall holds none) and carried over, by code, when the candidates are rebuilt.
   std::vector<std::uint32_t> wall_candidates_;
+  std::vector<ContactHistory> wall_history_;        ///< [candidate]
+  std::vector<FrameHistory> wall_frame_history_;    ///< [candidate], when frame histories are kept
+  std::size_t wall_count_at_build_ = 0;             ///< walls.size() the codes were made with
   bool rebuild_due_ = true;   ///< set by the step checks when a particle moved more than skin/2
   /// The last step's end checks measured every displacement. Particles edited between steps
   /// (positions, walls) must be followed by invalidate() or compute_forces().
