@@ -2,6 +2,8 @@
 // retries with backoff, the dead state, release, resume and the results table.
 #include <gtest/gtest.h>
 
+#include <chrono>
+
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -221,6 +223,10 @@ TEST_F(QueueTest, ResumeRequeuesExpiredAndFailedAndRemovesOrphans) {
   std::filesystem::create_directories(paths.tmp());
   test::write_text(paths.abs(a->output_rel), "lost");
   test::write_text(paths.root / "noop" / "ffffffffffffffffffff.a9.json", "orphan");
+  // An orphan is moved only when it is older than the resume's snapshot (issue #10 item 1): this
+  // one was left an hour ago.
+  std::filesystem::last_write_time(paths.root / "noop" / "ffffffffffffffffffff.a9.json",
+                                   std::filesystem::file_time_type::clock::now() - std::chrono::hours(1));
   test::write_text(paths.tmp() / (live->job_id + ".a1.out.json"), "in progress");
   std::this_thread::sleep_for(std::chrono::milliseconds(150));
   const auto rep = resume(db, paths, ResumeOptions{});
