@@ -28,9 +28,15 @@ case "${1:-}" in
     exec "$gs" status --db "$db"
     ;;
   export)
-    rm -rf "$data.tmp"
-    "$gs" export --db "$db" --out "$data.tmp" --rate-hz 2000
-    rm -rf "$data" && mv "$data.tmp" "$data"
+    # One measurement campaign per Table 3 row (a fit mixes every trial of a gravity level), and
+    # the drops of the other parts in results.csv of the campaign database.
+    for part in part1_chrono_1g:chrono_1g part2_chrono_lowg:chrono_0.1g part5_pkdgrav_1g:pkdgrav_1g; do
+      sweep="${part%%:*}"; dir="$data/${part##*:}"
+      rm -rf "$dir.tmp"
+      "$gs" export --db "$db" --sweep "$sweep" --out "$dir.tmp" --rate-hz 2000
+      rm -rf "$dir" && mv "$dir.tmp" "$dir"
+    done
+    "$gs" results --db "$db" --format csv --out "$data/results_all_parts.csv"
     du -sh "$data"
     ;;
   figures)
@@ -44,8 +50,9 @@ case "${1:-}" in
       plot --where 'sweep~_chrono_' --x vc_m_s --y "$y" --group gravity_m_s2 \
         --title "Chrono set, 10 cm (1 g) and 21 cm (0.1 m/s2) fills" --out "$figs/fig9_${y}_vs_vc.png"
     done
-    "$gs" model table3 "$data" | tee "$figs/table3.txt"
-    "$gs" report "$data" --out "$figs/report"
+    for d in "$data"/*/; do "$gs" model table3 "$d"; done | tee "$figs/table3.txt"
+    "$gs" model rank "$db" --where 'sweep~_chrono_' | tee "$figs/model_rank_chrono.txt"
+    "$gs" report "$data/chrono_1g" --out "$figs/report"
     ;;
   *)
     sed -n '2,12p' "${BASH_SOURCE[0]}"
