@@ -83,9 +83,15 @@ ErrorSummary summarize(const Campaign& c, const HeldOut& h);
 struct Table3Row {
   double g_m_s2 = 0;
   int trials = 0;
-  double f0_N = 0, f0_se_N = 0, inv_d1_1_m = 0, inv_d1_se_1_m = 0, vt_m_s = 0, vt_se_m_s = 0;
-  double alpha = 0, alpha_se = 0;
+  double f0_N = NAN, f0_se_N = NAN, inv_d1_1_m = NAN, inv_d1_se_1_m = NAN, vt_m_s = NAN, vt_se_m_s = NAN;
+  double alpha = NAN, alpha_se = NAN;
+  std::string note;  ///< why a level was not fitted (too few trials or speeds); empty when fitted
 };
+/// Eq. 2 is a line in vc^2: a level is fitted only with at least kTable3MinTrials trials whose
+/// collision speeds span at least a factor kTable3MinSpeedRatio (one speed cannot separate f0
+/// from 1/d1).
+inline constexpr int kTable3MinTrials = 3;
+inline constexpr double kTable3MinSpeedRatio = 1.5;
 std::vector<Table3Row> table3(const Campaign& c);
 /// Eqs. 3-4 predictions for a trial from its gravity level's row (NaN when f0 <= m g).
 Prediction predict_paper(const Table3Row& row, double mass_kg, double vc_m_s);

@@ -27,7 +27,16 @@ std::vector<Table3Row> table3_of(const Campaign& c, const std::vector<bool>& mas
     Table3Row r;
     r.g_m_s2 = g;
     r.trials = static_cast<int>(ts.size());
-    if (ts.size() < 3) {
+    double vmin = INFINITY, vmax = 0;
+    for (const auto* t : ts) {
+      vmin = std::min(vmin, t->processed.metrics.vc_m_s);
+      vmax = std::max(vmax, t->processed.metrics.vc_m_s);
+    }
+    if (r.trials < kTable3MinTrials || !(vmax >= kTable3MinSpeedRatio * vmin)) {
+      r.note = ts.empty() ? "no trials"
+                          : fmt::format("not fitted: Eq. 2 needs >= {} trials over a vc range of x{} (found {}, vc "
+                                        "{:.3g}-{:.3g} m/s)",
+                                        kTable3MinTrials, kTable3MinSpeedRatio, r.trials, vmin, vmax);
       rows.push_back(r);
       continue;
     }

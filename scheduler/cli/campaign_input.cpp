@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <set>
 
 #include "db/sqlite.h"
 #include "scheduler/cli/exit_codes.h"
@@ -149,6 +150,35 @@ CampaignInput load_campaign_input(const std::string& path, const std::vector<std
   }
   filter_in_memory(path, in, where);
   return in;
+}
+
+CampaignInput load_campaign_inputs(const std::vector<std::string>& paths, const std::vector<std::string>& where,
+                                   double cutoff_hz) {
+  if (paths.size() == 1) {
+    auto in = load_campaign_input(paths.front(), where, cutoff_hz);
+    describe_input(paths.front(), in);
+    return in;
+  }
+  CampaignInput all;
+  std::set<std::string> kinds, ids;
+  for (const auto& p : paths) {
+    auto in = load_campaign_input(p, where, cutoff_hz);
+    describe_input(p, in);
+    for (auto& t : in.campaign.trials) {
+      if (!ids.insert(t.info.trial_id).second)
+        throw UsageError(fmt::format("{}: trial '{}' is also in an earlier input: each trial may be read once", p,
+                                     t.info.trial_id));
+      all.campaign.trials.push_back(std::move(t));
+    }
+    for (auto& is : in.campaign.issues) all.campaign.issues.push_back(std::move(is));
+    kinds.insert(in.kind);
+    all.filtered_out += in.filtered_out;
+    if (!in.note.empty()) all.note += (all.note.empty() ? "" : "; ") + p + ": " + in.note;
+    all.campaign.directory += (all.campaign.directory.empty() ? "" : " + ") + p;
+  }
+  for (const auto& k : kinds) all.kind += (all.kind.empty() ? "" : " + ") + k;
+  all.kind = fmt::format("{} inputs ({})", paths.size(), all.kind);
+  return all;
 }
 
 void describe_input(const std::string& path, const CampaignInput& in) {

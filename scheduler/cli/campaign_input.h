@@ -23,6 +23,12 @@ struct CampaignInput {
 CampaignInput load_campaign_input(const std::string& path, const std::vector<std::string>& where,
                                   double cutoff_hz = 500.0);
 
+/// Reads several inputs (e.g. one exported dataset per gravity level) into one campaign: each is
+/// read and described (describe_input) in turn, the trials and issues concatenated, `--where`
+/// applied to each. Throws UsageError when a trial id appears in two inputs.
+CampaignInput load_campaign_inputs(const std::vector<std::string>& paths, const std::vector<std::string>& where,
+                                   double cutoff_hz = 500.0);
+
 /// Prints to stderr what was read ("<path>: <kind>, n trials") and every trial left out with its
 /// reason (unmeasurable or bad input).
 void describe_input(const std::string& path, const CampaignInput& in);

@@ -11,6 +11,7 @@
 #include "engine/core/error.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
+#include "scheduler/pipeline/build_version.h"
 
 namespace {
 
@@ -55,7 +56,7 @@ int main(int argc, char** argv) {
       "Run `gravsweep <verb> --help` for each verb, with an example.",
       "gravsweep"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", std::string(GRAVSWEEP_VERSION));
+  app.set_version_flag("--version", std::string(pipeline::build_version()));
   for (SetupFn setup : kVerbs) setup(app);
   try {
     app.parse(argc, argv);

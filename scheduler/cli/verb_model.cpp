@@ -2,6 +2,7 @@
 // campaign. Sub-verbs: terms, table3 (the paper's method), fit (before/after), rank (which
 // effect is missing).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 #include <cstdio>
@@ -27,12 +28,13 @@ using results::num;
 
 constexpr const char* kDirHelp =
     "campaign database from `submit`/`work` (every finished drop is a trial), SQLite file from "
-    "`measurements import`, or lab campaign folder";
+    "`measurements import`, or lab campaign folder; several are read as one campaign (e.g. one "
+    "exported dataset per gravity level)";
 constexpr const char* kWhereHelp =
     "filter the trials, grammar of `gravsweep results` (e.g. 'gravity_m_s2<1'); repeatable";
 
 struct ModelOptions {
-  std::string dir;
+  std::vector<std::string> dir;  ///< one or more inputs, read as one campaign
   std::string model = "base+depth_friction";
   std::string baseline = "base";
   std::string format = "table";
@@ -43,11 +45,11 @@ struct ModelOptions {
   double min_improvement = 0.03;
 };
 
-results::Campaign load(const std::string& dir, const std::vector<std::string>& where) {
-  auto in = load_campaign_input(dir, where);
-  describe_input(dir, in);
+results::Campaign load(const std::vector<std::string>& dir, const std::vector<std::string>& where) {
+  auto in = load_campaign_inputs(dir, where);
   if (in.campaign.trials.size() < 6)
-    throw UsageError(fmt::format("{}: only {} usable trials; at least 6 are needed", dir, in.campaign.trials.size()));
+    throw UsageError(fmt::format("{}: only {} usable trials; at least 6 are needed", fmt::join(dir, " + "),
+                                 in.campaign.trials.size()));
   return std::move(in.campaign);
 }
 
@@ -138,10 +140,11 @@ void setup_model(CLI::App& app) {
   t3->callback([o3]() {
     const auto c = load(o3->dir, o3->where);
     results::Table t({"gravity_m_s2", "trials", "f0_N", "f0_se_N", "inv_d1_1_m", "inv_d1_se_1_m", "vt_m_s",
-                      "vt_se_m_s", "alpha", "alpha_se"});
+                      "vt_se_m_s", "alpha", "alpha_se", "note"});
     for (const auto& r : results::table3(c))
       t.add({num(r.g_m_s2), std::to_string(r.trials), num(r.f0_N, 3), num(r.f0_se_N, 2), num(r.inv_d1_1_m, 3),
-             num(r.inv_d1_se_1_m, 2), num(r.vt_m_s, 3), num(r.vt_se_m_s, 2), num(r.alpha, 3), num(r.alpha_se, 2)});
+             num(r.inv_d1_se_1_m, 2), num(r.vt_m_s, 3), num(r.vt_se_m_s, 2), num(r.alpha, 3), num(r.alpha_se, 2),
+             r.note});
     t.print(o3->format);
   });
 

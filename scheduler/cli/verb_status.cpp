@@ -7,6 +7,7 @@
 #include <string>
 #include <thread>
 
+#include "scheduler/pipeline/build_version.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/progress.h"
 #include "scheduler/cli/verbs.h"
@@ -131,10 +132,10 @@ void run_status(const StatusOptions& o) {
       fmt::print("{}", render_status(s, o.db, secs));
       // Provenance: results from another build of gravsweep (like Snakemake's code rerun trigger).
       db::Statement other(db, "SELECT count(*), group_concat(DISTINCT code_version) FROM results WHERE code_version != ?");
-      other.bind(1, std::string(GRAVSWEEP_VERSION));
+      other.bind(1, std::string(pipeline::build_version()));
       if (other.step() && other.get_int(0) > 0)
         fmt::print("{} result(s) were computed by another code version ({}); this is {}\n", other.get_int(0),
-                   other.get_text(1), GRAVSWEEP_VERSION);
+                   other.get_text(1), pipeline::build_version());
     }
     std::fflush(stdout);
     if (o.watch_s <= 0) break;

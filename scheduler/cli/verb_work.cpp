@@ -13,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "scheduler/pipeline/build_version.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/impact.h"
@@ -142,7 +143,7 @@ int run_work(const WorkOptions& o) {
   w.poll_s = o.poll_s;
   w.max_jobs = o.max_jobs;
   w.backoff_base_s = o.backoff_s;
-  w.code_version = GRAVSWEEP_VERSION;
+  w.code_version = pipeline::build_version();
   w.verbose = !o.quiet;
   const auto rep = queue::run_worker(w, queue::all_runners());
   if (!o.quiet)

@@ -13,11 +13,9 @@
 #include "results/io/trace_file.h"
 #include "results/measurements/campaign.h"
 #include "results/processing/trace.h"
+#include "scheduler/pipeline/build_version.h"
 #include "scheduler/pipeline/scenario_spec.h"
 
-#ifndef GRAVSWEEP_VERSION
-#define GRAVSWEEP_VERSION "unknown"
-#endif
 
 namespace gravsweep::pipeline {
 
@@ -95,7 +93,7 @@ BedJobResult run_bed_job(const json& scenario, const std::filesystem::path& bed_
   b.surface_height_m = rep.surface_height_m;
   b.gravity_m_s2 = p.gravity_m_s2;
   b.time_s = sys.time_s();
-  b.code_version = GRAVSWEEP_VERSION;
+  b.code_version = pipeline::build_version();
   b.bed_key_json = bed_key_of_validated(s).dump();
   b.scenario_json = s.dump();
   json report{{"grains_placed", rep.grains_placed},
@@ -196,7 +194,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   td.scenario_json = s.dump();
   td.bed_key_json = want.dump();
   td.bed_file = std::filesystem::absolute(bed_in).string();
-  td.code_version = GRAVSWEEP_VERSION;
+  td.code_version = pipeline::build_version();
 
   // Sect. 2.3 through the one processing entry (results::process_trial): the trial's facts from
   // the trace (fill height = the measured surface height) and the scenario's /output settings,

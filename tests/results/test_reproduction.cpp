@@ -58,3 +58,22 @@ TEST(Reproduction, ModelRankNamesDepthFrictionOnTheChronoOneGDrops) {
   EXPECT_NE(r.out.find("Verdict: missing effect: gravity_depth_friction"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("better on 21 of 21 trials"), std::string::npos) << r.out;
 }
+
+// Several inputs are read as one campaign (one exported dataset per gravity level): the trials of
+// both are counted once each, each input is described, and reading one twice is refused.
+TEST(Reproduction, ModelVerbsReadSeveralDatasetsAsOneCampaign) {
+  const std::string both = "'" + dataset("chrono_1g") + "' '" + dataset("chrono_0.1g") + "'";
+  const auto r = gravsweep::testing::run_gravsweep("model table3 " + both + " --format csv", true);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("reading " + dataset("chrono_1g")), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("reading " + dataset("chrono_0.1g")), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("9.81,"), std::string::npos) << r.out;  // a row per gravity level
+  EXPECT_NE(r.out.find("0.1,"), std::string::npos) << r.out;
+  // The partial 0.1 m/s2 level (one speed so far) is listed, not fitted: one speed cannot
+  // separate f0 from 1/d1 (it printed 1/d1 = -1.5e5 1/m before).
+  EXPECT_NE(r.out.find("not fitted: Eq. 2 needs >= 3 trials over a vc range"), std::string::npos) << r.out;
+  const auto twice = gravsweep::testing::run_gravsweep(
+      "model table3 '" + dataset("chrono_1g") + "' '" + dataset("chrono_1g") + "'", true);
+  EXPECT_EQ(twice.code, 2) << twice.out;
+  EXPECT_NE(twice.out.find("is also in an earlier input"), std::string::npos) << twice.out;
+}
