@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/contact/hertz_batch.h"
 #include "engine/core/particles.h"
 #include "engine/geometry/walls.h"
 #include "engine/neighbor/verlet_list.h"
@@ -42,6 +43,85 @@ struct ForceContext {
 
 /// Overlap beyond this fraction of the smaller radius is a numerical failure.
 inline constexpr double kMaxOverlapFraction = 0.5;
+
+/// The particle-particle part of force_loop for the laws HertzBatch evaluates (hertz with sunday
+/// or none rolling): this thread's share of the list (the same static partition as the scalar
+/// loop) is filtered into batches of touching pairs, evaluated vectorised, and scattered back in
+/// list order. Called inside force_loop's parallel region (orphaned `omp for`).
+template <bool kRolling>
+void pair_loop_batched(ForceContext& c, Vec3* F, Vec3* T, long long& contacts, double& energy,
+                       double& my_ratio, long long& my_bad_i, long long& my_bad_j) {
+  Particles& p = c.p;
+  const std::size_t n = p.size();
+  const Vec3* V = c.use_eval_velocities ? p.eval_velocity_m_s.data() : p.velocity_m_s.data();
+  const Vec3* W = c.use_eval_velocities ? p.eval_omega_rad_s.data() : p.omega_rad_s.data();
+  const Vec3* X = p.position_m.data();
+  const double* R = p.radius_m.data();
+  const double* M = p.mass_kg.data();
+  const double* inv_m = p.inv_mass_1_kg.data();
+  const std::uint8_t* mat = p.material.data();
+  const std::uint32_t* off = c.nlist.offset.data();
+  const std::uint32_t* nbr = c.nlist.neighbor_.data();
+  ContactHistory* hist = c.nlist.history.data();
+  HertzBatch batch;
+  auto flush = [&] {
+    batch.compute<kRolling>(c.options, c.dt_s);
+    for (int b = 0; b < batch.count; ++b) {
+      ContactHistory& h = hist[batch.k[b]];
+      h.shear_m = Vec3(batch.sx[b], batch.sy[b], batch.sz[b]);
+      h.duration_s = batch.duration[b];
+      h.gate_s = batch.gate[b];
+      h.active = true;
+      const Vec3 f(batch.fx[b], batch.fy[b], batch.fz[b]);
+      const std::uint32_t i = batch.i[b], j = batch.j[b];
+      F[i] -= f;
+      F[j] += f;
+      T[i] += Vec3(batch.t1x[b], batch.t1y[b], batch.t1z[b]);
+      T[j] += Vec3(batch.t2x[b], batch.t2y[b], batch.t2z[b]);
+    }
+    if (c.track_energy)
+      for (int b = 0; b < batch.count; ++b) {
+        const double d = batch.overlap[b];
+        energy += (8.0 / 15.0) * batch.E[b] * std::sqrt(batch.R_eff[b]) * d * d * std::sqrt(d);
+      }
+    contacts += batch.count;
+    batch.count = 0;
+  };
+#pragma omp for schedule(static) nowait
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 xi = X[i];
+    const double ri = R[i];
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+      const std::uint32_t j = nbr[k];
+      const Vec3 d = X[j] - xi;
+      const double rsum = ri + R[j];
+      const double dist2 = d.squaredNorm();
+      ContactHistory& h = hist[k];
+      if (dist2 >= rsum * rsum) {
+        if (h.active) h.active = false;  // contact ended: history erased (no write otherwise)
+        continue;
+      }
+      if (inv_m[i] == 0 && inv_m[j] == 0) continue;  // two fixed particles
+      // Overlap beyond kMaxOverlapFraction of the smaller radius: exact ratio only then.
+      const double r_min = std::min(ri, R[j]);
+      const double limit = rsum - kMaxOverlapFraction * r_min;
+      if (dist2 < limit * limit) {
+        const double ratio = (rsum - std::sqrt(dist2)) / r_min;
+        if (ratio > kMaxOverlapFraction && ratio > my_ratio) {
+          my_ratio = ratio;
+          my_bad_i = static_cast<long long>(i);
+          my_bad_j = j;
+        }
+      }
+      const double mi = inv_m[i] == 0 ? kInf : M[i], mj = inv_m[j] == 0 ? kInf : M[j];
+      const double m_eff = std::isinf(mi) ? mj : std::isinf(mj) ? mi : mi * mj / (mi + mj);
+      batch.add(k, static_cast<std::uint32_t>(i), j, d, dist2, ri, R[j], m_eff, V[i], V[j], W[i], W[j],
+                c.pairs(mat[i], mat[j]), h);
+      if (batch.full()) flush();
+    }
+  }
+  if (batch.count > 0) flush();
+}
 
 template <class Law, class Rolling>
 void force_loop(ForceContext& c) {
@@ -83,52 +163,56 @@ void force_loop(ForceContext& c) {
     ContactForce out;
     ContactGeometry g;
     FrameHistory scratch;
-#pragma omp for schedule(static) nowait
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec3 xi = X[i];
-      const double ri = R[i];
-      for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
-        const std::uint32_t j = nbr[k];
-        const Vec3 d = X[j] - xi;
-        const double rsum = ri + R[j];
-        const double dist2 = d.squaredNorm();
-        ContactHistory& h = hist[k];
-        if (dist2 >= rsum * rsum) {
-          if (h.active) h.active = false;  // contact ended: history erased (no write otherwise)
-          continue;
+    if constexpr (kHasHertzBatch<Law, Rolling>) {
+      pair_loop_batched<std::is_same_v<Rolling, RollingSunday>>(c, F, T, contacts, energy, my_ratio, my_bad_i, my_bad_j);
+    } else {
+  #pragma omp for schedule(static) nowait
+      for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 xi = X[i];
+        const double ri = R[i];
+        for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+          const std::uint32_t j = nbr[k];
+          const Vec3 d = X[j] - xi;
+          const double rsum = ri + R[j];
+          const double dist2 = d.squaredNorm();
+          ContactHistory& h = hist[k];
+          if (dist2 >= rsum * rsum) {
+            if (h.active) h.active = false;  // contact ended: history erased (no write otherwise)
+            continue;
+          }
+          if (inv_m[i] == 0 && inv_m[j] == 0) continue;  // two fixed particles
+          const double dist = std::sqrt(dist2);
+          g.n = d / dist;
+          g.overlap_m = rsum - dist;
+          g.distance_m = dist;
+          g.r1_m = ri;
+          g.r2_m = R[j];
+          g.R_eff_m = ri * R[j] / rsum;
+          const double mi = inv_m[i] == 0 ? kInf : M[i], mj = inv_m[j] == 0 ? kInf : M[j];
+          g.m_eff_kg = std::isinf(mi) ? mj : std::isinf(mj) ? mi : mi * mj / (mi + mj);
+          g.v1 = V[i];
+          g.v2 = V[j];
+          g.w1 = W[i];
+          g.w2 = W[j];
+          g.wall = false;
+          const double ratio = g.overlap_m / std::min(ri, R[j]);
+          if (ratio > kMaxOverlapFraction && ratio > my_ratio) {
+            my_ratio = ratio;
+            my_bad_i = i;
+            my_bad_j = j;
+          }
+          const PairCoefficients& pc = c.pairs(mat[i], mat[j]);
+          FrameHistory& fh = kFrames ? frames[k] : scratch;
+          if (!h.active) fh = FrameHistory{};  // a new contact starts with empty springs
+          Law::evaluate(g, pc, c.options, h, fh, dt, out);
+          Rolling::apply(g, pc, c.options, h, fh, dt, out);
+          F[i] -= out.force_on_2;
+          F[j] += out.force_on_2;
+          T[i] += out.torque_1;
+          T[j] += out.torque_2;
+          ++contacts;
+          if (c.track_energy) energy += Law::normal_energy_J(g, pc);
         }
-        if (inv_m[i] == 0 && inv_m[j] == 0) continue;  // two fixed particles
-        const double dist = std::sqrt(dist2);
-        g.n = d / dist;
-        g.overlap_m = rsum - dist;
-        g.distance_m = dist;
-        g.r1_m = ri;
-        g.r2_m = R[j];
-        g.R_eff_m = ri * R[j] / rsum;
-        const double mi = inv_m[i] == 0 ? kInf : M[i], mj = inv_m[j] == 0 ? kInf : M[j];
-        g.m_eff_kg = std::isinf(mi) ? mj : std::isinf(mj) ? mi : mi * mj / (mi + mj);
-        g.v1 = V[i];
-        g.v2 = V[j];
-        g.w1 = W[i];
-        g.w2 = W[j];
-        g.wall = false;
-        const double ratio = g.overlap_m / std::min(ri, R[j]);
-        if (ratio > kMaxOverlapFraction && ratio > my_ratio) {
-          my_ratio = ratio;
-          my_bad_i = i;
-          my_bad_j = j;
-        }
-        const PairCoefficients& pc = c.pairs(mat[i], mat[j]);
-        FrameHistory& fh = kFrames ? frames[k] : scratch;
-        if (!h.active) fh = FrameHistory{};  // a new contact starts with empty springs
-        Law::evaluate(g, pc, c.options, h, fh, dt, out);
-        Rolling::apply(g, pc, c.options, h, fh, dt, out);
-        F[i] -= out.force_on_2;
-        F[j] += out.force_on_2;
-        T[i] += out.torque_1;
-        T[j] += out.torque_2;
-        ++contacts;
-        if (c.track_energy) energy += Law::normal_energy_J(g, pc);
       }
     }
     if (n_walls > 0) {

@@ -30,6 +30,7 @@ struct WorkOptions {
   std::string db = "campaign.db";
   int workers = 1;
   int threads = 0;
+  int pool_threads = 0;  ///< set by the supervisor for its workers (0: --threads)
   bool follow = false;
   double lease_s = 60;
   double heartbeat_s = 0;
@@ -50,6 +51,7 @@ int final_code(const std::string& db_path) {
 int supervise(const WorkOptions& o, int threads) {
   // Children are this binary again with --workers 1: each opens its own connection after exec.
   std::vector<std::string> args = {"work", "--db", o.db, "--workers", "1", "--threads", std::to_string(threads),
+                                   "--pool-threads", std::to_string(threads * o.workers),
                                    "--lease", fmt::format("{}", o.lease_s), "--poll", fmt::format("{}", o.poll_s),
                                    "--backoff", fmt::format("{}", o.backoff_s)};
   if (o.heartbeat_s > 0) args.insert(args.end(), {"--heartbeat", fmt::format("{}", o.heartbeat_s)});
@@ -137,6 +139,7 @@ int run_work(const WorkOptions& o) {
   queue::WorkerOptions w;
   w.db_path = o.db;
   w.threads = threads;
+  w.pool_threads = std::max(threads, o.pool_threads);
   w.lease_s = o.lease_s;
   w.heartbeat_s = o.heartbeat_s;
   w.follow = o.follow;
@@ -164,13 +167,19 @@ void setup_work(CLI::App& app) {
       "heartbeat carrying progress, and record each result with its trace path and checksum. They\n"
       "stop when no job is left (--follow: keep waiting for new ones). A worker killed in any way\n"
       "loses its lease after --lease seconds and another worker takes the job over. SIGINT/SIGTERM\n"
-      "stop the current job and give its lease back (exit 130). Exit 4 if some job is dead.\n\n"
+      "stop the current job and give its lease back (exit 130). Exit 4 if some job is dead.\n"
+      "A bed job that runs alone (nothing else running or claimable: its drops wait for it) gets the\n"
+      "threads of all the workers (--workers x --threads), so no core idles while it runs.\n\n"
       "Examples:\n"
       "  gravsweep work --db campaign.db --workers 2 --threads 1\n"
       "  gravsweep work --db campaign.db --follow          # a worker that waits for new submissions");
   sub->add_option("--db", opt->db, "campaign database")->capture_default_str();
   sub->add_option("--workers", opt->workers, "worker processes")->check(CLI::Range(1, 256))->capture_default_str();
   sub->add_option("--threads", opt->threads, "engine threads per worker (0: cores / workers)")->check(CLI::Range(0, 1024))->capture_default_str();
+  sub->add_option("--pool-threads", opt->pool_threads,
+                  "threads all the workers hold together (the supervisor passes workers x threads): a bed "
+                  "job that runs alone, with nothing else running or claimable, uses them all (0: --threads)")
+      ->check(CLI::Range(0, 4096))->capture_default_str();
   sub->add_flag("--follow", opt->follow, "keep waiting for new jobs when none is left");
   sub->add_option("--lease", opt->lease_s, "lease length, s: a worker silent this long is presumed dead")->check(CLI::Range(0.5, 86400.0))->capture_default_str();
   sub->add_option("--heartbeat", opt->heartbeat_s, "heartbeat (lease renewal + progress) interval, s (0: min(lease/4, 2 s))")->check(CLI::Range(0.0, 3600.0))->capture_default_str();

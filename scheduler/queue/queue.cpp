@@ -627,6 +627,15 @@ bool work_remains(Database& db) {
   return st.get_int(0) != 0;
 }
 
+int threads_for_claim(Database& db, const Claim& c, int threads, int pool_threads) {
+  if (c.kind != "bed" || pool_threads <= threads) return threads;
+  Statement st(db,
+               "SELECT EXISTS(SELECT 1 FROM jobs WHERE job_id<>? AND state IN ('queued','running','failed'))");
+  st.bind(1, c.job_id);
+  st.step();
+  return st.get_int(0) != 0 ? threads : pool_threads;
+}
+
 // ---- resume -----------------------------------------------------------------------------------
 
 void remove_lost_files(const CampaignPaths& paths, const Reclaimed& r) {

@@ -128,6 +128,11 @@ bool release(db::Database& db, const Claim& c, const std::string& why);
 /// True while some job may still become runnable (queued, waiting, failed, running).
 bool work_remains(db::Database& db);
 
+/// Threads for the claimed job: `pool_threads` (all the threads the workers hold) for a bed job
+/// that runs alone, i.e. no other job is running, queued or waiting to retry (the other workers
+/// would idle until the bed is done: its drops wait for it); `threads` otherwise.
+int threads_for_claim(db::Database& db, const Claim& c, int threads, int pool_threads);
+
 // ---- resume -----------------------------------------------------------------------------------
 struct ResumeOptions {
   bool retry_dead = false;     ///< also requeue dead jobs with `extra_attempts` more tries

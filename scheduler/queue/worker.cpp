@@ -237,10 +237,18 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
         continue;
       }
     }
+    int threads = o.threads;
+    try {
+      threads = threads_for_claim(db, *c, o.threads, o.pool_threads);
+      if (threads != o.threads && o.verbose)
+        std::fprintf(stderr, "worker %d: bed job %s runs alone: %d threads\n", who.pid, c->job_id.c_str(), threads);
+    } catch (const db::DbError& e) {
+      if (!e.busy()) throw;  // busy: run with the worker's own threads
+    }
     try {
       if (runner == runners.end())
         throw ConfigError(fmt::format("job {}: no runner for kind '{}' in this build", c->job_id, c->kind));
-      RunContext ctx{*c, tmp, c->dep_output_rel.empty() ? fs::path() : paths.abs(c->dep_output_rel), o.threads,
+      RunContext ctx{*c, tmp, c->dep_output_rel.empty() ? fs::path() : paths.abs(c->dep_output_rel), threads,
                      [&sig](const std::string& phase, double f, const std::string& detail) {
                        std::lock_guard g(sig.m);
                        sig.phase = phase;
@@ -317,6 +325,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     done.metrics = out.metrics;
     done.report = out.report;
     done.report["wall_s"] = secs;
+    done.report["threads"] = threads;
     if (complete(db, *c, done)) {
       ++rep.done;
       if (o.verbose)

@@ -43,6 +43,9 @@ Runner noop_runner();
 struct WorkerOptions {
   std::filesystem::path db_path;
   int threads = 1;
+  /// Threads all the workers of this campaign hold together (workers x threads): a bed job that
+  /// runs alone gets them all (threads_for_claim). At most `threads` when there is one worker.
+  int pool_threads = 1;
   double lease_s = 60;
   double heartbeat_s = 0;       ///< 0: min(lease / 4, 2 s)
   bool follow = false;          ///< keep waiting for new jobs when none is left

@@ -30,9 +30,12 @@ struct CmdResult {
   std::string out, err;
 };
 
-/// Runs the gravsweep binary with args; captures stdout and stderr (through files).
-inline CmdResult run_cli(const std::vector<std::string>& args, const std::filesystem::path& workdir) {
-  const auto out_path = workdir / ".cli_out", err_path = workdir / ".cli_err";
+/// Runs the gravsweep binary with args; captures stdout and stderr (through files in
+/// capture_dir, by default workdir: a test that fills workdir's disk must capture elsewhere).
+inline CmdResult run_cli(const std::vector<std::string>& args, const std::filesystem::path& workdir,
+                         const std::filesystem::path& capture_dir = {}) {
+  const auto& cap = capture_dir.empty() ? workdir : capture_dir;
+  const auto out_path = cap / ".cli_out", err_path = cap / ".cli_err";
   const pid_t pid = fork();
   if (pid == 0) {
     const int o = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);

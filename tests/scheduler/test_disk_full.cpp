@@ -31,7 +31,8 @@ TEST(DiskFull, WorkerExitsOneCleanlyAndFinishedWorkStaysIntact) {
   } unmount{mnt};
   const std::string example = std::string(GRAVSWEEP_SOURCE_DIR) + "/examples/sweep_tiny.json";
   ASSERT_EQ(run_cli({"submit", example, "--db", "c.db"}, mnt).code, 0);
-  const auto r = run_cli({"work", "--db", "c.db", "--threads", "1", "--quiet"}, mnt);
+  // stderr is captured outside the tmpfs: on the full disk the message itself could not be written.
+  const auto r = run_cli({"work", "--db", "c.db", "--threads", "1", "--quiet"}, mnt, d.path);
   EXPECT_EQ(r.code, 1) << "exit " << r.code << ": " << r.err.substr(r.err.size() > 800 ? r.err.size() - 800 : 0);
   EXPECT_TRUE(r.err.find("disk is full") != std::string::npos || r.err.find("No space left") != std::string::npos)
       << r.err.substr(r.err.size() > 800 ? r.err.size() - 800 : 0);

@@ -288,3 +288,25 @@ TEST_F(QueueTest, StatusIsFastOnAHundredThousandJobs) {
   // Measured about 10 ms; the bound only catches a query that scans and sorts the table.
   EXPECT_LT(secs, 1.0) << "status took " << secs << " s on 100,000 jobs";
 }
+
+TEST_F(QueueTest, ABedThatRunsAloneGetsThePoolsThreads) {
+  // Two beds claimable: the first one claimed shares the machine (the other bed waits for a worker).
+  submit_spec(impact_spec(), bed_key);
+  auto bed = claim(db, me, paths, 60);
+  ASSERT_TRUE(bed);
+  EXPECT_EQ(threads_for_claim(db, *bed, 1, 2), 1) << "another bed is claimable";
+  // The second bed while the first still runs: still its own share.
+  auto bed2 = claim(db, me, paths, 60);
+  ASSERT_TRUE(bed2);
+  EXPECT_EQ(threads_for_claim(db, *bed2, 1, 2), 1) << "another bed is running";
+  // The first bed done: its drops are claimable, so the second bed keeps one thread.
+  ASSERT_TRUE(complete(db, *bed, done_for(*bed)));
+  EXPECT_EQ(threads_for_claim(db, *bed2, 1, 2), 1) << "drops are claimable";
+  // Every drop done: the second bed is alone (its drops wait for it) and gets the pool.
+  while (auto d = claim(db, me, paths, 60)) {
+    EXPECT_EQ(threads_for_claim(db, *d, 1, 2), 1) << "drops keep the worker's threads";
+    ASSERT_TRUE(complete(db, *d, done_for(*d)));
+  }
+  EXPECT_EQ(threads_for_claim(db, *bed2, 1, 2), 2);
+  EXPECT_EQ(threads_for_claim(db, *bed2, 2, 2), 2) << "one worker: its own threads";
+}
