@@ -258,7 +258,7 @@ def plot_trace():
     import json
     spec = json.load(open(os.path.join(D, "trace.json")))
     plt.rcParams.update({"font.size": 10})
-    fig, axs = plt.subplots(3, 1, figsize=(7.5, 9.5), sharex=True)
+    fig, axs = plt.subplots(3, 1, figsize=(11, 9.5), sharex=True, layout="constrained")
     seen_dem = False
     xmax = 0.0
     for idx, rec in enumerate(spec["records"]):
@@ -297,9 +297,11 @@ def plot_trace():
     for ax in axs:
         ax.grid(alpha=0.3)
         ax.axvline(0, color="k", ls="--", lw=0.7)
-        ax.legend(fontsize=7, loc="best")
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
+    axs[0].plot([], [], "k--", lw=0.7, label="collision start")
+    axs[0].plot([], [], "k:", lw=0.8, label="collision end")
+    axs[0].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     axs[0].set_title(spec.get("title", ""), fontsize=10)
-    fig.tight_layout()
     fig.savefig(spec["out"], dpi=120)
     plt.close(fig)
     written.append(spec["out"])
@@ -316,9 +318,11 @@ def mark_fig2(axs, rows, t, m):
     box = dict(arrowstyle="->", color="k", lw=0.8)
     axs[0].annotate(f"apeak = {m['apeak_m_s2']:.1f} m/s$^2$", xy=(t[ipk], m["apeak_m_s2"]),
                     xytext=(t[ipk] + 0.25 * t_end + 1, m["apeak_m_s2"]), arrowprops=box, va="center", fontsize=9)
-    y0 = axs[0].get_ylim()[0]
-    axs[0].annotate("", xy=(0, 0.5 * y0), xytext=(t_end, 0.5 * y0), arrowprops=dict(arrowstyle="<->", lw=0.8))
-    axs[0].text(0.5 * t_end, 0.5 * y0, f"tstop = {m['tstop_s'] * 1000:.1f} ms", ha="center", va="bottom", fontsize=9)
+    y0, y1 = axs[0].get_ylim()
+    yt = y0 + 0.1 * (y1 - y0)
+    axs[0].annotate("", xy=(0, yt), xytext=(t_end, yt), arrowprops=dict(arrowstyle="<->", lw=0.8))
+    axs[0].text(0.5 * t_end, yt, f"tstop = {m['tstop_s'] * 1000:.1f} ms", ha="center", va="bottom", fontsize=9,
+                bbox=dict(facecolor="white", edgecolor="none", alpha=0.8, pad=1))
     axs[1].annotate(f"vc = {m['vc_m_s']:.3f} m/s", xy=(0, m["vc_m_s"]), xytext=(0.2 * t_end + 1, 1.05 * m["vc_m_s"]),
                     arrowprops=box, fontsize=9)
     axs[2].annotate(f"zstop = {100 * m['zstop_m']:.2f} cm", xy=(t_end, 100 * m["zstop_m"]),
@@ -337,11 +341,13 @@ def plot_bed():
     Rc = 100 * spec["container_diameter_m"] / 2
     Hw = 100 * spec["wall_height_m"]
     plt.rcParams.update({"font.size": 10})
-    fig, axs = plt.subplots(1, len(panels), figsize=(6.2 * len(panels), 5.6), squeeze=False)
     top = Hw
     for p in panels:
         if "projectile" in p:
             top = max(top, 100 * (p["projectile"]["z_m"] + p["projectile"]["radius_m"]))
+    height = min(9.0, max(3.5, 6.2 * (top + 2) / (2 * Rc + 2) + 1.8))
+    fig, axs = plt.subplots(1, len(panels), figsize=(6.2 * len(panels) + 1.2, height), squeeze=False,
+                            layout="constrained")
     mappable = None
     for ax, p in zip(axs[0], panels):
         rows = read(os.path.join(D, p["grains"]))
