@@ -21,7 +21,7 @@ trap 'rm -rf "$profile"' EXIT
 rm -f "$shot"
 # --no-sandbox: tests and CI run as root; a fresh profile so nothing of a user's browser is read.
 timeout 120 "$browser" --headless --no-sandbox --disable-gpu --hide-scrollbars --user-data-dir="$profile" \
-  --window-size=1280,3200 --screenshot="$(realpath -m "$shot")" "file://$page" >/dev/null 2>&1 || true
+  --window-size=1280,6400 --screenshot="$(realpath -m "$shot")" "file://$page" >/dev/null 2>&1 || true
 if [ ! -s "$shot" ] || [ "$(head -c 4 "$shot" | tail -c 3)" != "PNG" ]; then
   echo "check-report: chromium wrote no screenshot of $page" >&2
   exit 1
