@@ -87,7 +87,11 @@ Fig2Record load_record(const std::string& path) {
                                         ? parent
                                         : fs::path(path).stem().string());
     const ProcessedTrace& p = r.trial.processed;
+    // "processed using the same method as the experimental data" (Sect. 2.3, Fig. 2): as a lab
+    // record (no own velocity and depth, bias taken from free fall and rest: about 0 for a DEM
+    // record), from the engine's contact start and the engine's vc.
     Trace bare = r.trial.raw;
+    bare.source = TraceSource::lab;
     bare.velocity_down_m_s.clear();
     bare.depth_m.clear();
     MetricOptions o = metric_options(r.trial.info);

@@ -341,10 +341,12 @@ def plot_bed():
     Rc = 100 * spec["container_diameter_m"] / 2
     Hw = 100 * spec["wall_height_m"]
     plt.rcParams.update({"font.size": 10})
-    top = Hw
+    # Up to 2 cm above the highest of the surface and the projectile (the walls may go higher).
+    top = 100 * spec["surface_height_m"]
     for p in panels:
         if "projectile" in p:
             top = max(top, 100 * (p["projectile"]["z_m"] + p["projectile"]["radius_m"]))
+    top = min(Hw, top + 2)
     height = min(9.0, max(3.5, 6.2 * (top + 2) / (2 * Rc + 2) + 1.8))
     fig, axs = plt.subplots(1, len(panels), figsize=(6.2 * len(panels) + 1.2, height), squeeze=False,
                             layout="constrained")
@@ -373,7 +375,7 @@ def plot_bed():
             ax.add_patch(Circle((100 * pj["x_m"], 100 * pj["z_m"]), 100 * cut, facecolor="0.75", edgecolor="k",
                                 lw=1.2, label=f"projectile ({200 * rad:.0f} cm)"))
         ax.set_xlim(-Rc - 1, Rc + 1)
-        ax.set_ylim(-0.5, top + 1)
+        ax.set_ylim(-0.5, top)
         ax.set_aspect("equal")
         ax.set_xlabel("x (cm), cut through the axis at y = 0")
         ax.set_ylabel("height above the container floor (cm)")
