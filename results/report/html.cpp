@@ -21,7 +21,7 @@ h2 { font-size: 1.25em; margin-top: 1.8em; color: #234; }
 table { border-collapse: collapse; margin: .6em 0 1.2em; font-size: .9em; }
 th, td { border: 1px solid #bbb; padding: .25em .6em; }
 th { background: #e8ecf0; text-align: left; }
-td.n { text-align: right; font-variant-numeric: tabular-nums; }
+td.n { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
 figure { margin: 1.5em 0; }
 figure img { max-width: 100%; border: 1px solid #ccc; }
 figcaption { font-size: .92em; color: #333; margin-top: .3em; }
