@@ -46,12 +46,12 @@ double snapshot_interval(const RunOptions& o) {
 }
 
 /// Fig. 2 of the drop next to its trace; a drop the metrics cannot measure gets none (said why).
-void draw_run_fig2(const std::filesystem::path& trace) {
+void draw_run_fig2(const std::filesystem::path& trace, const std::filesystem::path& bed) {
   const auto png = trace.parent_path() / "fig2.png";
   try {
     results::draw_fig2({trace.string(), "", png.string()});
     fmt::print("wrote {} (Fig. 2; `gravsweep plot bed {} --trace {}` draws Fig. 1)\n", png.string(),
-               (trace.parent_path() / "bed.h5").string(), trace.string());
+               bed.string(), trace.string());
   } catch (const ConfigError& e) {
     fmt::print("no fig2.png: {}\n", e.what());
   }
@@ -157,7 +157,7 @@ void run_impact(const RunOptions& o) {
     if (d.snapshots > 0)
       fmt::print("wrote {} snapshots ({:.0f} kB of state each) to {}, index {} (ParaView, VisIt)\n", d.snapshots,
                  d.snapshot_bytes / 1e3, d.snapshot_path.string(), d.snapshot_xdmf.string());
-    if (!o.no_figures) draw_run_fig2(d.trace_path);
+    if (!o.no_figures) draw_run_fig2(d.trace_path, bed_path);
   } catch (const pipeline::Interrupted& e) {
     bar.finish();
     throw InterruptedExit(e.what());
