@@ -323,7 +323,7 @@ def mark_fig2(axs, rows, t, m):
     axs[0].annotate("", xy=(0, yt), xytext=(t_end, yt), arrowprops=dict(arrowstyle="<->", lw=0.8))
     axs[0].text(0.5 * t_end, yt, f"tstop = {m['tstop_s'] * 1000:.1f} ms", ha="center", va="bottom", fontsize=9,
                 bbox=dict(facecolor="white", edgecolor="none", alpha=0.8, pad=1))
-    axs[1].annotate(f"vc = {m['vc_m_s']:.3f} m/s", xy=(0, m["vc_m_s"]), xytext=(0.2 * t_end + 1, 1.05 * m["vc_m_s"]),
+    axs[1].annotate(f"vc = {m['vc_m_s']:.3f} m/s", xy=(0, m["vc_m_s"]), xytext=(0.2 * t_end + 1, 0.85 * m["vc_m_s"]),
                     arrowprops=box, fontsize=9)
     axs[2].annotate(f"zstop = {100 * m['zstop_m']:.2f} cm", xy=(t_end, 100 * m["zstop_m"]),
                     xytext=(0.45 * t_end, 0.5 * 100 * m["zstop_m"]), arrowprops=box, fontsize=9)
