@@ -6,7 +6,11 @@
 #   4. compare the collision model with a laboratory campaign (depth-friction-dev, if present):
 #      import, rank the candidate terms, fit base vs base+depth_friction, write the report,
 #   5. the same questions of the gravity sweep itself: every finished drop of the campaign
-#      database is a trial (model rank, Table 3, report), and the repeats' means per group.
+#      database is a trial (model rank, Table 3, report), and the repeats' means per group,
+#   6. figures (issue 15): the campaign's metrics against vc, and one demo drop (`gravsweep run`
+#      on the campaign's 1 g bed at 1 m/s): Fig. 2, Fig. 1 and its ParaView snapshots; the
+#      report's index.html opened in headless chromium when it is installed. Paths are printed;
+#      nothing here is committed (runs/ is not tracked).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$root/deploy/install-deps.sh"
@@ -43,4 +47,31 @@ echo "== 5. the sweep as a campaign: model rank, table3, report on $db"
 "$gs" model table3 "$db"
 "$gs" report "$db" --out "$out/report-sweep"
 echo "   report written to $out/report-sweep"
+echo "== 6. figures of the campaign and of one drop"
+figs="$out/figures"
+mkdir -p "$figs"
+for y in apeak_m_s2 zstop_m tstop_s; do
+  "$gs" plot results --db "$db" --x vc_m_s --y "$y" --group gravity_m_s2 --out "$figs/campaign_${y}_vs_vc.png"
+done
+# One drop with snapshots: the sweep's base scenario at 1 m/s, on the campaign's 1 g bed.
+/usr/bin/python3 - "$root/examples/sweep_tiny.json" "$out/drop.json" <<'PY'
+import json, sys
+base = json.load(open(sys.argv[1]))["base"]
+base["projectile"]["impact_speed_m_s"] = 1.0
+json.dump(base, open(sys.argv[2], "w"), indent=1)
+PY
+bed="$(sqlite3 "$db" "SELECT output_path FROM jobs WHERE kind='bed' AND state='done' AND \
+  json_extract(scenario_json, '$.gravity_m_s2') = 9.81 LIMIT 1")"
+case "$bed" in /*) ;; *) bed="$out/campaign.files/$bed" ;; esac
+"$gs" run "$out/drop.json" --out "$out/drop" --bed "$bed" --threads 2 --quiet
+"$gs" plot bed "$bed" --trace "$out/drop/trace.h5" --snapshots "$out/drop/snapshots.h5" --out "$out/drop/fig1.png"
+"$gs" plot trace "$out/drop/trace.h5" --out "$out/drop/fig2.png"
+echo "   campaign figures:"
+ls -1 "$figs"/*.png "$out/report-sweep"/*.png | sed 's/^/     /'
+echo "   demo drop: $out/drop/fig1.png (Fig. 1), $out/drop/fig2.png (Fig. 2),"
+echo "              $out/drop/snapshots.xdmf (open in ParaView: grains and projectile as point sets)"
+echo "   report to send: $out/report-sweep/index.html"
+if "$root/deploy/check-report.sh" "$out/report-sweep" "$out/report-sweep/screenshot.png" >/dev/null; then
+  echo "   headless chromium screenshot of it: $out/report-sweep/screenshot.png"
+fi
 echo "demo finished: $out"

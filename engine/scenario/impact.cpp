@@ -37,7 +37,8 @@ std::optional<FirstTouch> first_touch_bottom(const System& sys, double x_m, doub
 }
 
 DropResult drop_projectile(System& sys, double surface_height_m, const ProjectileSpec& ps,
-                           const DropStop& stop, double sample_rate_hz, const DropProgress& progress) {
+                           const DropStop& stop, double sample_rate_hz, const DropProgress& progress,
+                           const DropSnapshots& snapshots) {
   if (ps.impact_speed_m_s.has_value() == ps.drop_height_m.has_value())
     throw ConfigError("projectile: give exactly one of impact_speed_m_s and drop_height_m");
   if (!(ps.diameter_m > 0) || !(ps.mass_kg > 0))
@@ -116,9 +117,22 @@ DropResult drop_projectile(System& sys, double surface_height_m, const Projectil
     return s;
   };
 
+  // Snapshots every snapshot_every samples (0: off), the last one at the end of the run.
+  const bool snap = snapshots.interval_s > 0 && snapshots.write;
+  const long long snapshot_every =
+      snap ? std::max<long long>(1, std::llround(snapshots.interval_s / sample_dt)) : 0;
+  long long last_snapshot = -1;
+  auto snapshot = [&](long long k) {
+    if (!snap || k == last_snapshot) return;
+    snapshots.write(sys, ip, sys.time_s() - t0);
+    last_snapshot = k;
+  };
+
   // Sample 0: the force at release (free fall unless something already touches).
   sys.compute_forces();
   sample(sys.particles.force_N[ip].z() / ps.mass_kg);
+  snapshot(0);
+  long long k_done = 0;
   res.samples.reserve(static_cast<std::size_t>(std::min<long long>(max_samples + 2, 1 << 22)));
   long long below = 0;
   for (long long k = 1; k <= max_samples; ++k) {
@@ -126,6 +140,8 @@ DropResult drop_projectile(System& sys, double surface_height_m, const Projectil
     sys.advance(steps_per_sample);
     const double vz_after = sys.particles.velocity_m_s[ip].z();
     const DropSample s = sample((vz_after - vz_before) / sample_dt);
+    k_done = k;
+    if (snap && k % snapshot_every == 0) snapshot(k);
     if (s.contacts > 0 && !res.first_contact_s) res.first_contact_s = s.t_s;
     if (res.first_contact_s) {
       const double speed = sys.particles.velocity_m_s[ip].norm();
@@ -141,6 +157,7 @@ DropResult drop_projectile(System& sys, double surface_height_m, const Projectil
                fmt::format("t={:.4f}s depth={:.2f}cm v={:.3f}m/s contacts={}", s.t_s,
                            100 * s.depth_m, s.velocity_down_m_s, s.contacts));
   }
+  snapshot(k_done);
   res.steps = sys.step_count() - step0;
   if (progress) progress(1.0, res.stopped ? "projectile at rest" : "time cap reached");
   return res;

@@ -77,11 +77,19 @@ std::optional<FirstTouch> first_touch_bottom(const System& sys, double x_m, doub
 /// progress(fraction of the time cap, detail); may throw to abort the run.
 using DropProgress = std::function<void(double, const std::string&)>;
 
+/// Grain snapshots during a drop (issue 15): `write(sys, projectile, t_s)` is called at release,
+/// every interval_s of simulated time (rounded to whole samples, at least one) and at the end.
+/// Off when interval_s <= 0 or `write` is empty. `write` may throw to abort the run.
+struct DropSnapshots {
+  double interval_s = 0;
+  std::function<void(const System&, ParticleIndex projectile, double t_since_release_s)> write;
+};
+
 /// Adds the projectile to the bed held by `sys` (grains + container walls), releases it and runs
 /// to the stop criterion or the time cap. `surface_height_m` is the bed's mean surface (engine z).
 DropResult drop_projectile(System& sys, double surface_height_m, const ProjectileSpec& projectile,
                            const DropStop& stop, double sample_rate_hz,
-                           const DropProgress& progress = {});
+                           const DropProgress& progress = {}, const DropSnapshots& snapshots = {});
 
 /// Kinetic energy (translational + rotational) of the free grains.
 double grain_kinetic_energy_J(const System& sys);

@@ -291,6 +291,18 @@ int System::contact_count(ParticleIndex i) const {
   return count;
 }
 
+std::vector<int> System::contact_counts() const {
+  const std::size_t n = particles.size();
+  std::vector<int> count(n, 0);
+  for (std::size_t a = 0; a + 1 < nlist_.offset.size() && a < n; ++a)
+    for (std::uint32_t k = nlist_.offset[a]; k < nlist_.offset[a + 1]; ++k)
+      if (nlist_.history[k].active) ++count[a], ++count[nlist_.neighbor_[k]];
+  const std::size_t nw = std::max<std::size_t>(1, wall_count_at_build_);
+  for (std::size_t c = 0; c < wall_candidates_.size(); ++c)
+    if (wall_history_[c].active && wall_candidates_[c] / nw < n) ++count[wall_candidates_[c] / nw];
+  return count;
+}
+
 double System::bytes_per_particle() const {
   const std::size_t n = std::max<std::size_t>(1, particles.size());
   const std::size_t per_particle_state =

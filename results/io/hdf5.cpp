@@ -47,14 +47,14 @@ Handle open_dataset(hid_t parent, const std::string& name) {
 
 void write_dataset(hid_t parent, const std::string& name, hid_t file_type, hid_t mem_type,
                    const void* data, const std::vector<hsize_t>& dims, const std::string& units,
-                   const std::string& description) {
+                   const std::string& description, Storage storage = Storage::compressed) {
   Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), &H5Sclose);
   if (space.get() < 0) fail(parent, fmt::format("cannot create dataspace for '{}'", name));
   Handle plist(H5Pcreate(H5P_DATASET_CREATE), &H5Pclose);
   hsize_t total = 1;
   for (hsize_t d : dims) total *= d;
   // Compress larger datasets (chunked along the first axis); small ones stay contiguous.
-  if (total >= 4096 && !dims.empty()) {
+  if (storage == Storage::compressed && total >= 4096 && !dims.empty()) {
     std::vector<hsize_t> chunk = dims;
     chunk[0] = std::min<hsize_t>(dims[0], 16384);
     H5Pset_chunk(plist, static_cast<int>(chunk.size()), chunk.data());
@@ -172,18 +172,18 @@ bool exists(hid_t parent, const std::string& name) {
 
 void write_doubles(hid_t parent, const std::string& name, const std::vector<double>& data,
                    const std::vector<hsize_t>& dims, const std::string& units,
-                   const std::string& description) {
+                   const std::string& description, Storage storage) {
   hsize_t total = 1;
   for (hsize_t d : dims) total *= d;
   if (total != data.size())
     fail(parent, fmt::format("dataset '{}': {} values do not fill the shape", name, data.size()));
-  write_dataset(parent, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, data.data(), dims, units, description);
+  write_dataset(parent, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, data.data(), dims, units, description, storage);
 }
 
 void write_int32(hid_t parent, const std::string& name, const std::vector<std::int32_t>& data,
-                 const std::string& units, const std::string& description) {
+                 const std::string& units, const std::string& description, Storage storage) {
   write_dataset(parent, name, H5T_STD_I32LE, H5T_NATIVE_INT32, data.data(), {data.size()}, units,
-                description);
+                description, storage);
 }
 
 void write_uint8(hid_t parent, const std::string& name, const std::vector<std::uint8_t>& data,

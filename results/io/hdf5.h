@@ -81,12 +81,17 @@ Handle open_group(hid_t parent, const std::string& name);
 /// True when a link `name` exists under `parent`.
 bool exists(hid_t parent, const std::string& name);
 
+/// compressed: datasets of 4096 values or more are chunked, shuffled and deflated (level 4);
+/// contiguous: stored as they are (grain snapshots: state doubles hardly compress, BENCHMARKS.md).
+enum class Storage { compressed, contiguous };
+
 /// Writes a dataset of doubles with shape `dims` (row-major), plus "units" and "description".
 void write_doubles(hid_t parent, const std::string& name, const std::vector<double>& data,
                    const std::vector<hsize_t>& dims, const std::string& units,
-                   const std::string& description);
+                   const std::string& description, Storage storage = Storage::compressed);
 void write_int32(hid_t parent, const std::string& name, const std::vector<std::int32_t>& data,
-                 const std::string& units, const std::string& description);
+                 const std::string& units, const std::string& description,
+                 Storage storage = Storage::compressed);
 void write_uint8(hid_t parent, const std::string& name, const std::vector<std::uint8_t>& data,
                  const std::string& units, const std::string& description);
 

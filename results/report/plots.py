@@ -240,48 +240,152 @@ def plot_xy():
     written.append(spec["out"])
 
 
+def column(rows, key, sc=1.0):
+    """A column scaled, or None when the record does not have it (empty cells)."""
+    if not rows or rows[0].get(key, "") == "":
+        return None
+    return [sc * num(r[key]) for r in rows]
+
+
+# Fig. 2 colours as the paper: lab black, DEM blue (a second DEM red), the re-integration green.
+FIG2_STYLE = {"lab": ("black", "0.55"), "dem": ("tab:blue", "lightsteelblue"), "dem2": ("tab:red", "lightsalmon")}
+
+
 def plot_trace():
-    """Sunday et al. 2021 Fig. 2 for one record: a, v, z against time, raw and processed."""
+    """Sunday et al. 2021 Fig. 2: a, v, z against the time since the collision start, raw and
+    processed (500 Hz Butterworth, v and z re-integrated from the filtered a: the green line),
+    with vc, apeak, zstop and tstop marked for the first record; a second record laid over it."""
     import json
     spec = json.load(open(os.path.join(D, "trace.json")))
-    rows = read(os.path.join(D, "trace.csv"))
-    m = spec["metrics"]
-    t = [1000 * num(r["t_s"]) for r in rows]
-    fig, axs = plt.subplots(3, 1, figsize=(7, 8.5), sharex=True)
-    panels = [("accel_raw_m_s2", "accel_m_s2", "acceleration, up (m/s2)", 1.0),
-              ("velocity_raw_m_s", "velocity_m_s", "velocity, down (m/s)", 1.0),
-              ("depth_raw_m", "depth_m", "depth below the surface (cm)", 100.0)]
-    for ax, (raw, proc, lab, sc) in zip(axs, panels):
-        if rows and rows[0].get(raw, "") != "":
-            ax.plot(t, [sc * num(r[raw]) for r in rows], color="0.6", lw=0.7, label="raw record")
-        if proc == "accel_m_s2":
-            plab = "500 Hz Butterworth (paper)"
-        elif spec.get("source") == "dem":
-            plab = "the engine's own (DEM)"
-        else:
-            plab = "integrated from the filtered a"
-        ax.plot(t, [sc * num(r[proc]) for r in rows], color="tab:green", lw=1.4, label=plab)
-        ax.set_ylabel(lab)
-        ax.grid(alpha=0.3)
-        for key, style in (("t_start_s", "--"), ("t_end_s", ":")):
-            if m.get(key) is not None:
-                ax.axvline(1000 * m[key], color="k", ls=style, lw=0.8)
-    if m.get("apeak_m_s2") is not None:
-        axs[0].axhline(m["apeak_m_s2"], color="tab:red", lw=0.8,
-                       label=f"apeak = {m['apeak_m_s2']:.1f} m/s2")
-    if m.get("vc_m_s") is not None:
-        axs[1].axhline(m["vc_m_s"], color="tab:blue", lw=0.8, label=f"vc = {m['vc_m_s']:.3f} m/s")
-    if m.get("zstop_m") is not None:
-        axs[2].axhline(100 * m["zstop_m"], color="tab:purple", lw=0.8,
-                       label=f"zstop = {100 * m['zstop_m']:.2f} cm")
-    if m.get("tstop_s") is not None:
-        axs[2].plot([], [], "k--", lw=0.8, label=f"start / end (tstop = {1000 * m['tstop_s']:.1f} ms)")
-    for ax in axs:
-        ax.legend(fontsize=7, loc="best")
+    plt.rcParams.update({"font.size": 10})
+    fig, axs = plt.subplots(3, 1, figsize=(11, 9.5), sharex=True, layout="constrained")
+    seen_dem = False
+    xmax = 0.0
+    for idx, rec in enumerate(spec["records"]):
+        rows = read(os.path.join(D, rec["csv"]))
+        t = [1000 * num(r["t_s"]) for r in rows]
+        kind = rec["source"] if rec["source"] == "lab" else ("dem2" if seen_dem else "dem")
+        seen_dem = seen_dem or rec["source"] == "dem"
+        main, light = FIG2_STYLE[kind]
+        lab = rec["label"]
+        a_raw = column(rows, "accel_raw_m_s2")
+        if a_raw is not None:
+            axs[0].plot(t, a_raw, color=light, lw=0.6, label=f"{lab}: raw a ({'sensor' if kind == 'lab' else 'engine'})")
+        axs[0].plot(t, column(rows, "accel_m_s2"), color=main, lw=1.5, label=f"{lab}: 500 Hz Butterworth")
+        for ax, raw, integ, sc, what in ((axs[1], "velocity_raw_m_s", "velocity_int_m_s", 1.0, "v"),
+                                         (axs[2], "depth_raw_m", "depth_int_m", 100.0, "z")):
+            own = column(rows, raw, sc)
+            if own is not None:
+                ax.plot(t, own, color=main, lw=1.5, label=f"{lab}: {what} of the {'engine' if kind != 'lab' else 'record'}")
+            itg = column(rows, integ, sc)
+            if itg is not None:
+                green = "tab:green" if kind != "lab" or own is not None else main
+                ax.plot(t, itg, color=green, lw=1.3, ls="--" if own is not None else "-",
+                        label=f"{lab}: {what} integrated from the filtered a")
+        m = rec["metrics"]
+        xmax = max(xmax, 1000 * (m["t_end_s"] - m["t_start_s"]))
+        if idx == 0:
+            mark_fig2(axs, rows, t, m)
+        if rec.get("note"):
+            axs[0].text(0.01, 0.02, rec["note"], transform=axs[0].transAxes, fontsize=7, color="tab:red")
+    axs[0].set_ylabel("acceleration, up (m/s$^2$)")
+    axs[1].set_ylabel("velocity, down (m/s)")
+    axs[2].set_ylabel("depth below the surface (cm)")
     axs[2].invert_yaxis()
-    axs[2].set_xlabel("time since release (ms)")
-    axs[0].set_title(spec.get("title", ""), fontsize=9)
-    fig.tight_layout()
+    axs[2].set_xlabel("time since the collision start (ms)")
+    axs[0].set_xlim(-0.25 * xmax - 2, 1.35 * xmax + 2)
+    for ax in axs:
+        ax.grid(alpha=0.3)
+        ax.axvline(0, color="k", ls="--", lw=0.7)
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
+    axs[0].plot([], [], "k--", lw=0.7, label="collision start")
+    axs[0].plot([], [], "k:", lw=0.8, label="collision end")
+    axs[0].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
+    axs[0].set_title(spec.get("title", ""), fontsize=10)
+    fig.savefig(spec["out"], dpi=120)
+    plt.close(fig)
+    written.append(spec["out"])
+
+
+def mark_fig2(axs, rows, t, m):
+    """The paper's annotations: vc at the start, apeak at the peak, zstop at the end, tstop."""
+    t_end = 1000 * (m["t_end_s"] - m["t_start_s"])
+    for ax in axs:
+        ax.axvline(t_end, color="k", ls=":", lw=0.8)
+    a = column(rows, "accel_m_s2")
+    inside = [i for i, x in enumerate(t) if 0 <= x <= t_end] or list(range(len(t)))
+    ipk = max(inside, key=lambda i: a[i])
+    box = dict(arrowstyle="->", color="k", lw=0.8)
+    axs[0].annotate(f"apeak = {m['apeak_m_s2']:.1f} m/s$^2$", xy=(t[ipk], m["apeak_m_s2"]),
+                    xytext=(t[ipk] + 0.25 * t_end + 1, m["apeak_m_s2"]), arrowprops=box, va="center", fontsize=9)
+    y0, y1 = axs[0].get_ylim()
+    yt = y0 + 0.1 * (y1 - y0)
+    axs[0].annotate("", xy=(0, yt), xytext=(t_end, yt), arrowprops=dict(arrowstyle="<->", lw=0.8))
+    axs[0].text(0.5 * t_end, yt, f"tstop = {m['tstop_s'] * 1000:.1f} ms", ha="center", va="bottom", fontsize=9,
+                bbox=dict(facecolor="white", edgecolor="none", alpha=0.8, pad=1))
+    axs[1].annotate(f"vc = {m['vc_m_s']:.3f} m/s", xy=(0, m["vc_m_s"]), xytext=(0.2 * t_end + 1, 0.85 * m["vc_m_s"]),
+                    arrowprops=box, fontsize=9)
+    axs[2].annotate(f"zstop = {100 * m['zstop_m']:.2f} cm", xy=(t_end, 100 * m["zstop_m"]),
+                    xytext=(0.45 * t_end, 0.5 * 100 * m["zstop_m"]), arrowprops=box, fontsize=9)
+
+
+def plot_bed():
+    """Sunday et al. 2021 Fig. 1: the container cut through its axis (plane y = 0), the grains the
+    plane cuts drawn at their cut radius, coloured by their radial position in the prepared bed;
+    the projectile at release and at rest."""
+    import json
+    from matplotlib.collections import PatchCollection
+    from matplotlib.patches import Circle
+    spec = json.load(open(os.path.join(D, "bed.json")))
+    panels = spec["panels"]
+    Rc = 100 * spec["container_diameter_m"] / 2
+    Hw = 100 * spec["wall_height_m"]
+    plt.rcParams.update({"font.size": 10})
+    # Up to 2 cm above the highest of the surface and the projectile (the walls may go higher).
+    top = 100 * spec["surface_height_m"]
+    for p in panels:
+        if "projectile" in p:
+            top = max(top, 100 * (p["projectile"]["z_m"] + p["projectile"]["radius_m"]))
+    top = min(Hw, top + 2)
+    height = min(9.0, max(3.5, 6.2 * (top + 2) / (2 * Rc + 2) + 1.8))
+    fig, axs = plt.subplots(1, len(panels), figsize=(6.2 * len(panels) + 1.2, height), squeeze=False,
+                            layout="constrained")
+    mappable = None
+    for ax, p in zip(axs[0], panels):
+        rows = read(os.path.join(D, p["grains"]))
+        circles, colours = [], []
+        for r in rows:
+            y, rad = num(r["y_m"]), num(r["radius_m"])
+            if abs(y) >= rad:
+                continue
+            cut = math.sqrt(rad * rad - y * y)
+            circles.append(Circle((100 * num(r["x_m"]), 100 * num(r["z_m"])), 100 * cut))
+            colours.append(100 * num(r["r0_m"]))
+        pc = PatchCollection(circles, cmap="viridis", edgecolor="none")
+        pc.set_array(colours)
+        pc.set_clim(0, Rc)
+        ax.add_collection(pc)
+        mappable = pc
+        ax.plot([-Rc, -Rc, Rc, Rc], [Hw, 0, 0, Hw], color="k", lw=2, label="container (cut)")
+        ax.axhline(100 * spec["surface_height_m"], color="0.3", ls="--", lw=0.8, label="mean bed surface")
+        if "projectile" in p:
+            pj = p["projectile"]
+            y, rad = pj["y_m"], pj["radius_m"]
+            cut = math.sqrt(max(rad * rad - y * y, 0.0))
+            ax.add_patch(Circle((100 * pj["x_m"], 100 * pj["z_m"]), 100 * cut, facecolor="0.75", edgecolor="k",
+                                lw=1.2, label=f"projectile ({200 * rad:.0f} cm)"))
+        ax.set_xlim(-Rc - 1, Rc + 1)
+        ax.set_ylim(-0.5, top)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (cm), cut through the axis at y = 0")
+        ax.set_ylabel("height above the container floor (cm)")
+        ax.set_title(p["title"], fontsize=10)
+        if p.get("note"):
+            ax.text(0.02, 0.97, p["note"], transform=ax.transAxes, fontsize=8, va="top", color="tab:red")
+        ax.legend(fontsize=7, loc="upper right")
+    cb = fig.colorbar(mappable, ax=list(axs[0]), shrink=0.8, pad=0.02)
+    cb.set_label("initial radial position of the grain (cm)")
+    fig.suptitle(spec.get("title", ""), fontsize=10)
     fig.savefig(spec["out"], dpi=120)
     plt.close(fig)
     written.append(spec["out"])
@@ -289,6 +393,8 @@ def plot_trace():
 
 if WHICH == "trace":
     plot_trace()
+if WHICH == "bed":
+    plot_bed()
 if WHICH == "xy":
     plot_xy()
 if WHICH in ("all", "errors"):

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sys/wait.h>
+#include <unistd.h>
 #include <stdexcept>
 
 #include "results/report/plots_py.h"
@@ -161,6 +162,16 @@ void write_report_data(const std::string& dir, const Campaign& c,
     auto v = open_out(D / "verdict.txt");
     v << d->verdict << "\n";
   }
+}
+
+ScratchDir::ScratchDir(const std::string& tag)
+    : path(std::filesystem::temp_directory_path() / fmt::format("gravsweep-{}-{}", tag, ::getpid())) {
+  std::filesystem::create_directories(path);
+}
+
+ScratchDir::~ScratchDir() {
+  std::error_code ec;
+  std::filesystem::remove_all(path, ec);
 }
 
 int run_plots(const std::string& dir, const std::string& which, std::string& log) {

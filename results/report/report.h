@@ -1,6 +1,7 @@
 // Held-out comparisons of collision models (before/after tables), the data files behind the
 // report figures, and the PNG plots (results/report/plots.py, run with Debian's python3).
 #pragma once
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -28,5 +29,14 @@ void write_report_data(const std::string& dir, const Campaign& c,
 /// Runs the plotting script on `dir` (writes the PNGs there); returns the script's exit status
 /// and fills `log` with its output.
 int run_plots(const std::string& dir, const std::string& which, std::string& log);
+
+/// A private temporary folder for a figure's data (<tmp>/gravsweep-<tag>-<pid>), removed afterwards.
+struct ScratchDir {
+  std::filesystem::path path;
+  explicit ScratchDir(const std::string& tag);
+  ~ScratchDir();
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+};
 
 }  // namespace gravsweep::results

@@ -13,6 +13,13 @@
 
 namespace gravsweep::results {
 
+/// &, <, >, " escaped for HTML text and attributes.
+inline std::string html_escape(const std::string& x) {
+  std::string o;
+  for (char c : x) o += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : c == '"' ? "&quot;" : std::string(1, c);
+  return o;
+}
+
 class Table {
  public:
   explicit Table(std::vector<std::string> columns) : cols_(std::move(columns)) {}
@@ -70,6 +77,24 @@ class Table {
       throw std::invalid_argument(fmt::format("--format '{}': expected table, csv or json", format));
     }
     return out;
+  }
+  /// An HTML <table> (cells escaped; numeric cells right-aligned by the page's style).
+  [[nodiscard]] std::string render_html() const {
+    const auto& esc = html_escape;
+    std::string out = "<table>\n<tr>";
+    for (const auto& c : cols_) out += "<th>" + esc(c) + "</th>";
+    out += "</tr>\n";
+    for (const auto& r : rows_) {
+      out += "<tr>";
+      for (const auto& c : r) {
+        char* end = nullptr;
+        std::strtod(c.c_str(), &end);
+        const bool number = !c.empty() && end && *end == '\0';
+        out += (number ? "<td class=\"n\">" : "<td>") + esc(c) + "</td>";
+      }
+      out += "</tr>\n";
+    }
+    return out + "</table>\n";
   }
   void print(const std::string& format) const { std::fputs(render(format).c_str(), stdout); }
 

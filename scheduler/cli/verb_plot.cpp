@@ -2,9 +2,9 @@
 // against another (each run, and the mean +/- standard deviation of the repeats at each x), one
 // series per value of --group: the paper's Figs. 3 (zstop vs fill height), 6 (zstop vs mu_r) and
 // the metrics-vs-vc panels of Figs. 4-9 come from it. Units follow the column names (cm, ms, m/s2
-// on the axes, as the paper).
+// on the axes, as the paper). `plot trace` is Fig. 2 of one record, `plot bed` Fig. 1 of one run
+// (results/report/figures.h).
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -13,9 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "results/io/trace_file.h"
-#include "results/measurements/campaign.h"
-#include "results/processing/trace.h"
+#include "results/report/figures.h"
 #include "results/report/report.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
@@ -35,20 +33,6 @@ struct PlotResultsOptions {
   std::string db = "campaign.db";
   std::string x, y, group, sweep, title, out;
   std::vector<std::string> where;
-};
-
-/// A private temporary folder for the plot's data, removed afterwards.
-struct ScratchDir {
-  fs::path path;
-  ScratchDir() : path(fs::temp_directory_path() / fmt::format("gravsweep-plot-{}", ::getpid())) {
-    fs::create_directories(path);
-  }
-  ~ScratchDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  ScratchDir(const ScratchDir&) = delete;
-  ScratchDir& operator=(const ScratchDir&) = delete;
 };
 
 std::string csv_cell(const nlohmann::json& v) {
@@ -75,7 +59,7 @@ void run_plot_results(const PlotResultsOptions& o) {
   if (usable == 0)
     throw UsageError(fmt::format("{}: no finished run has numbers in both '{}' and '{}'{}", o.db, o.x, o.y,
                                  o.where.empty() && o.sweep.empty() ? "" : " (after --where/--sweep)"));
-  ScratchDir tmp;
+  results::ScratchDir tmp("plot");
   {
     std::ofstream f(tmp.path / "xy.csv");
     f << "x,y,group\n";
@@ -93,57 +77,19 @@ void run_plot_results(const PlotResultsOptions& o) {
   fmt::print("{} runs plotted: {}\n", usable, out.string());
 }
 
-struct PlotTraceOptions {
-  std::string trace, out;
-};
-
-/// The campaign's processing of a DEM record: the one processing entry of the model verbs and
-/// the drop job (read_dem_trial + process_trial: the scenario's filter and collision-end settings).
-results::ProcessedTrace process_dem_trace(const std::string& file) {
-  try {
-    results::MeasuredTrial t = results::read_dem_trial({fs::path(file).stem().string(), "", file});
-    results::process_trial(t);
-    return t.processed;
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(fmt::format("{}: cannot process the record: {}", file, e.what()));
-  }
+void run_plot_trace(const results::Fig2Request& o) {
+  results::Fig2Request rq = o;
+  if (rq.out.empty()) rq.out = (fs::path(o.record).parent_path() / "fig2.png").string();
+  const results::Metrics m = results::draw_fig2(rq);
+  fmt::print("vc {:.3f} m/s, apeak {:.2f} m/s2, zstop {:.2f} cm, tstop {:.1f} ms: {}\n", m.vc_m_s, m.apeak_m_s2,
+             100 * m.zstop_m, 1000 * m.tstop_s, fs::absolute(rq.out).string());
 }
 
-void run_plot_trace(const PlotTraceOptions& o) {
-  if (!fs::exists(o.trace)) throw UsageError(fmt::format("no trace file at '{}'", o.trace));
-  const std::string out_name = o.out.empty() ? (fs::path(o.trace).parent_path() / "fig2.png").string() : o.out;
-  if (fs::path(out_name).extension() != ".png")
-    throw UsageError(fmt::format("--out: expected a file name ending in .png, found '{}'", out_name));
-  results::TraceData td;
-  try {
-    td = results::read_trace(o.trace);
-  } catch (const std::exception& e) {
-    throw UsageError(fmt::format("{}: not a readable gravsweep trace.h5 ({})", o.trace, e.what()));
-  }
-  const results::ProcessedTrace p = process_dem_trace(o.trace);
-  ScratchDir tmp;
-  {
-    std::ofstream f(tmp.path / "trace.csv");
-    f << "t_s,accel_raw_m_s2,velocity_raw_m_s,depth_raw_m,accel_m_s2,velocity_m_s,depth_m\n";
-    for (std::size_t i = 0; i < p.t_s.size(); ++i)
-      f << fmt::format("{},{},{},{},{},{},{}\n", p.t_s[i], td.accel_up_m_s2[i], td.velocity_down_m_s[i], td.depth_m[i],
-                       p.accel_up_m_s2[i], p.velocity_down_m_s[i], p.depth_m[i]);
-  }
-  const auto& m = p.metrics;
-  const fs::path out = fs::absolute(out_name);
-  fs::create_directories(out.parent_path());
-  {
-    const json metrics{{"vc_m_s", m.vc_m_s},   {"apeak_m_s2", m.apeak_m_s2}, {"zstop_m", m.zstop_m},
-                       {"tstop_s", m.tstop_s}, {"t_start_s", m.t_start_s},   {"t_end_s", m.t_end_s}};
-    std::ofstream f(tmp.path / "trace.json");
-    f << json{{"out", out.string()}, {"source", "dem"}, {"metrics", metrics},
-              {"title", fmt::format("{}: g = {} m/s2, vc = {:.3f} m/s", o.trace, td.gravity_m_s2, m.vc_m_s)}}
-             .dump();
-  }
-  std::string log;
-  if (results::run_plots(tmp.path.string(), "trace", log) != 0) throw std::runtime_error("plotting failed: " + log);
-  fmt::print("vc {:.3f} m/s, apeak {:.2f} m/s2, zstop {:.2f} cm, tstop {:.1f} ms: {}\n", m.vc_m_s, m.apeak_m_s2,
-             100 * m.zstop_m, 1000 * m.tstop_s, out.string());
+void run_plot_bed(const results::Fig1Request& o) {
+  results::Fig1Request rq = o;
+  if (rq.out.empty()) rq.out = (fs::path(o.bed).parent_path() / "fig1.png").string();
+  const std::string what = results::draw_fig1(rq);
+  fmt::print("{}: {}\n", what, fs::absolute(rq.out).string());
 }
 
 }  // namespace
@@ -171,19 +117,45 @@ void setup_plot(CLI::App& app) {
   res->add_option("--out", o->out, "PNG file to write")->required();
   res->callback([o]() { run_plot_results(*o); });
 
-  auto ot = std::make_shared<PlotTraceOptions>();
+  auto ot = std::make_shared<results::Fig2Request>();
   auto* tr = plot->add_subcommand(
       "trace",
-      "Sunday et al. 2021 Fig. 2 for one drop: acceleration (raw and after the paper's 500 Hz\n"
-      "Butterworth), velocity and depth against time, with the collision start and end, vc, apeak,\n"
-      "zstop and tstop marked, processed exactly as the campaign processed it (the scenario's filter\n"
-      "and collision-end settings). Default output: fig2.png next to the trace.\n\n"
+      "Sunday et al. 2021 Fig. 2 for one record: acceleration, velocity and depth against the time\n"
+      "since the collision start, raw and as the paper processes it (2nd-order 500 Hz Butterworth;\n"
+      "velocity and depth re-integrated from the filtered acceleration: the paper's green line),\n"
+      "with vc, apeak, zstop and tstop marked. A DEM trace.h5 is processed exactly as the campaign\n"
+      "processed it (the scenario's filter and collision-end settings); a lab trace CSV with its\n"
+      "campaign's trials.csv (in its folder or the one above). --compare lays another record, lab\n"
+      "or DEM, over the first. Default output: fig2.png next to the record (`gravsweep run` writes\n"
+      "it for every run). A record without contact is refused (exit 2).\n\n"
       "Examples:\n"
       "  gravsweep plot trace runs/1g/trace.h5\n"
+      "  gravsweep plot trace runs/1g/trace.h5 --compare ../shared/data/measurements/depth-friction-dev/traces/t001.csv\n"
       "  gravsweep plot trace campaign.files/traces/<job>.a1.h5 --out fig2.png");
-  tr->add_option("trace", ot->trace, "a trace.h5 of `gravsweep run` or of a campaign")->required();
-  tr->add_option("--out", ot->out, "PNG file to write (default: fig2.png next to the trace)");
+  tr->add_option("record", ot->record, "a trace.h5 of `gravsweep run` or of a campaign, or a lab trace .csv")->required();
+  tr->add_option("--compare", ot->compare, "another record (trace.h5 or lab .csv) drawn over the first");
+  tr->add_option("--out", ot->out, "PNG file to write (default: fig2.png next to the record)");
   tr->callback([ot]() { run_plot_trace(*ot); });
+
+  auto ob = std::make_shared<results::Fig1Request>();
+  auto* bd = plot->add_subcommand(
+      "bed",
+      "Sunday et al. 2021 Fig. 1 for one run: the container cut through its axis (the grains that\n"
+      "the plane y = 0 cuts, drawn at their cut radius), coloured by each grain's radial position in\n"
+      "the prepared bed, with the projectile at release (a) and at rest (b) from --trace. The grains\n"
+      "of (b) come from the drop's snapshots.h5 when it has one (`gravsweep run` writes it), so the\n"
+      "colours show how the impact displaced them; else the prepared bed is drawn. Default output:\n"
+      "fig1.png next to the bed.\n\n"
+      "Examples:\n"
+      "  gravsweep plot bed runs/1g/bed.h5 --trace runs/1g/trace.h5\n"
+      "  gravsweep plot bed runs/1g/bed.h5 --trace runs/1g/trace.h5 --at rest --out rest.png");
+  bd->add_option("bed", ob->bed, "a bed.h5 of `gravsweep run` or of a campaign")->required();
+  bd->add_option("--trace", ob->trace, "the drop's trace.h5: draws the projectile");
+  bd->add_option("--at", ob->at, "only one panel: release or rest (default: both, with --trace)")
+      ->check(CLI::IsMember({"release", "rest"}));
+  bd->add_option("--snapshots", ob->snapshots, "the drop's snapshots.h5 (default: the one next to --trace)");
+  bd->add_option("--out", ob->out, "PNG file to write (default: fig1.png next to the bed)");
+  bd->callback([ob]() { run_plot_bed(*ob); });
 }
 
 }  // namespace gravsweep::cli

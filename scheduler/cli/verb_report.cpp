@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "results/model/model.h"
+#include "results/report/html.h"
 #include "results/report/report.h"
 #include "results/report/table.h"
 #include "scheduler/cli/campaign_input.h"
@@ -24,14 +25,93 @@ struct ReportOptions {
   std::vector<std::string> where;
   int folds = 6;
 };
+/// The figures of a report, each with its one-line caption.
+std::vector<results::HtmlFigure> report_figures() {
+  return {
+      {"fig9_metrics_vs_vc.png",
+       "Fig. 9 of Sunday et al. 2021: apeak, zstop and tstop against the collision velocity vc, one column per "
+       "gravity level; dots are the trials, lines the models fitted on all trials."},
+      {"residual_vs_depth_speed.png",
+       "Residual a_meas - a_model (in g) against depth and speed, coloured by gravity, for the baseline and the "
+       "extended model: a trend left over is a missing term."},
+      {"fig10_zstop_vs_H.png",
+       "Fig. 10: penetration depth zstop against the total height H = drop height + zstop (log-log), with the "
+       "models' curves."},
+      {"ranking.png",
+       "Candidate terms by the mean held-out improvement of the trace error per trial (green: significant in a "
+       "signed-rank test over trials, Bonferroni over the candidates)."},
+      {"error_falls.png",
+       "Held-out relative RMS errors of the trace, zstop, tstop and apeak per model (grouped CV, whole trials left "
+       "out)."},
+  };
+}
+
+/// Verdict, tables and figures of the report, rendered into summary.md and index.html.
+results::HtmlReport report_page(const std::string& dir, const CampaignInput& in, const results::Discovery& d,
+                                const std::vector<results::ComparedModel>& cm) {
+  const results::Campaign& c = in.campaign;
+  results::HtmlReport page;
+  page.title = fmt::format("Model vs measurements: {} ({})", dir, in.kind);
+  page.summary = fmt::format("{} trials, gravity levels:", c.trials.size());
+  for (double g : c.gravity_levels()) page.summary += fmt::format(" {} m/s2", g);
+  page.summary += fmt::format(". {} not usable{}", c.issues.size(), c.issues.empty() ? "." : "");
+  for (const auto& is : c.issues) page.issues.push_back(is.to_string());
+  page.verdict = d.verdict;
+  {
+    results::HtmlSection s;
+    s.heading = fmt::format("Where {} fails", d.baseline);
+    s.text = "Residual a_meas - a_model (in g) by quantile bins of each axis; eta2 is the share of the residual "
+             "variance the bins explain, the sign test counts trials whose within-trial slope is up or down.";
+    for (const auto* axes : {&d.residual_before, &d.residual_after}) {
+      results::Table t({"axis", "eta2", "trials_up", "trials_down", "mean_residual_over_g_by_bin"});
+      for (const auto& a : *axes) {
+        std::string bins;
+        for (std::size_t i = 0; i < a.bin_center.size(); ++i)
+          bins += fmt::format("{}{:.3g}:{:+.3f}", i ? " " : "", a.bin_center[i], a.bin_mean_r_over_g[i]);
+        t.add({a.axis, results::num(a.eta2, 3), std::to_string(a.trials_positive), std::to_string(a.trials_negative),
+               bins});
+      }
+      s.tables.emplace_back(axes == &d.residual_before ? "before (" + d.baseline + ")" : "after (with the added terms)", t);
+    }
+    page.sections.push_back(std::move(s));
+  }
+  {
+    results::Table t({"gravity_m_s2", "trials", "f0_N", "f0_se_N", "inv_d1_1_m", "inv_d1_se_1_m", "vt_m_s", "alpha", "alpha_se"});
+    for (const auto& r : results::table3(c))
+      t.add({results::num(r.g_m_s2), std::to_string(r.trials), results::num(r.f0_N, 3), results::num(r.f0_se_N, 2),
+             results::num(r.inv_d1_1_m, 3), results::num(r.inv_d1_se_1_m, 2), results::num(r.vt_m_s, 3),
+             results::num(r.alpha, 3), results::num(r.alpha_se, 2)});
+    page.sections.push_back({"Table 3 (paper's method: Eq. 2 fitted to apeak per gravity level)", "", {{"", t}}});
+  }
+  {
+    results::Table t({"model", "trace_rel_pct", "zstop_rms_mm", "zstop_rel_pct", "tstop_rms_ms", "tstop_rel_pct", "apeak_rel_pct"});
+    for (const auto& m : cm)
+      t.add({m.name, results::num(m.errors.trace_rel_pct, 3), results::num(m.errors.zstop_rms_mm, 3),
+             results::num(m.errors.zstop_rel_pct, 3), results::num(m.errors.tstop_rms_ms, 3),
+             results::num(m.errors.tstop_rel_pct, 3), results::num(m.errors.apeak_rel_pct, 3)});
+    page.sections.push_back({"Held-out errors (grouped CV, whole trials held out)", "", {{"", t}}});
+  }
+  {
+    results::Table t({"round", "term", "mean_rel_improvement_pct", "trials_better", "trials", "p_signed_rank", "significant"});
+    for (std::size_t r = 0; r < d.rounds.size(); ++r)
+      for (const auto& cd : d.rounds[r])
+        t.add({std::to_string(r + 1), cd.term, results::num(100 * cd.mean_rel_improvement, 3),
+               std::to_string(cd.trials_better), std::to_string(cd.trials), results::num(cd.p_value, 2),
+               cd.significant ? "yes" : "no"});
+    page.sections.push_back({"Candidate ranking", "", {{"", t}}});
+  }
+  page.figures = report_figures();
+  return page;
+}
+
 }  // namespace
 
 void setup_report(CLI::App& app) {
   auto o = std::make_shared<ReportOptions>();
   auto* sub = app.add_subcommand(
       "report",
-      "Compare collision models with a measurement campaign and write PNG figures and a summary\n"
-      "page (summary.md) into --out: fig9_metrics_vs_vc.png (apeak, zstop, tstop vs vc with the\n"
+      "Compare collision models with a measurement campaign and write PNG figures, a summary\n"
+      "page (summary.md) and index.html (one self-contained page, figures embedded, to send) into --out: fig9_metrics_vs_vc.png (apeak, zstop, tstop vs vc with the\n"
       "model lines), residual_vs_depth_speed.png (coloured by gravity), fig10_zstop_vs_H.png,\n"
       "ranking.png and error_falls.png, plus the CSV files behind them. Without --model the\n"
       "missing effect is searched for (as `gravsweep model rank`) and the winner is added.\n\n"
@@ -79,64 +159,28 @@ void setup_report(CLI::App& app) {
     std::string log;
     const int rc = results::run_plots(o->out, "all", log);
     if (rc != 0) throw std::runtime_error("plotting failed (python3 with matplotlib needed): " + log);
-    // Summary page.
+    // The same tables in summary.md and index.html.
     namespace fs = std::filesystem;
+    results::HtmlReport page = report_page(o->dir, in, d, cm);
     std::ofstream md(fs::path(o->out) / "summary.md");
-    md << fmt::format("# Model vs measurements: {} ({})\n\n", o->dir, in.kind);
-    md << fmt::format("{} trials, gravity levels:", c.trials.size());
-    for (double g : c.gravity_levels()) md << fmt::format(" {} m/s2", g);
-    md << fmt::format(". {} not usable{}\n\n", c.issues.size(), c.issues.empty() ? "." : ":");
-    for (const auto& is : c.issues) md << fmt::format("- {}\n", is.to_string());
-    md << fmt::format("{}## Verdict\n\n{}\n\n", c.issues.empty() ? "" : "\n", d.verdict);
-    md << fmt::format("## Where {} fails\n\nResidual a_meas - a_model (in g) by quantile bins of each axis; eta2 is the share "
-                      "of the residual variance the bins explain, the sign test counts trials whose within-trial slope "
-                      "is up or down.\n\n```\n", d.baseline);
-    for (const auto* axes : {&d.residual_before, &d.residual_after}) {
-      results::Table t({"axis", "eta2", "trials_up", "trials_down", "mean_residual_over_g_by_bin"});
-      for (const auto& a : *axes) {
-        std::string bins;
-        for (std::size_t i = 0; i < a.bin_center.size(); ++i)
-          bins += fmt::format("{}{:.3g}:{:+.3f}", i ? " " : "", a.bin_center[i], a.bin_mean_r_over_g[i]);
-        t.add({a.axis, results::num(a.eta2, 3), std::to_string(a.trials_positive), std::to_string(a.trials_negative), bins});
-      }
-      md << (axes == &d.residual_before ? "before (" + d.baseline + "):\n" : "\nafter (with the added terms):\n");
-      md << t.render("table");
+    md << fmt::format("# {}\n\n{}", page.title, page.summary);
+    md << fmt::format("{}\n\n", c.issues.empty() ? "" : ":");
+    for (const auto& is : page.issues) md << fmt::format("- {}\n", is);
+    md << fmt::format("{}## Verdict\n\n{}\n\n", c.issues.empty() ? "" : "\n", page.verdict);
+    for (const auto& sec : page.sections) {
+      md << fmt::format("## {}\n\n{}```\n", sec.heading, sec.text.empty() ? "" : sec.text + "\n\n");
+      for (std::size_t i = 0; i < sec.tables.size(); ++i)
+        md << (i ? "\n" : "") << (sec.tables[i].first.empty() ? "" : sec.tables[i].first + ":\n")
+           << sec.tables[i].second.render("table");
+      md << "```\n\n";
     }
-    md << "```\n\n";
-    md << "## Table 3 (paper's method: Eq. 2 fitted to apeak per gravity level)\n\n```\n";
-    {
-      results::Table t({"gravity_m_s2", "trials", "f0_N", "f0_se_N", "inv_d1_1_m", "inv_d1_se_1_m", "vt_m_s", "alpha", "alpha_se"});
-      for (const auto& r : results::table3(c))
-        t.add({results::num(r.g_m_s2), std::to_string(r.trials), results::num(r.f0_N, 3), results::num(r.f0_se_N, 2),
-               results::num(r.inv_d1_1_m, 3), results::num(r.inv_d1_se_1_m, 2), results::num(r.vt_m_s, 3),
-               results::num(r.alpha, 3), results::num(r.alpha_se, 2)});
-      md << t.render("table");
-    }
-    md << "```\n\n## Held-out errors (grouped CV, whole trials held out)\n\n```\n";
-    {
-      results::Table t({"model", "trace_rel_pct", "zstop_rms_mm", "zstop_rel_pct", "tstop_rms_ms", "tstop_rel_pct", "apeak_rel_pct"});
-      for (const auto& m : cm)
-        t.add({m.name, results::num(m.errors.trace_rel_pct, 3), results::num(m.errors.zstop_rms_mm, 3),
-               results::num(m.errors.zstop_rel_pct, 3), results::num(m.errors.tstop_rms_ms, 3),
-               results::num(m.errors.tstop_rel_pct, 3), results::num(m.errors.apeak_rel_pct, 3)});
-      md << t.render("table");
-    }
-    md << "```\n\n## Candidate ranking\n\n```\n";
-    {
-      results::Table t({"round", "term", "mean_rel_improvement_pct", "trials_better", "trials", "p_signed_rank", "significant"});
-      for (std::size_t r = 0; r < d.rounds.size(); ++r)
-        for (const auto& cd : d.rounds[r])
-          t.add({std::to_string(r + 1), cd.term, results::num(100 * cd.mean_rel_improvement, 3),
-                 std::to_string(cd.trials_better), std::to_string(cd.trials), results::num(cd.p_value, 2),
-                 cd.significant ? "yes" : "no"});
-      md << t.render("table");
-    }
-    md << "```\n\n## Figures\n\n";
-    for (const char* png : {"fig9_metrics_vs_vc.png", "residual_vs_depth_speed.png", "fig10_zstop_vs_H.png",
-                            "ranking.png", "error_falls.png"})
-      md << fmt::format("![{}]({})\n\n", png, png);
+    md << "## Figures\n\n";
+    for (const auto& f : page.figures)
+      if (fs::exists(fs::path(o->out) / f.file)) md << fmt::format("![{}]({})\n\n{}\n\n", f.file, f.file, f.caption);
+    const fs::path html = results::write_html_report(o->out, page);
     fmt::print("{}", log);
-    fmt::print("{}\nverdict: {}\n", (fs::path(o->out) / "summary.md").string(), d.verdict);
+    fmt::print("{}\n{} (one self-contained page: open it in a browser)\nverdict: {}\n",
+               (fs::path(o->out) / "summary.md").string(), html.string(), d.verdict);
   });
 }
 

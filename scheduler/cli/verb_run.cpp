@@ -9,6 +9,8 @@
 #include <memory>
 #include <string>
 
+#include "engine/core/error.h"
+#include "results/report/figures.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/progress.h"
 #include "scheduler/cli/verbs.h"
@@ -25,7 +27,35 @@ struct RunOptions {
   std::string bed;
   int threads = 0;
   bool quiet = false;
+  double snapshot_interval_s = -1;  ///< < 0: the scenario's /output/snapshot_interval_s, else kRunSnapshotInterval_s
+  bool no_figures = false;
 };
+
+/// `run`'s grain snapshots when neither the scenario nor --snapshot-interval sets them (issue 15):
+/// 200 per simulated second, about 40 for a drop to rest (BENCHMARKS.md: bytes and slowdown).
+constexpr double kRunSnapshotInterval_s = 0.005;
+
+/// The snapshot interval of this run: --snapshot-interval, else the scenario file's own
+/// /output/snapshot_interval_s, else kRunSnapshotInterval_s (campaign drops default to none).
+double snapshot_interval(const RunOptions& o) {
+  if (o.snapshot_interval_s >= 0) return o.snapshot_interval_s;
+  std::ifstream f(o.scenario);
+  const auto raw = nlohmann::json::parse(f, nullptr, false);
+  const auto ptr = "/output/snapshot_interval_s"_json_pointer;
+  return raw.is_object() && raw.contains(ptr) && raw[ptr].is_number() ? raw[ptr].get<double>() : kRunSnapshotInterval_s;
+}
+
+/// Fig. 2 of the drop next to its trace; a drop the metrics cannot measure gets none (said why).
+void draw_run_fig2(const std::filesystem::path& trace, const std::filesystem::path& bed) {
+  const auto png = trace.parent_path() / "fig2.png";
+  try {
+    results::draw_fig2({trace.string(), "", png.string()});
+    fmt::print("wrote {} (Fig. 2; `gravsweep plot bed {} --trace {}` draws Fig. 1)\n", png.string(),
+               bed.string(), trace.string());
+  } catch (const ConfigError& e) {
+    fmt::print("no fig2.png: {}\n", e.what());
+  }
+}
 
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop.store(true); }
@@ -64,7 +94,8 @@ void print_metrics(const nlohmann::json& m, const nlohmann::json& bed_report) {
 }
 
 void run_impact(const RunOptions& o) {
-  const nlohmann::json scenario = pipeline::load_scenario(o.scenario);  // refuses bad specs first
+  nlohmann::json scenario = pipeline::load_scenario(o.scenario);  // refuses bad specs first
+  scenario["output"]["snapshot_interval_s"] = snapshot_interval(o);
   const std::filesystem::path out(o.out);
   std::error_code ec;
   std::filesystem::create_directories(out, ec);
@@ -123,6 +154,10 @@ void run_impact(const RunOptions& o) {
     print_metrics(metrics, bed_report);
     fmt::print("\nwrote {}, {} and {}\n", o.bed.empty() ? bed_path.string() : std::string("(bed reused)"),
                d.trace_path.string(), mpath.string());
+    if (d.snapshots > 0)
+      fmt::print("wrote {} snapshots ({:.0f} kB of state each) to {}, index {} (ParaView, VisIt)\n", d.snapshots,
+                 d.snapshot_bytes / 1e3, d.snapshot_path.string(), d.snapshot_xdmf.string());
+    if (!o.no_figures) draw_run_fig2(d.trace_path, bed_path);
   } catch (const pipeline::Interrupted& e) {
     bar.finish();
     throw InterruptedExit(e.what());
@@ -140,7 +175,10 @@ void setup_run(CLI::App& app) {
       "vc, apeak, zstop, tstop (Butterworth 500 Hz, end at a < 0.1 g with the speed below 10 % of vc)\n"
       "and the rebound flag.\n"
       "Writes DIR/bed.h5 (the prepared bed, reusable), DIR/trace.h5 (the projectile at 10 kHz),\n"
-      "DIR/metrics.json, and prints the metrics. The spec is checked against\n"
+      "DIR/metrics.json, DIR/fig2.png (Sunday et al. Fig. 2, as `gravsweep plot trace`), grain\n"
+      "snapshots DIR/snapshots.h5 with DIR/snapshots.xdmf (open it in ParaView: grains and\n"
+      "projectile as point sets, every 5 ms unless the scenario or --snapshot-interval says\n"
+      "otherwise), and prints the metrics. The spec is checked against\n"
       "schemas/scenario.schema.json before any work; errors name the JSON pointer of the field.\n\n"
       "Examples:\n"
       "  gravsweep run examples/impact_1g.json --out runs/1g\n"
@@ -157,6 +195,12 @@ void setup_run(CLI::App& app) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   sub->add_flag("--quiet", opt->quiet, "no progress bar");
+  sub->add_option("--snapshot-interval", opt->snapshot_interval_s,
+                  fmt::format("grain snapshots every S s of simulated time into DIR/snapshots.h5 + .xdmf; 0: none "
+                              "(default: the scenario's /output/snapshot_interval_s, else {})",
+                              kRunSnapshotInterval_s))
+      ->check(CLI::NonNegativeNumber);
+  sub->add_flag("--no-figures", opt->no_figures, "do not draw DIR/fig2.png");
   sub->callback([opt]() {
     try {
       run_impact(*opt);

@@ -4,12 +4,14 @@
 
 #include <chrono>
 #include <cmath>
+#include <memory>
 
 #include "engine/core/error.h"
 #include "engine/scenario/bed.h"
 #include "engine/scenario/impact.h"
 #include "engine/scenario/paper_params.h"
 #include "results/io/bed_file.h"
+#include "results/io/snapshot_file.h"
 #include "results/io/trace_file.h"
 #include "results/measurements/campaign.h"
 #include "results/processing/trace.h"
@@ -48,6 +50,19 @@ json bed_key_of_validated(const json& s) {
 std::string first_difference(const json& a, const json& b) {
   const json patch = json::diff(a, b);
   return patch.empty() ? std::string() : patch[0].value("path", std::string("/"));
+}
+
+/// The state of one point set for a snapshot (results/io/snapshot_file.h).
+void gather_points(const Particles& p, const std::vector<int>& contacts, std::size_t begin, std::size_t end,
+                   results::SnapshotPoints& out) {
+  for (std::size_t i = begin; i < end; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      out.position_m.push_back(p.position_m[i][k]);
+      out.velocity_m_s.push_back(p.velocity_m_s[i][k]);
+      out.omega_rad_s.push_back(p.omega_rad_s[i][k]);
+    }
+    out.contacts.push_back(contacts[i]);
+  }
 }
 
 }  // namespace
@@ -159,11 +174,29 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   System sys(p.drop_config);
   load_bed(sys, bed);
 
+  // Grain snapshots (issue 15): the grains keep the order of bed.h5, the projectile comes last.
+  std::unique_ptr<results::SnapshotWriter> snaps;
+  DropSnapshots ds;
+  if (p.snapshot_interval_s > 0) {
+    snaps = std::make_unique<results::SnapshotWriter>(results::snapshot_path_for(trace_out), bed.radius_m,
+                                                      0.5 * p.projectile.diameter_m, p.snapshot_interval_s,
+                                                      GRAVSWEEP_VERSION);
+    ds.interval_s = p.snapshot_interval_s;
+    ds.write = [&](const System& sy, ParticleIndex ip, double t_s) {
+      const std::vector<int> c = sy.contact_counts();
+      results::Snapshot sn;
+      sn.t_s = t_s;
+      gather_points(sy.particles, c, 0, ip, sn.grains);
+      gather_points(sy.particles, c, ip, ip + 1, sn.projectile);
+      snaps->append(sn);
+    };
+  }
   const DropResult dr = drop_projectile(sys, bed.surface_height_m, p.projectile, p.stop, p.sample_rate_hz,
                                         [&](double f, const std::string& d) {
                                           check_stop(stop, "drop");
                                           if (progress) progress("drop", f, d);
-                                        });
+                                        },
+                                        ds);
   const double wall_s = seconds_since(t0);
 
   results::TraceData td;
@@ -239,8 +272,15 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   m["wall_time_s"] = wall_s;
   td.metrics_json = m.dump();
   check_stop(stop, "drop");
+  DropJobResult out{trace_out, m};
+  if (snaps) {
+    out.snapshots = snaps->count();
+    out.snapshot_bytes = snaps->bytes_per_snapshot();
+    out.snapshot_path = results::snapshot_path_for(trace_out);
+    out.snapshot_xdmf = snaps->finish();
+  }
   results::write_trace(trace_out, td);
-  return DropJobResult{trace_out, m};
+  return out;
 }
 
 }  // namespace gravsweep::pipeline

@@ -33,7 +33,11 @@ struct BedJobResult {
 struct DropJobResult {
   std::filesystem::path trace_path;
   nlohmann::json metrics;  ///< vc_m_s, apeak_m_s2, zstop_m, tstop_s, rebound, wall_time_s, ...
+  /// Grain snapshots (/output/snapshot_interval_s > 0): the .h5 and its .xdmf index, else empty.
+  std::filesystem::path snapshot_path, snapshot_xdmf;
+  std::size_t snapshots = 0, snapshot_bytes = 0;  ///< count, state bytes per snapshot
 };
+
 
 /// Validates `scenario` (throws SpecError, a ConfigError, with the JSON pointer on bad input),
 /// prepares the bed and writes it to bed_out (HDF5), written under a temporary name then renamed.
@@ -45,6 +49,7 @@ BedJobResult run_bed_job(const nlohmann::json& scenario, const std::filesystem::
 /// (HDF5, temporary name then rename) and returns the metrics: the paper's vc, apeak, zstop, tstop,
 /// rebound, plus wall time. A collision the metrics cannot resolve (e.g. no contact before the time
 /// cap) is not an error: the metrics carry "metrics_error" with the reason, and null values.
+/// With /output/snapshot_interval_s > 0 it also writes results::snapshot_path_for(trace_out) and its XDMF.
 DropJobResult run_drop_job(const nlohmann::json& scenario, const std::filesystem::path& bed_in,
                            const std::filesystem::path& trace_out, int threads, const Progress& progress,
                            const std::atomic<bool>* stop);

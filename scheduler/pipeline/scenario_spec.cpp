@@ -301,6 +301,7 @@ ScenarioParams scenario_params(const json& s) {
   out.stop.hold_time_s = s["/stop/hold_time_s"_json_pointer];
   out.stop.max_time_s = s["/stop/max_time_s"_json_pointer];
   out.sample_rate_hz = s["/output/sample_rate_hz"_json_pointer];
+  out.snapshot_interval_s = s["/output/snapshot_interval_s"_json_pointer];
 
   results::MetricOptions& mo = out.metric_options;
   mo.gravity_m_s2 = out.gravity_m_s2;

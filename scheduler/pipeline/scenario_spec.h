@@ -35,6 +35,7 @@ struct ScenarioParams {
   DropStop stop;
   double gravity_m_s2 = 9.81;
   double sample_rate_hz = 1e4;
+  double snapshot_interval_s = 0;  ///< /output/snapshot_interval_s: grain snapshots, 0 = none
   results::MetricOptions metric_options;  ///< fill height and grain diameter set from the bed
 };
 

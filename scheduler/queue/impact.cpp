@@ -37,6 +37,13 @@ void add_impact_runners(RunnerTable& table) {
                                     ctx.stop);
     if (r.trace_path != ctx.output_tmp && !r.trace_path.empty())
       std::filesystem::rename(r.trace_path, ctx.output_tmp);
+    if (!r.snapshot_path.empty()) {
+      // Grain snapshots (/output/snapshot_interval_s > 0): <campaign>.files/snapshots/, a folder that
+      // `resume` leaves alone (they are for viewing; no job refers to them).
+      const auto dir = ctx.output_tmp.parent_path().parent_path() / "snapshots";
+      std::filesystem::create_directories(dir);
+      for (const auto& f : {r.snapshot_path, r.snapshot_xdmf}) std::filesystem::rename(f, dir / f.filename());
+    }
     RunOutput out;
     out.metrics = r.metrics;
     return out;

@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 
 #include "results_helpers.h"
+#include "tests/common/png_check.h"
 
 using gravsweep::testing::TempDir;
 namespace fs = std::filesystem;
@@ -97,6 +98,29 @@ TEST(Cli, ReportWritesFiguresAndSummary) {
   const std::string s{std::istreambuf_iterator<char>(md), std::istreambuf_iterator<char>()};
   EXPECT_NE(s.find("immersion_drag"), std::string::npos);
   EXPECT_NE(s.find("Table 3"), std::string::npos);
+  // index.html: one self-contained page with the verdict, the tables and every figure embedded.
+  std::ifstream hf(fs::path(out) / "index.html");
+  const std::string h{std::istreambuf_iterator<char>(hf), std::istreambuf_iterator<char>()};
+  EXPECT_NE(h.find("<h2>Verdict</h2>"), std::string::npos);
+  EXPECT_NE(h.find("immersion_drag"), std::string::npos);
+  EXPECT_NE(h.find("<table>"), std::string::npos);
+  std::size_t images = 0;
+  for (auto at = h.find("src=\"data:image/png;base64,iVBORw0KGgo"); at != std::string::npos;
+       at = h.find("src=\"data:image/png;base64,iVBORw0KGgo", at + 1))
+    ++images;  // "iVBORw0KGgo" is the PNG signature in base64
+  EXPECT_EQ(images, 5u);
+  EXPECT_EQ(h.find("src=\"http"), std::string::npos);
+  EXPECT_EQ(h.find("src=\"fig"), std::string::npos);
+  EXPECT_NE(h.find("<figcaption><b>fig10_zstop_vs_H.png</b>: Fig. 10"), std::string::npos);
+  // In a real browser (deploy/check-report.sh: headless chromium, a screenshot that is not blank).
+  const std::string shot = d.str() + "/shot.png";
+  const int rc = std::system(("'" GRAVSWEEP_SOURCE_DIR "/deploy/check-report.sh' '" + out + "' '" + shot + "' >/dev/null 2>&1").c_str());
+  if (WIFEXITED(rc) && WEXITSTATUS(rc) == 77) GTEST_SKIP() << "chromium not installed: the browser check is skipped";
+  ASSERT_EQ(WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, 0) << "deploy/check-report.sh failed";
+  const auto st = gravsweep::test::png_stats(shot);
+  ASSERT_TRUE(st.ok);
+  EXPECT_EQ(st.width, 1280);
+  EXPECT_GT(st.pixel_std, 0.05) << "the screenshot is blank";
 }
 
 TEST(Cli, CheckDetectionCountsRankedFirstAndNullReports) {

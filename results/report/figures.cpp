@@ -1,0 +1,258 @@
+// Figures of one drop: the data of Fig. 1 and Fig. 2 (see figures.h), drawn by plots.py.
+#include "results/report/figures.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "engine/core/error.h"
+#include "results/io/bed_file.h"
+#include "results/io/hdf5.h"
+#include "results/io/snapshot_file.h"
+#include "results/io/trace_file.h"
+#include "results/measurements/campaign.h"
+#include "results/report/report.h"
+
+namespace gravsweep::results {
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+double interp(const std::vector<double>& t, const std::vector<double>& y, double tq) {
+  if (t.empty() || y.size() != t.size()) return NAN;
+  if (tq <= t.front()) return y.front();
+  if (tq >= t.back()) return y.back();
+  const auto k = static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), tq) - t.begin());
+  const double w = (tq - t[k - 1]) / (t[k] - t[k - 1]);
+  return y[k - 1] + w * (y[k] - y[k - 1]);
+}
+
+/// A lab record: the trial of the campaign folder (trials.csv in the trace's folder or the one above)
+/// whose trace_file is this file, read and processed as `measurements import` does.
+MeasuredTrial load_lab_record(const fs::path& path) {
+  const fs::path file = fs::weakly_canonical(path);
+  for (const fs::path& dir : {file.parent_path(), file.parent_path().parent_path()}) {
+    if (!fs::exists(dir / "trials.csv")) continue;
+    Campaign c;
+    try {
+      c = load_campaign(dir.string());
+    } catch (const std::exception& e) {
+      throw ConfigError(fmt::format("{}: cannot read the campaign of this record: {}", path.string(), e.what()));
+    }
+    for (auto& t : c.trials)
+      if (fs::weakly_canonical(dir / t.info.trace_file) == file) return std::move(t);
+    for (const auto& is : c.issues)
+      if (fs::weakly_canonical(dir / is.file) == file)
+        throw ConfigError(fmt::format("{}: cannot process the record: {}", path.string(), is.to_string()));
+    throw ConfigError(fmt::format("{}: no row of {} names this trace (column trace_file)", path.string(),
+                                  (dir / "trials.csv").string()));
+  }
+  throw ConfigError(fmt::format("{}: a lab trace needs its campaign's trials.csv (gravity, impact speed, ...) in "
+                                "the same folder or the one above; none found",
+                                path.string()));
+}
+
+/// One record of Fig. 2 with the paper's green line: velocity and depth integrated from the
+/// filtered acceleration (for a lab record that is its processing; for a DEM trace it is done
+/// again without the engine's own velocity and depth, as Sunday et al. 2021 did with Chrono's).
+struct Fig2Record {
+  MeasuredTrial trial;
+  std::vector<double> v_int, z_int;
+  std::string label, note;
+};
+
+Fig2Record load_record(const std::string& path) {
+  if (path.empty() || !fs::exists(path)) throw ConfigError(fmt::format("no record at '{}'", path));
+  Fig2Record r;
+  const std::string ext = fs::path(path).extension().string();
+  if (ext == ".h5") {
+    try {
+      r.trial = read_dem_trial({fs::path(path).stem().string(), "", path});
+    } catch (const std::exception& e) {
+      throw ConfigError(fmt::format("{}: not a readable gravsweep trace.h5 ({})", path, e.what()));
+    }
+    try {
+      process_trial(r.trial);
+    } catch (const std::invalid_argument& e) {
+      throw ConfigError(fmt::format("{}: cannot process the record: {}", path, e.what()));
+    }
+    const auto parent = fs::path(path).parent_path().filename().string();
+    r.label = fmt::format("DEM {}", fs::path(path).filename() == "trace.h5" && !parent.empty()
+                                        ? parent
+                                        : fs::path(path).stem().string());
+    const ProcessedTrace& p = r.trial.processed;
+    // "processed using the same method as the experimental data" (Sect. 2.3, Fig. 2): as a lab
+    // record (no own velocity and depth, bias taken from free fall and rest: about 0 for a DEM
+    // record), from the engine's contact start and the engine's vc.
+    Trace bare = r.trial.raw;
+    bare.source = TraceSource::lab;
+    bare.velocity_down_m_s.clear();
+    bare.depth_m.clear();
+    MetricOptions o = metric_options(r.trial.info);
+    o.impact_velocity_m_s = p.metrics.vc_m_s;
+    try {
+      const ProcessedTrace q = process_trace(bare, o);
+      const double z0 = interp(p.t_s, p.depth_m, p.metrics.t_start_s);
+      r.v_int = q.velocity_down_m_s;
+      r.z_int = q.depth_m;
+      for (double& z : r.z_int) z += z0;
+    } catch (const std::invalid_argument& e) {
+      r.note = fmt::format("no re-integrated line: {}", e.what());
+    }
+  } else if (ext == ".csv") {
+    r.trial = load_lab_record(path);
+    r.label = fmt::format("lab {}", r.trial.info.trial_id);
+    r.v_int = r.trial.processed.velocity_down_m_s;
+    r.z_int = r.trial.processed.depth_m;
+  } else {
+    throw ConfigError(fmt::format("{}: expected a DEM trace (.h5) or a lab trace (.csv)", path));
+  }
+  return r;
+}
+
+json metrics_json(const Metrics& m) {
+  return json{{"vc_m_s", m.vc_m_s},   {"apeak_m_s2", m.apeak_m_s2}, {"zstop_m", m.zstop_m},
+              {"tstop_s", m.tstop_s}, {"t_start_s", m.t_start_s},   {"t_end_s", m.t_end_s}};
+}
+
+/// fig2_<i>.csv: time since the collision start and the columns plots.py draws (empty = absent).
+json write_fig2_record(const fs::path& dir, std::size_t i, const Fig2Record& r) {
+  const auto& raw = r.trial.raw;
+  const auto& p = r.trial.processed;
+  const std::string name = fmt::format("fig2_{}.csv", i);
+  std::ofstream f(dir / name);
+  f << "t_s,accel_raw_m_s2,velocity_raw_m_s,depth_raw_m,accel_m_s2,velocity_int_m_s,depth_int_m\n";
+  auto cell = [](const std::vector<double>& v, std::size_t k) { return k < v.size() ? fmt::format("{}", v[k]) : ""; };
+  for (std::size_t k = 0; k < p.t_s.size(); ++k)
+    f << fmt::format("{},{},{},{},{},{},{}\n", p.t_s[k] - p.metrics.t_start_s, cell(raw.accel_up_m_s2, k),
+                     cell(raw.velocity_down_m_s, k), cell(raw.depth_m, k), p.accel_up_m_s2[k], cell(r.v_int, k),
+                     cell(r.z_int, k));
+  if (!f) throw std::runtime_error(fmt::format("{}: cannot write", (dir / name).string()));
+  return json{{"csv", name},
+              {"label", r.label},
+              {"source", to_string(r.trial.info.source)},
+              {"gravity_m_s2", r.trial.info.gravity_m_s2},
+              {"bias_m_s2", p.bias_m_s2},
+              {"note", r.note},
+              {"metrics", metrics_json(p.metrics)}};
+}
+
+void check_png(const std::string& out) {
+  if (out.empty() || fs::path(out).extension() != ".png")
+    throw ConfigError(fmt::format("--out: expected a file name ending in .png, found '{}'", out));
+}
+
+void plot(const ScratchDir& tmp, const char* which, const json& spec, const std::string& out) {
+  fs::create_directories(fs::absolute(out).parent_path());
+  {
+    std::ofstream f(tmp.path / (std::string(which) + ".json"));
+    f << spec.dump();
+  }
+  std::string log;
+  if (run_plots(tmp.path.string(), which, log) != 0) throw std::runtime_error("plotting failed: " + log);
+}
+
+}  // namespace
+
+Metrics draw_fig2(const Fig2Request& rq) {
+  check_png(rq.out);
+  const Fig2Record main = load_record(rq.record);
+  ScratchDir tmp("fig2");
+  json records = json::array({write_fig2_record(tmp.path, 0, main)});
+  if (!rq.compare.empty()) {
+    const Fig2Record other = load_record(rq.compare);
+    records.push_back(write_fig2_record(tmp.path, 1, other));
+  }
+  const Metrics& m = main.trial.processed.metrics;
+  const json spec{{"out", fs::absolute(rq.out).string()},
+                  {"records", records},
+                  {"title", fmt::format("{}: g = {:g} m/s2, vc = {:.3f} m/s", main.label,
+                                        main.trial.info.gravity_m_s2, m.vc_m_s)}};
+  plot(tmp, "trace", spec, rq.out);
+  return m;
+}
+
+std::string draw_fig1(const Fig1Request& rq) {
+  check_png(rq.out);
+  if (rq.at != "" && rq.at != "release" && rq.at != "rest")
+    throw ConfigError(fmt::format("--at '{}': expected release or rest", rq.at));
+  if (!rq.at.empty() && rq.trace.empty()) throw ConfigError("--at needs --trace (the projectile's record)");
+  if (!fs::exists(rq.bed)) throw ConfigError(fmt::format("no bed file at '{}'", rq.bed));
+  BedData bed;
+  try {
+    bed = read_bed(rq.bed);
+  } catch (const std::exception& e) {
+    throw ConfigError(fmt::format("{}: not a readable gravsweep bed.h5 ({})", rq.bed, e.what()));
+  }
+  TraceData td;
+  if (!rq.trace.empty()) {
+    if (!fs::exists(rq.trace)) throw ConfigError(fmt::format("--trace: no trace file at '{}'", rq.trace));
+    try {
+      td = read_trace(rq.trace);
+    } catch (const std::exception& e) {
+      throw ConfigError(fmt::format("{}: not a readable gravsweep trace.h5 ({})", rq.trace, e.what()));
+    }
+    if (td.size() == 0) throw ConfigError(fmt::format("{}: the trace holds no sample", rq.trace));
+  }
+  ScratchDir tmp("fig1");
+  auto write_grains = [&](const std::string& name, const std::vector<double>& pos) {
+    std::ofstream f(tmp.path / name);
+    f << "x_m,y_m,z_m,radius_m,r0_m\n";
+    for (std::size_t i = 0; i < bed.size(); ++i)
+      f << fmt::format("{},{},{},{},{}\n", pos[3 * i], pos[3 * i + 1], pos[3 * i + 2], bed.radius_m[i],
+                       std::hypot(bed.position_m[3 * i], bed.position_m[3 * i + 1]));
+  };
+  write_grains("bed.csv", bed.position_m);
+  json panels = json::array();
+  const double R = 0.5 * td.projectile_diameter_m;
+  auto projectile = [&](std::size_t k) {
+    return json{{"x_m", td.position_m[3 * k]}, {"y_m", td.position_m[3 * k + 1]}, {"z_m", td.position_m[3 * k + 2]},
+                {"radius_m", R}, {"t_s", td.t_s[k]}, {"depth_m", td.depth_m[k]}};
+  };
+  std::string what = fmt::format("{} grains", bed.size());
+  if (rq.trace.empty()) panels.push_back(json{{"title", "prepared bed"}, {"grains", "bed.csv"}});
+  if (!rq.trace.empty() && rq.at != "rest")
+    panels.push_back(json{{"title", fmt::format("(a) release, {:.1f} cm above the surface",
+                                                100 * (td.release_height_m - td.surface_height_m))},
+                          {"grains", "bed.csv"}, {"projectile", projectile(0)}});
+  if (!rq.trace.empty() && rq.at != "release") {
+    const std::size_t k = td.size() - 1;
+    json panel{{"title", fmt::format("(b) {} at t = {:.0f} ms, {:.2f} cm deep", td.stopped ? "at rest" : "at the time cap",
+                                     1000 * td.t_s[k], 100 * td.depth_m[k])},
+               {"grains", "bed.csv"}, {"projectile", projectile(k)}};
+    const std::string snaps = rq.snapshots.empty() ? snapshot_path_for(rq.trace).string() : rq.snapshots;
+    if (fs::exists(snaps)) {
+      try {
+        const Snapshot s = read_snapshot(snaps, -1);
+        if (s.grains.size() != bed.size())
+          throw ConfigError(fmt::format("{}: {} grains, the bed has {}", snaps, s.grains.size(), bed.size()));
+        write_grains("rest.csv", s.grains.position_m);
+        panel["grains"] = "rest.csv";
+        what += fmt::format(", grains at rest from {}", snaps);
+      } catch (const h5::H5Error& e) {
+        throw ConfigError(fmt::format("{}: not a readable snapshots file ({})", snaps, e.what()));
+      }
+    } else {
+      panel["note"] = "grains as prepared (no snapshots.h5 of this drop)";
+      what += ", no snapshots: grains as prepared in (b)";
+    }
+    panels.push_back(panel);
+  }
+  const json spec{{"out", fs::absolute(rq.out).string()},
+                  {"panels", panels},
+                  {"container_diameter_m", bed.container_diameter_m},
+                  {"wall_height_m", bed.wall_height_m},
+                  {"surface_height_m", bed.surface_height_m},
+                  {"title", fmt::format("{}: {} grains, fill {:.1f} cm, g = {:g} m/s2", rq.bed, bed.size(),
+                                        100 * bed.fill_height_m, bed.gravity_m_s2)}};
+  plot(tmp, "bed", spec, rq.out);
+  return what;
+}
+
+}  // namespace gravsweep::results

@@ -1,0 +1,38 @@
+// Figures of one drop (issue #15), drawn by results/report/plots.py from data prepared here:
+//  - Fig. 2 of Sunday et al. 2021: acceleration, velocity and depth against time, raw and
+//    processed as the paper does (500 Hz Butterworth; velocity and depth re-integrated from the
+//    filtered acceleration, the paper's green line), vc, apeak, zstop and tstop marked. A DEM
+//    trace.h5 or a lab record (traces/<trial>.csv of a campaign folder), with another record of
+//    either kind laid over it.
+//  - Fig. 1: the container cut through its axis, the grains coloured by their initial radial
+//    position, the projectile at release and at rest.
+// Bad input (a missing or unreadable file, a record without contact) throws ConfigError naming the
+// file and the reason (the CLI's exit code 2).
+#pragma once
+#include <string>
+
+#include "results/processing/trace.h"
+
+namespace gravsweep::results {
+
+struct Fig2Request {
+  std::string record;   ///< trace.h5, or a lab trace CSV inside a campaign folder
+  std::string compare;  ///< optional: another record laid over the first
+  std::string out;      ///< PNG
+};
+
+/// Draws Fig. 2; returns the metrics of `record` (processed exactly as the campaign does).
+Metrics draw_fig2(const Fig2Request& request);
+
+struct Fig1Request {
+  std::string bed;    ///< bed.h5
+  std::string trace;  ///< optional trace.h5: the projectile at release / at rest
+  std::string at;     ///< "release", "rest" or "" (both, when a trace is given)
+  std::string snapshots;  ///< optional snapshots.h5 of the drop: the grains at rest (default: next to the trace)
+  std::string out;    ///< PNG
+};
+
+/// Draws Fig. 1; returns a one-line description of what was drawn.
+std::string draw_fig1(const Fig1Request& request);
+
+}  // namespace gravsweep::results
