@@ -180,7 +180,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   if (p.snapshot_interval_s > 0) {
     snaps = std::make_unique<results::SnapshotWriter>(results::snapshot_path_for(trace_out), bed.radius_m,
                                                       0.5 * p.projectile.diameter_m, p.snapshot_interval_s,
-                                                      GRAVSWEEP_VERSION);
+                                                      build_version());
     ds.interval_s = p.snapshot_interval_s;
     ds.write = [&](const System& sy, ParticleIndex ip, double t_s) {
       const std::vector<int> c = sy.contact_counts();
