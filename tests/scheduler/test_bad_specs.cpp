@@ -161,3 +161,31 @@ TEST(BadSpecs, AScenarioFileOfRunIsCheckedTheSameWay) {
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_FALSE(fs::exists(d.path / "o"));
 }
+
+TEST(BadSpecs, EveryProblemOfAScenarioIsListedInOneMessage) {
+  // Three independent problems (a wrong type, an unknown field, a fill below two grains): all three
+  // are reported at once, by `run` at the scenario's pointers and by `submit` at the base's.
+  if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
+  TempDir d;
+  json scenario = json::parse(tiny_base());
+  scenario["projectile"]["mass_kg"] = "heavy";
+  scenario["projectile"]["colour"] = "red";
+  scenario["container"]["fill_height_m"] = 0.001;
+  write_text(d.path / "three.json", scenario.dump(1));
+  auto r = run_cli({"run", "three.json", "--out", "o"}, d.path);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("three.json: 3 problems"), std::string::npos) << r.err;
+  for (const char* p : {"/projectile/mass_kg", "/projectile/colour", "/container/fill_height_m"})
+    EXPECT_NE(r.err.find(std::string(p) + " = "), std::string::npos) << p << " missing in: " << r.err;
+  EXPECT_FALSE(fs::exists(d.path / "o"));
+
+  json doc = impact_doc();
+  doc["base"] = scenario;
+  write_text(d.path / "sweep.json", doc.dump(1));
+  r = run_cli({"submit", "sweep.json", "--db", "c.db"}, d.path);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("sweep.json: invalid sweep spec (3 problems)"), std::string::npos) << r.err;
+  for (const char* p : {"/base/projectile/mass_kg:", "/base/projectile/colour:", "/base/container/fill_height_m:"})
+    EXPECT_NE(r.err.find(p), std::string::npos) << p << " missing in: " << r.err;
+  EXPECT_FALSE(fs::exists(d.path / "c.db"));
+}
