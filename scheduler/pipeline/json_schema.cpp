@@ -17,7 +17,12 @@ std::string shown(const json& v) {
   return s;
 }
 
-std::string number(double v) { return fmt::format("{:g}", v); }
+/// A bound as written in the schema: integers in full (9007199254740991, not 9.0072e+15).
+std::string number(double v) {
+  constexpr double kExactIntegers = 9007199254740992.0;  // 2^53: every integer below is a double
+  if (std::floor(v) == v && std::fabs(v) <= kExactIntegers) return fmt::format("{}", static_cast<long long>(v));
+  return fmt::format("{:g}", v);
+}
 
 std::string problem_line(const SpecProblem& p) {
   return fmt::format("{} = {} is invalid: expected {}", p.pointer.empty() ? std::string("(document root)") : p.pointer,
@@ -101,7 +106,11 @@ void SchemaValidator::check(json& node, const json& schema_in, const std::string
     else if (type == "boolean") ok = node.is_boolean();
     else if (type == "array") ok = node.is_array();
     if (!ok) return fail(shown(node), expect(fmt::format("a JSON {}", type)));  // nothing below to check
-    if (type == "integer" && node.is_number_float()) node = static_cast<long long>(node.get<double>());
+    // An integral float becomes an integer where long long holds it exactly; a larger one (2^64)
+    // stays a float and the range check below reports it as written, never wrapped around.
+    constexpr double kLongLongLimit = 9223372036854775808.0;  // 2^63
+    if (type == "integer" && node.is_number_float() && std::fabs(node.get<double>()) < kLongLongLimit)
+      node = static_cast<long long>(node.get<double>());
   }
   if (s.contains("enum")) {
     bool ok = false;

@@ -123,7 +123,9 @@ std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json
     axis.pointer = a["pointer"].get<std::string>();
     try {
       const json::json_pointer jp(axis.pointer);
-      if (!base.contains(jp)) {
+      if (!base.is_object()) {
+        // The base could not be read (its problem is reported at /base): nothing to look the pointer up in.
+      } else if (!base.contains(jp)) {
         ck.add(join(ptr, "pointer"), &a["pointer"], "a pointer to a field present in the base scenario (to sweep a default, write the field into the base)");
         ok = false;
       } else {
