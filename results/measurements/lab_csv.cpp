@@ -264,7 +264,7 @@ Campaign load_campaign(const std::string& directory, double cutoff_hz) {
     }
   }
   if (c.trials.empty() && c.issues.empty())
-    c.issues.push_back({"trials.csv", ln, 0, "no trials: one row per trial after the header expected"});
+    c.issues.push_back({"trials.csv", ln, 0, "no trial rows: one row per trial after the header expected"});
   return c;
 }
 

@@ -97,10 +97,13 @@ std::unique_ptr<System> make_bed(double container_diameter_m, const BenchOptions
   return sys;
 }
 
-/// A bed written by `gravsweep run` (bed.h5), in a system with Table 1's Chrono set.
+/// A bed written by `gravsweep run` (bed.h5, verified as `run --bed` does), in a system with
+/// Table 1's Chrono set.
 std::unique_ptr<System> load_bed_file(const std::string& path) {
   auto sys = std::make_unique<System>(chrono_table1_config());
-  pipeline::load_bed(*sys, results::read_bed(path));
+  std::string unverified;
+  pipeline::load_bed(*sys, pipeline::read_user_bed(path, &unverified));
+  if (!unverified.empty()) std::fprintf(stderr, "warning: %s\n", unverified.c_str());
   return sys;
 }
 

@@ -96,12 +96,15 @@ void print_metrics(const nlohmann::json& m, const nlohmann::json& bed_report) {
 void run_impact(const RunOptions& o) {
   nlohmann::json scenario = pipeline::load_scenario(o.scenario);  // refuses bad specs first
   scenario["output"]["snapshot_interval_s"] = snapshot_interval(o);
+  if (!o.bed.empty()) {  // verified before any work: checksum, then the layout (bad -> exit 2)
+    std::string unverified;
+    (void)pipeline::read_user_bed(o.bed, &unverified);
+    if (!unverified.empty()) std::fprintf(stderr, "warning: %s\n", unverified.c_str());
+  }
   const std::filesystem::path out(o.out);
   std::error_code ec;
   std::filesystem::create_directories(out, ec);
   if (ec) throw std::runtime_error(fmt::format("{}: cannot create the output folder: {}", out.string(), ec.message()));
-  if (!o.bed.empty() && !std::filesystem::exists(o.bed))
-    throw UsageError(fmt::format("--bed {}: no such file", o.bed));
 
   g_stop = false;
   auto old_int = std::signal(SIGINT, on_signal);
@@ -124,6 +127,7 @@ void run_impact(const RunOptions& o) {
       bed_path = out / "bed.h5";
       const auto b = pipeline::run_bed_job(scenario, bed_path, o.threads, progress, &g_stop);
       bar.finish();
+      pipeline::write_bed_checksum(bed_path);
       bed_report = b.report;
       fmt::print("bed: {} grains kept of {} poured, surface at {:.2f} cm, bulk density {:.0f} kg/m3, {} "
                  "(rms {:.1e} m/s, max {:.1e} m/s), prepared in {}\n",
@@ -174,23 +178,25 @@ void setup_run(CLI::App& app) {
       "flatten the bed at the fill height, drop the projectile, stop when it rests, and measure\n"
       "vc, apeak, zstop, tstop (Butterworth 500 Hz, end at a < 0.1 g with the speed below 10 % of vc)\n"
       "and the rebound flag.\n"
-      "Writes DIR/bed.h5 (the prepared bed, reusable), DIR/trace.h5 (the projectile at 10 kHz),\n"
-      "DIR/metrics.json, DIR/fig2.png (Sunday et al. Fig. 2, as `gravsweep plot trace`), grain\n"
-      "snapshots DIR/snapshots.h5 with DIR/snapshots.xdmf (open it in ParaView: grains and\n"
+      "Writes DIR/bed.h5 (the prepared bed, reusable) with its checksum DIR/bed.h5.sha256,\n"
+      "DIR/trace.h5 (the projectile at 10 kHz), DIR/metrics.json, DIR/fig2.png (Sunday et al.\n"
+      "Fig. 2, as `gravsweep plot trace`), grain snapshots DIR/snapshots.h5 with DIR/snapshots.xdmf (open it in ParaView: grains and\n"
       "projectile as point sets, every 5 ms unless the scenario or --snapshot-interval says\n"
       "otherwise), and prints the metrics. The spec is checked against\n"
       "schemas/scenario.schema.json before any work; errors name the JSON pointer of the field.\n\n"
       "Examples:\n"
       "  gravsweep run examples/impact_1g.json --out runs/1g\n"
       "  gravsweep run runs/1g_mur0.json --out runs/1g_mur0 --bed runs/1g/bed.h5   # reuse a bed:\n"
-      "      only fields outside the bed (speed, offsets, dt of the drop, ...) may differ\n\n"
+      "      only fields outside the bed (speed, offsets, dt of the drop, ...) may differ\n"
+      "--bed checks the bed against BED.sha256 first and refuses (exit 2) a bed that changed or is\n"
+      "not a readable bed file; a bed without BED.sha256 (older runs) is used with a warning.\n\n"
       "gravsweep waits passively between OpenMP steps (OMP_WAIT_POLICY=passive unless you set it):\n"
       "with spinning threads an oversubscribed 2-core machine ran the paper's bed ~50x slower.");
   sub->add_option("scenario", opt->scenario, "scenario spec (JSON, see schemas/scenario.schema.json)")
       ->required()
       ->check(CLI::ExistingFile);
   sub->add_option("--out", opt->out, "output folder (created if missing)")->required();
-  sub->add_option("--bed", opt->bed, "reuse this prepared bed (bed.h5 of an earlier run) instead of preparing one");
+  sub->add_option("--bed", opt->bed, "reuse this prepared bed (bed.h5 of an earlier run, verified against bed.h5.sha256) instead of preparing one");
   sub->add_option("--threads", opt->threads, "OpenMP threads (0: the scenario's, else all cores)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();

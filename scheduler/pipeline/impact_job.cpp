@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <memory>
 
 #include "engine/core/error.h"
@@ -17,6 +18,7 @@
 #include "results/processing/trace.h"
 #include "scheduler/pipeline/build_version.h"
 #include "scheduler/pipeline/scenario_spec.h"
+#include "scheduler/sweep/canonical.h"
 
 
 namespace gravsweep::pipeline {
@@ -128,6 +130,50 @@ BedJobResult run_bed_job(const json& scenario, const std::filesystem::path& bed_
   check_stop(stop, "bed preparation");
   results::write_bed(bed_out, b);
   return BedJobResult{bed_out, report};
+}
+
+std::filesystem::path bed_checksum_path(const std::filesystem::path& bed) { return bed.string() + ".sha256"; }
+
+void write_bed_checksum(const std::filesystem::path& bed) {
+  const auto path = bed_checksum_path(bed), tmp = std::filesystem::path(path.string() + ".tmp");
+  {
+    std::ofstream f(tmp);
+    f << sweep::sha256_file(bed) << "  " << bed.filename().string() << "\n";
+    if (!f.flush()) throw std::runtime_error(fmt::format("{}: cannot write", tmp.string()));
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+results::BedData read_user_bed(const std::filesystem::path& bed, std::string* unverified) {
+  constexpr std::size_t kHexDigits = 64;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(bed, ec))
+    throw ConfigError(fmt::format("bed {}: {}", bed.string(),
+                                  std::filesystem::exists(bed, ec) ? "not a regular file" : "no such file"));
+  const auto sum_path = bed_checksum_path(bed);
+  if (std::filesystem::exists(sum_path, ec)) {
+    std::ifstream f(sum_path);
+    std::string recorded;
+    f >> recorded;
+    if (recorded.size() != kHexDigits || recorded.find_first_not_of("0123456789abcdef") != std::string::npos)
+      throw ConfigError(fmt::format("bed {}: its checksum file {} does not hold a SHA-256 (64 hex digits)",
+                                    bed.string(), sum_path.string()));
+    const std::string found = sweep::sha256_file(bed);
+    if (found != recorded)
+      throw ConfigError(fmt::format(
+          "bed {} does not match its checksum ({}): sha256 {}, recorded {} when it was written; the file "
+          "changed since (one flipped bit changes every drop's results): prepare the bed again (omit --bed)",
+          bed.string(), sum_path.string(), found, recorded));
+  } else if (unverified) {
+    *unverified = fmt::format("bed {} has no checksum file {} (written before `run` recorded one, or copied "
+                              "without it): it cannot be verified",
+                              bed.string(), sum_path.string());
+  }
+  try {
+    return results::read_bed(bed);
+  } catch (const std::exception& e) {  // HDF5 layer: cut short, random bytes, missing datasets
+    throw ConfigError(fmt::format("bed {}: not a readable gravsweep bed file: {}", bed.string(), e.what()));
+  }
 }
 
 void load_bed(System& sys, const results::BedData& bed) {

@@ -17,17 +17,37 @@ std::string shown(const json& v) {
   return s;
 }
 
-std::string number(double v) { return fmt::format("{:g}", v); }
+/// A bound as written in the schema: integers in full (9007199254740991, not 9.0072e+15).
+std::string number(double v) {
+  constexpr double kExactIntegers = 9007199254740992.0;  // 2^53: every integer below is a double
+  if (std::floor(v) == v && std::fabs(v) <= kExactIntegers) return fmt::format("{}", static_cast<long long>(v));
+  return fmt::format("{:g}", v);
+}
+
+std::string problem_line(const SpecProblem& p) {
+  return fmt::format("{} = {} is invalid: expected {}", p.pointer.empty() ? std::string("(document root)") : p.pointer,
+                     p.found, p.expected);
+}
+
+/// One problem: "FILE: POINTER = FOUND is invalid: expected X"; several: a count, then one per line.
+std::string problems_message(const std::string& source, const std::vector<SpecProblem>& problems) {
+  constexpr std::size_t kMaxListed = 50;
+  if (problems.size() == 1) return fmt::format("{}: {}", source, problem_line(problems.front()));
+  std::string m = fmt::format("{}: {} problems", source, problems.size());
+  for (std::size_t i = 0; i < problems.size() && i < kMaxListed; ++i) m += "\n  " + problem_line(problems[i]);
+  if (problems.size() > kMaxListed) m += fmt::format("\n  ... and {} more", problems.size() - kMaxListed);
+  return m;
+}
 
 }  // namespace
 
 SpecError::SpecError(std::string source, std::string pointer, std::string found, std::string expected)
-    : ConfigError(fmt::format("{}: {} = {} is invalid: expected {}", source,
-                              pointer.empty() ? std::string("(document root)") : pointer, found, expected)),
-      source_(std::move(source)),
-      pointer_(std::move(pointer)),
-      found_(std::move(found)),
-      expected_(std::move(expected)) {}
+    : SpecError(std::move(source), std::vector<SpecProblem>{{std::move(pointer), std::move(found), std::move(expected)}}) {}
+
+SpecError::SpecError(std::string source, std::vector<SpecProblem> problems)
+    : ConfigError(problems_message(source, problems)), source_(std::move(source)), problems_(std::move(problems)) {
+  if (problems_.empty()) throw std::logic_error("SpecError without a problem");
+}
 
 std::string pointer_token(const std::string& key) {
   std::string out;
@@ -54,14 +74,20 @@ json SchemaValidator::resolve(const json& s) const {
 }
 
 void SchemaValidator::validate(json& instance, const std::string& source) const {
-  check(instance, schema_, "", source);
+  std::vector<SpecProblem> problems;
+  collect(instance, problems);
+  if (!problems.empty()) throw SpecError(source, std::move(problems));
+}
+
+void SchemaValidator::collect(json& instance, std::vector<SpecProblem>& problems) const {
+  check(instance, schema_, "", problems);
 }
 
 void SchemaValidator::check(json& node, const json& schema_in, const std::string& ptr,
-                            const std::string& source) const {
+                            std::vector<SpecProblem>& problems) const {
   const json s = resolve(schema_in);
   auto fail = [&](const std::string& found, const std::string& expected) {
-    throw SpecError(source, ptr, found, expected);
+    problems.push_back({ptr, found, expected});
   };
   const std::string desc = s.contains("description") ? s["description"].get<std::string>() : "";
   auto expect = [&](const std::string& what) {
@@ -79,17 +105,21 @@ void SchemaValidator::check(json& node, const json& schema_in, const std::string
     else if (type == "string") ok = node.is_string();
     else if (type == "boolean") ok = node.is_boolean();
     else if (type == "array") ok = node.is_array();
-    if (!ok) fail(shown(node), expect(fmt::format("a JSON {}", type)));
-    if (type == "integer" && node.is_number_float()) node = static_cast<long long>(node.get<double>());
+    if (!ok) return fail(shown(node), expect(fmt::format("a JSON {}", type)));  // nothing below to check
+    // An integral float becomes an integer where long long holds it exactly; a larger one (2^64)
+    // stays a float and the range check below reports it as written, never wrapped around.
+    constexpr double kLongLongLimit = 9223372036854775808.0;  // 2^63
+    if (type == "integer" && node.is_number_float() && std::fabs(node.get<double>()) < kLongLongLimit)
+      node = static_cast<long long>(node.get<double>());
   }
   if (s.contains("enum")) {
     bool ok = false;
     for (const auto& e : s["enum"]) ok = ok || e == node;
-    if (!ok) fail(shown(node), fmt::format("one of {}", s["enum"].dump()));
+    if (!ok) return fail(shown(node), fmt::format("one of {}", s["enum"].dump()));
   }
   if (node.is_number()) {
     const double v = node.get<double>();
-    if (!std::isfinite(v)) fail(shown(node), "a finite number");
+    if (!std::isfinite(v)) return fail(shown(node), "a finite number");
     std::vector<std::string> bounds;
     bool ok = true;
     if (s.contains("minimum")) {
@@ -122,25 +152,25 @@ void SchemaValidator::check(json& node, const json& schema_in, const std::string
         if (props.contains(it.key())) continue;
         std::string known;
         for (auto p = props.begin(); p != props.end(); ++p) known += (known.empty() ? "" : ", ") + p.key();
-        throw SpecError(source, ptr + "/" + pointer_token(it.key()), shown(it.value()) + " (unknown field)",
-                        fmt::format("one of the fields {}", known));
+        problems.push_back({ptr + "/" + pointer_token(it.key()), shown(it.value()) + " (unknown field)",
+                            fmt::format("one of the fields {}", known)});
       }
     }
     if (s.contains("required"))
       for (const auto& r : s["required"]) {
         const std::string key = r.get<std::string>();
         if (!node.contains(key))
-          throw SpecError(source, ptr + "/" + pointer_token(key), "nothing (missing)", "a value: the field is required");
+          problems.push_back({ptr + "/" + pointer_token(key), "nothing (missing)", "a value: the field is required"});
       }
     for (auto p = props.begin(); p != props.end(); ++p) {
       const std::string child_ptr = ptr + "/" + pointer_token(p.key());
       if (node.contains(p.key())) {
-        check(node[p.key()], p.value(), child_ptr, source);
+        check(node[p.key()], p.value(), child_ptr, problems);
       } else {
         const json ps = resolve(p.value());
         if (ps.contains("default")) {
           node[p.key()] = ps["default"];
-          check(node[p.key()], p.value(), child_ptr, source);
+          check(node[p.key()], p.value(), child_ptr, problems);
         }
       }
     }

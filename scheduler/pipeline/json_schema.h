@@ -3,27 +3,39 @@
 // required, enum, minimum, maximum, exclusiveMinimum, exclusiveMaximum, default, and $ref to
 // "#/$defs/<name>" (with sibling keywords). Defaults are inserted into the instance, so after
 // validation the instance is complete. Debian 12 packages no C++ JSON-schema validator, hence this.
-// The first violation throws SpecError with the JSON pointer of the field, what was found and what
-// was expected.
+// Validation does not stop at the first violation: every one is collected (JSON pointer of the
+// field, what was found, what was expected) and SpecError lists them all.
 #pragma once
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "engine/core/error.h"
 
 namespace gravsweep::pipeline {
 
-/// A spec field is invalid. Derives from ConfigError, so the CLI exits with code 2.
+/// One problem of a spec: where, what was found, what was expected.
+struct SpecProblem {
+  std::string pointer;   ///< JSON pointer of the field ("" = the document)
+  std::string found;     ///< the value found, as compact JSON (or "nothing (missing)")
+  std::string expected;  ///< what was expected
+};
+
+/// Spec fields are invalid: every problem found, in order. Derives from ConfigError, so the CLI
+/// exits with code 2. pointer()/found()/expected() are those of the first problem.
 class SpecError : public ConfigError {
  public:
   SpecError(std::string source, std::string pointer, std::string found, std::string expected);
+  SpecError(std::string source, std::vector<SpecProblem> problems);  ///< at least one problem
   [[nodiscard]] const std::string& source() const { return source_; }
-  [[nodiscard]] const std::string& pointer() const { return pointer_; }
-  [[nodiscard]] const std::string& found() const { return found_; }
-  [[nodiscard]] const std::string& expected() const { return expected_; }
+  [[nodiscard]] const std::vector<SpecProblem>& problems() const { return problems_; }
+  [[nodiscard]] const std::string& pointer() const { return problems_.front().pointer; }
+  [[nodiscard]] const std::string& found() const { return problems_.front().found; }
+  [[nodiscard]] const std::string& expected() const { return problems_.front().expected; }
 
  private:
-  std::string source_, pointer_, found_, expected_;
+  std::string source_;
+  std::vector<SpecProblem> problems_;
 };
 
 /// JSON pointer escaping of one reference token (RFC 6901: ~ -> ~0, / -> ~1).
@@ -32,15 +44,18 @@ std::string pointer_token(const std::string& key);
 class SchemaValidator {
  public:
   explicit SchemaValidator(nlohmann::json schema);
-  /// Validates `instance` in place (inserting defaults); `source` names the file in messages.
+  /// Validates `instance` in place (inserting defaults); throws SpecError listing every problem,
+  /// `source` naming the file.
   void validate(nlohmann::json& instance, const std::string& source) const;
+  /// Validates in place and appends every problem found (nothing thrown for bad input).
+  void collect(nlohmann::json& instance, std::vector<SpecProblem>& problems) const;
   [[nodiscard]] const nlohmann::json& schema() const { return schema_; }
 
  private:
   nlohmann::json schema_;
   [[nodiscard]] nlohmann::json resolve(const nlohmann::json& s) const;
   void check(nlohmann::json& node, const nlohmann::json& schema, const std::string& pointer,
-             const std::string& source) const;
+             std::vector<SpecProblem>& problems) const;
 };
 
 }  // namespace gravsweep::pipeline

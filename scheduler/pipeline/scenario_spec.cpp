@@ -90,14 +90,67 @@ SystemConfig base_config(const json& s) {
   return c;
 }
 
+/// The cross-field checks of a scenario the schema may have found problems in: each check runs,
+/// records its problems and goes on, so every problem is listed, not only the first. A check that
+/// reads a field already found bad (or missing) is skipped: its problem is listed already.
+class Checks {
+ public:
+  Checks(const json& s, std::vector<SpecProblem>& problems) : s_(s), problems_(problems) {}
+
+  /// Runs one check; it stops quietly at the first field it reads that is not sound.
+  template <class F>
+  void run(F&& check) {
+    try {
+      check();
+    } catch (const Unsound&) {
+    }
+  }
+  /// True when `pointer` exists and neither it, a field around it nor one inside it has a problem.
+  [[nodiscard]] bool sound(const std::string& pointer) const {
+    if (!s_.contains(json::json_pointer(pointer))) return false;
+    auto inside = [](const std::string& outer, const std::string& p) {
+      return p == outer || outer.empty() || p.rfind(outer + "/", 0) == 0;
+    };
+    for (const auto& pr : problems_)
+      if (inside(pr.pointer, pointer) || inside(pointer, pr.pointer)) return false;
+    return true;
+  }
+  const json& at(const std::string& pointer) const {
+    if (!sound(pointer)) throw Unsound{};
+    return s_[json::json_pointer(pointer)];
+  }
+  double num(const std::string& pointer) const {
+    const json& v = at(pointer);
+    if (!v.is_number()) throw Unsound{};
+    return v.get<double>();
+  }
+  /// The field at `pointer` is bad: its value is shown as found.
+  void bad(const std::string& pointer, const std::string& expected) {
+    const json::json_pointer jp(pointer);
+    problems_.push_back({pointer, s_.contains(jp) ? s_[jp].dump() : "nothing (missing)", expected});
+  }
+  void bad(const std::string& pointer, const std::string& found, const std::string& expected) {
+    problems_.push_back({pointer, found, expected});
+  }
+
+ private:
+  struct Unsound {};
+  const json& s_;
+  std::vector<SpecProblem>& problems_;
+};
+
 /// Runs the engine's own parameter and time-step checks on a two-body system built from the
 /// scenario (smallest grain, projectile, container walls), so errors surface before any work.
-void engine_checks(const json& s, const SystemConfig& cfg, const std::string& dt_pointer,
-                   const std::string& source) {
+/// Runs when the fields the engine reads have no problem so far.
+void engine_checks(const json& s, Checks& ck) {
+  for (const char* p : {"/grains", "/projectile/diameter_m", "/projectile/mass_kg", "/container/diameter_m",
+                        "/materials", "/contact", "/integrator", "/threads"})
+    if (!ck.sound(p)) return;
   const double d = s["/grains/diameter_m"_json_pointer];
   const double spread = s["/grains/diameter_spread_m"_json_pointer];
   const double rho = s["/grains/density_kg_m3"_json_pointer];
   const double r_min = 0.5 * (d - spread);
+  const SystemConfig cfg = base_config(s);
   auto build = [&](double dt) {
     SystemConfig c = cfg;
     c.dt_s = dt;
@@ -114,14 +167,18 @@ void engine_checks(const json& s, const SystemConfig& cfg, const std::string& dt
   try {
     build(1e-12);
   } catch (const ConfigError& e) {
-    throw SpecError(source, "/materials", fmt::format("parameters the engine rejects ({})", e.what()),
-                    "materials and contact.pairs valid for the contact law");
+    ck.bad("/materials", fmt::format("parameters the engine rejects ({})", e.what()),
+           "materials and contact.pairs valid for the contact law");
+    return;
   }
-  try {
-    build(cfg.dt_s);
-  } catch (const ConfigError& e) {
-    throw SpecError(source, dt_pointer, fmt::format("{:g}", cfg.dt_s),
-                    fmt::format("a time step the contact law accepts ({})", e.what()));
+  for (const char* dt_pointer : {"/bed/dt_s", "/dt_s"}) {
+    if (!ck.sound(dt_pointer)) continue;
+    const double dt = s[json::json_pointer(dt_pointer)];
+    try {
+      build(dt);
+    } catch (const ConfigError& e) {
+      ck.bad(dt_pointer, fmt::format("{:g}", dt), fmt::format("a time step the contact law accepts ({})", e.what()));
+    }
   }
 }
 
@@ -135,27 +192,115 @@ double machine_memory_bytes() {
 /// any work (issue #10 item 10). Grains: random close packing (0.64) of the fill, twice over for
 /// the lattice poured above the fill height; ~2 kB per grain (state, Verlet pairs with contact
 /// history, per-thread force buffers).
-void check_size_and_steps(const json& s, const std::string& source) {
+void check_size_and_steps(Checks& ck) {
   constexpr double kMinDt_s = 1e-9, kBytesPerGrain = 2048, kMaxSteps = 1e10;
-  auto num = [&](const char* p) { return s[json::json_pointer(p)].get<double>(); };
   for (const char* p : {"/dt_s", "/bed/dt_s"})
-    if (!(num(p) >= kMinDt_s))
-      throw SpecError(source, p, fmt::format("{:g}", num(p)),
-                      fmt::format("a time step of at least {:g} s (smaller steps never finish)", kMinDt_s));
-  const double d = num("/grains/diameter_m"), Dc = num("/container/diameter_m"), H = num("/container/fill_height_m");
-  const double grains = 2 * 0.64 * (0.25 * M_PI * Dc * Dc * H) / (M_PI / 6 * d * d * d);
-  const double need = grains * kBytesPerGrain, have = machine_memory_bytes();
-  if (have > 0 && need > 0.8 * have)
-    throw SpecError(source, "/container/fill_height_m",
-                    fmt::format("{:g} m of {:g} m grains in a {:g} m container: about {:.3g} grains, {:.3g} GB", H, d,
-                                Dc, grains, need / 1e9),
-                    fmt::format("a bed that fits this machine's memory ({:.3g} GB; at most about {:.3g} grains)",
-                                have / 1e9, 0.8 * have / kBytesPerGrain));
-  const double steps = num("/stop/max_time_s") / num("/dt_s");
-  if (steps > kMaxSteps)
-    throw SpecError(source, "/dt_s", fmt::format("{:g}", num("/dt_s")),
-                    fmt::format("a time step giving at most {:g} steps over stop.max_time_s ({:g} s)", kMaxSteps,
-                                num("/stop/max_time_s")));
+    ck.run([&] {
+      if (!(ck.num(p) >= kMinDt_s))
+        ck.bad(p, fmt::format("{:g}", ck.num(p)),
+               fmt::format("a time step of at least {:g} s (smaller steps never finish)", kMinDt_s));
+    });
+  ck.run([&] {
+    const double d = ck.num("/grains/diameter_m"), Dc = ck.num("/container/diameter_m");
+    const double H = ck.num("/container/fill_height_m");
+    const double grains = 2 * 0.64 * (0.25 * M_PI * Dc * Dc * H) / (M_PI / 6 * d * d * d);
+    const double need = grains * kBytesPerGrain, have = machine_memory_bytes();
+    if (have > 0 && need > 0.8 * have)
+      ck.bad("/container/fill_height_m",
+             fmt::format("{:g} m of {:g} m grains in a {:g} m container: about {:.3g} grains, {:.3g} GB", H, d, Dc,
+                         grains, need / 1e9),
+             fmt::format("a bed that fits this machine's memory ({:.3g} GB; at most about {:.3g} grains)", have / 1e9,
+                         0.8 * have / kBytesPerGrain));
+  });
+  ck.run([&] {
+    const double steps = ck.num("/stop/max_time_s") / ck.num("/dt_s");
+    if (steps > kMaxSteps)
+      ck.bad("/dt_s", fmt::format("{:g}", ck.num("/dt_s")),
+             fmt::format("a time step giving at most {:g} steps over stop.max_time_s ({:g} s)", kMaxSteps,
+                         ck.num("/stop/max_time_s")));
+  });
+}
+
+/// Names resolved by the engine's registries.
+void check_names(Checks& ck) {
+  auto one_of = [&](const char* p, const std::vector<std::string>& names, const char* what) {
+    ck.run([&] {
+      if (std::find(names.begin(), names.end(), ck.at(p).get<std::string>()) == names.end())
+        ck.bad(p, fmt::format("one of the {} {}", what, join(names)));
+    });
+  };
+  one_of("/contact/law", contact_law_names(), "contact laws");
+  one_of("/contact/rolling_model", rolling_model_names(), "rolling models");
+  std::vector<std::string> integrators;
+  for (const auto& e : integrator_table()) integrators.emplace_back(e.name);
+  one_of("/integrator", integrators, "integrators");
+}
+
+/// Grains, container and projectile fit together; the start of the drop is reachable.
+void check_geometry(Checks& ck) {
+  ck.run([&] {
+    const double d = ck.num("/grains/diameter_m");
+    if (!(ck.num("/grains/diameter_spread_m") < 0.5 * d))
+      ck.bad("/grains/diameter_spread_m", fmt::format("a spread below half the grain diameter ({:g} m)", 0.5 * d));
+  });
+  ck.run([&] {
+    const double d = ck.num("/grains/diameter_m");
+    if (!(ck.num("/container/diameter_m") > 4 * d))
+      ck.bad("/container/diameter_m", fmt::format("more than 4 grain diameters ({:g} m)", 4 * d));
+  });
+  ck.run([&] {
+    const double d = ck.num("/grains/diameter_m");
+    if (!(ck.num("/container/fill_height_m") >= 2 * d))
+      ck.bad("/container/fill_height_m", fmt::format("at least 2 grain diameters ({:g} m)", 2 * d));
+  });
+  ck.run([&] {
+    const double d = ck.num("/grains/diameter_m"), Dc = ck.num("/container/diameter_m");
+    const double Dp = ck.num("/projectile/diameter_m");
+    if (!(Dp + 2 * d < Dc)) {
+      ck.bad("/projectile/diameter_m",
+             fmt::format("a projectile narrower than the container minus two grains ({:g} m)", Dc - 2 * d));
+      return;
+    }
+    const double lateral = ck.num("/projectile/lateral_offset_max_grain_diameters") * d;
+    if (!(lateral + 0.5 * Dp + d < 0.5 * Dc))
+      ck.bad("/projectile/lateral_offset_max_grain_diameters",
+             fmt::format("an offset that keeps the projectile one grain from the side wall (at most {:g})",
+                         (0.5 * Dc - 0.5 * Dp - d) / d));
+  });
+  ck.run([&] {
+    const json& p = ck.at("/projectile");
+    const bool has_speed = p.contains("impact_speed_m_s"), has_height = p.contains("drop_height_m");
+    if (has_speed && has_height)
+      ck.bad("/projectile/drop_height_m", "no drop height when impact_speed_m_s is given (give exactly one)");
+    if (!has_speed && !has_height)
+      ck.bad("/projectile/impact_speed_m_s", "an impact speed or a drop_height_m (give exactly one)");
+    if (!has_speed || has_height) return;
+    const double g = ck.num("/gravity_m_s2"), d = ck.num("/grains/diameter_m");
+    const double v = ck.num("/projectile/impact_speed_m_s");
+    const double gap = ck.num("/projectile/start_gap_m");
+    const double vert = ck.num("/projectile/vertical_offset_max_grain_diameters") * d;
+    if (!(v * v > 2 * g * gap))
+      ck.bad("/projectile/start_gap_m",
+             fmt::format("a gap below {:g} m: free fall over a larger gap already exceeds {} m/s", v * v / (2 * g), v));
+    else if (!(v * v > 2 * g * (gap + vert)))
+      ck.bad("/projectile/vertical_offset_max_grain_diameters",
+             fmt::format("at most {:g}: free fall over a larger start height already exceeds {} m/s",
+                         (v * v / (2 * g) - gap) / d, v));
+  });
+}
+
+/// The output rate fits the time step, the filter the output rate.
+void check_output(Checks& ck) {
+  ck.run([&] {
+    const double dt = ck.num("/dt_s");
+    if (!(ck.num("/output/sample_rate_hz") * dt <= 1.0))
+      ck.bad("/output/sample_rate_hz", fmt::format("at most 1/dt_s = {:g} Hz", 1.0 / dt));
+  });
+  ck.run([&] {
+    const double rate = ck.num("/output/sample_rate_hz");
+    if (!(ck.num("/output/filter_cutoff_hz") < 0.5 * rate))
+      ck.bad("/output/filter_cutoff_hz", fmt::format("below the Nyquist frequency {:g} Hz", 0.5 * rate));
+  });
 }
 
 }  // namespace
@@ -167,71 +312,15 @@ const std::string& scenario_schema_text() {
 
 json validate_scenario(const json& scenario, const std::string& source) {
   json s = scenario;
-  validator().validate(s, source);
-  auto num = [&](const char* p) { return s[json::json_pointer(p)].get<double>(); };
-  auto bad = [&](const char* p, const std::string& expected) {
-    const json::json_pointer jp(p);
-    throw SpecError(source, p, s.contains(jp) ? s[jp].dump() : "nothing (missing)", expected);
-  };
-  // Names resolved by the engine's registries.
-  const auto laws = contact_law_names();
-  if (std::find(laws.begin(), laws.end(), s["/contact/law"_json_pointer].get<std::string>()) == laws.end())
-    bad("/contact/law", "one of the contact laws " + join(laws));
-  const auto rolls = rolling_model_names();
-  if (std::find(rolls.begin(), rolls.end(), s["/contact/rolling_model"_json_pointer].get<std::string>()) == rolls.end())
-    bad("/contact/rolling_model", "one of the rolling models " + join(rolls));
-  std::vector<std::string> integrators;
-  for (const auto& e : integrator_table()) integrators.emplace_back(e.name);
-  if (std::find(integrators.begin(), integrators.end(), s["/integrator"_json_pointer].get<std::string>()) ==
-      integrators.end())
-    bad("/integrator", "one of the integrators " + join(integrators));
-  // Geometry.
-  const double d = num("/grains/diameter_m");
-  if (!(num("/grains/diameter_spread_m") < 0.5 * d))
-    bad("/grains/diameter_spread_m", fmt::format("a spread below half the grain diameter ({:g} m)", 0.5 * d));
-  const double Dc = num("/container/diameter_m");
-  if (!(Dc > 4 * d)) bad("/container/diameter_m", fmt::format("more than 4 grain diameters ({:g} m)", 4 * d));
-  if (!(num("/container/fill_height_m") >= 2 * d))
-    bad("/container/fill_height_m", fmt::format("at least 2 grain diameters ({:g} m)", 2 * d));
-  const json& p = s["projectile"];
-  const double Dp = num("/projectile/diameter_m");
-  if (!(Dp + 2 * d < Dc))
-    bad("/projectile/diameter_m", fmt::format("a projectile narrower than the container minus two grains ({:g} m)", Dc - 2 * d));
-  const double lateral = num("/projectile/lateral_offset_max_grain_diameters") * d;
-  if (!(lateral + 0.5 * Dp + d < 0.5 * Dc))
-    bad("/projectile/lateral_offset_max_grain_diameters",
-        fmt::format("an offset that keeps the projectile one grain from the side wall (at most {:g})",
-                    (0.5 * Dc - 0.5 * Dp - d) / d));
-  const bool has_speed = p.contains("impact_speed_m_s"), has_height = p.contains("drop_height_m");
-  if (has_speed && has_height)
-    bad("/projectile/drop_height_m", "no drop height when impact_speed_m_s is given (give exactly one)");
-  if (!has_speed && !has_height)
-    bad("/projectile/impact_speed_m_s", "an impact speed or a drop_height_m (give exactly one)");
-  const double g = num("/gravity_m_s2");
-  if (has_speed) {
-    const double v = num("/projectile/impact_speed_m_s");
-    const double gap = num("/projectile/start_gap_m");
-    const double vert = num("/projectile/vertical_offset_max_grain_diameters") * d;
-    if (!(v * v > 2 * g * gap))
-      bad("/projectile/start_gap_m",
-          fmt::format("a gap below {:g} m: free fall over a larger gap already exceeds {} m/s", v * v / (2 * g), v));
-    if (!(v * v > 2 * g * (gap + vert)))
-      bad("/projectile/vertical_offset_max_grain_diameters",
-          fmt::format("at most {:g}: free fall over a larger start height already exceeds {} m/s",
-                      (v * v / (2 * g) - gap) / d, v));
-  }
-  const double dt = num("/dt_s");
-  check_size_and_steps(s, source);
-  if (!(num("/output/sample_rate_hz") * dt <= 1.0))
-    bad("/output/sample_rate_hz", fmt::format("at most 1/dt_s = {:g} Hz", 1.0 / dt));
-  if (!(num("/output/filter_cutoff_hz") < 0.5 * num("/output/sample_rate_hz")))
-    bad("/output/filter_cutoff_hz", fmt::format("below the Nyquist frequency {:g} Hz", 0.5 * num("/output/sample_rate_hz")));
-  // The engine's own checks (materials, pair values, stability bound of dt).
-  SystemConfig c = base_config(s);
-  c.dt_s = num("/bed/dt_s");
-  engine_checks(s, c, "/bed/dt_s", source);
-  c.dt_s = dt;
-  engine_checks(s, c, "/dt_s", source);
+  std::vector<SpecProblem> problems;
+  validator().collect(s, problems);  // the schema: types, ranges, unknown and missing fields
+  Checks ck(s, problems);            // then the rules across fields, on the sound fields
+  check_names(ck);
+  check_geometry(ck);
+  check_size_and_steps(ck);
+  check_output(ck);
+  engine_checks(s, ck);  // the engine's own checks (materials, pair values, dt bound)
+  if (!problems.empty()) throw SpecError(source, std::move(problems));
   return s;
 }
 

@@ -19,8 +19,9 @@ const std::string& scenario_schema_text();
 /// Validates a scenario against the schema and the cross-field rules (exactly one of
 /// impact_speed_m_s / drop_height_m, grains fit the container, the projectile and its offsets fit,
 /// dt within the contact law's stability bound, sample rate <= 1/dt, ...) and returns it with
-/// every default filled in. Throws SpecError (a ConfigError) naming `source`, the JSON pointer of
-/// the field, the value found and what was expected.
+/// every default filled in. Throws SpecError (a ConfigError) naming `source` and, for every
+/// problem (not only the first), the JSON pointer of the field, the value found and what was
+/// expected; a rule that needs a field already found bad is skipped rather than reported twice.
 nlohmann::json validate_scenario(const nlohmann::json& scenario, const std::string& source = "scenario");
 
 /// Reads a scenario file (JSON) and validates it; parse errors name the file, line and column.

@@ -123,7 +123,9 @@ std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json
     axis.pointer = a["pointer"].get<std::string>();
     try {
       const json::json_pointer jp(axis.pointer);
-      if (!base.contains(jp)) {
+      if (!base.is_object()) {
+        // The base could not be read (its problem is reported at /base): nothing to look the pointer up in.
+      } else if (!base.contains(jp)) {
         ck.add(join(ptr, "pointer"), &a["pointer"], "a pointer to a field present in the base scenario (to sweep a default, write the field into the base)");
         ok = false;
       } else {
@@ -482,17 +484,22 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
   std::vector<std::size_t> idx(spec.groups.size(), 0);
   std::vector<SpecProblem> problems;
   std::vector<std::size_t> repeats;
+  // A problem of a base field no axis replaces is reported once, at its pointer under /base; a
+  // swept field is checked at each point instead (its base value may be a placeholder).
+  auto swept = [&](const std::string& pointer) {
+    for (const auto& g : spec.groups)
+      for (const auto& ax : g.axes)
+        if (pointer == ax.pointer || pointer.rfind(ax.pointer + "/", 0) == 0 || ax.pointer.rfind(pointer + "/", 0) == 0)
+          return true;
+    return false;
+  };
   if (spec.job_kind != "noop" && bed_key) {
-    // A problem of the base itself is reported once, at its pointer under /base.
     try {
       (void)bed_key(spec.base);
     } catch (const pipeline::SpecError& e) {
-      bool swept = false;  // a base value an axis replaces is checked at each point instead
-      for (const auto& g : spec.groups)
-        for (const auto& ax : g.axes) swept = swept || e.pointer().rfind(ax.pointer, 0) == 0;
-      if (!swept)
-        throw SpecError(spec.file.empty() ? spec.name : spec.file,
-                      {{"/base" + e.pointer(), e.found(), e.expected()}});
+      for (const auto& p : e.problems())
+        if (!swept(p.pointer)) problems.push_back({"/base" + p.pointer, p.found, p.expected});
+      if (!problems.empty()) throw SpecError(spec.file.empty() ? spec.name : spec.file, problems);
     } catch (const std::exception&) {
       // Not checkable alone (e.g. a field every axis sets): the points report it.
     }
@@ -532,6 +539,21 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
     try {
       if (!bed_key) throw std::runtime_error("no bed key function (the impact pipeline is not built in)");
       key = bed_key(job.scenario);
+    } catch (const pipeline::SpecError& e) {
+      // The base was sound, so these are problems of swept values: one per field and reason,
+      // counting the other points that have it.
+      for (const auto& sp : e.problems()) {
+        auto same = std::find_if(problems.begin(), problems.end(), [&](const SpecProblem& p) {
+          return p.pointer == "/base" + sp.pointer && p.expected == sp.expected;
+        });
+        if (same != problems.end()) {
+          ++repeats[static_cast<std::size_t>(same - problems.begin())];
+        } else if (problems.size() < 20) {
+          problems.push_back({"/base" + sp.pointer, sp.found + " at point " + job.params.dump(), sp.expected});
+          repeats.push_back(0);
+        }
+      }
+      continue;
     } catch (const std::exception& e) {
       // One problem per distinct message: a bad base field fails every point the same way.
       const std::string expected = std::string("a valid scenario: ") + e.what();

@@ -14,13 +14,12 @@
 #include <string>
 #include <vector>
 
+#include "scheduler/pipeline/json_schema.h"
+
 namespace gravsweep::sweep {
 
-struct SpecProblem {
-  std::string pointer;   ///< JSON pointer into the spec ("" = the document)
-  std::string found;     ///< the value found, as compact JSON (or "missing")
-  std::string expected;  ///< what was expected
-};
+/// One problem: JSON pointer into the spec ("" = the document), the value found, what was expected.
+using SpecProblem = pipeline::SpecProblem;
 
 class SpecError : public std::runtime_error {
  public:

@@ -116,7 +116,7 @@ std::vector<Case> corpus() {
       {"a line with a column missing", [](V&, V& tr, const fs::path&) { tr[7] = tr[7].substr(0, tr[7].find(',')); },
        "traces/A.csv:8:2", "missing on this line"},
       {"empty trials.csv", [](V& t, V&, const fs::path&) { t.clear(); }, "trials.csv:1", "empty file"},
-      {"header-only trials.csv", [](V& t, V&, const fs::path&) { t.resize(1); }, "trials.csv:1", "no trials"},
+      {"header-only trials.csv", [](V& t, V&, const fs::path&) { t.resize(1); }, "trials.csv:1", "no trial rows"},
   };
 }
 

@@ -139,6 +139,25 @@ TEST(ScenarioSpec, CrossFieldRulesAreRefusedAtTheRightField) {
   EXPECT_NO_FATAL_FAILURE(refused_at(s, "/container/diameter_m"));
 }
 
+TEST(ScenarioSpec, EveryProblemIsListedNotOnlyTheFirst) {
+  json s = minimal();
+  s["projectile"]["mass_kg"] = "heavy";             // schema: a number
+  s["grains"] = {{"diameter_spread_m", 0.02}};       // rule: below half the grain diameter
+  s["output"] = {{"sample_rate_hz", 1e7}};           // rule: at most 1/dt_s
+  s["dt_s"] = "small";                               // schema: a number (the rate check then skips)
+  try {
+    validate_scenario(s, "spec.json");
+    FAIL() << "accepted";
+  } catch (const SpecError& e) {
+    std::vector<std::string> ptrs;
+    for (const auto& p : e.problems()) ptrs.push_back(p.pointer);
+    EXPECT_EQ(ptrs, (std::vector<std::string>{"/dt_s", "/projectile/mass_kg", "/grains/diameter_spread_m"}))
+        << e.what();
+    EXPECT_EQ(e.pointer(), "/dt_s");
+    EXPECT_NE(std::string(e.what()).find("spec.json: 3 problems"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ScenarioSpec, TimeStepsAboveTheStabilityBoundAreRefused) {
   json s = minimal();
   s["dt_s"] = 5e-5;  // Hertz bound: 0.3 x Rayleigh time ~ 15 us for 1 cm glass beads at 700 MPa

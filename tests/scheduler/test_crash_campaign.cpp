@@ -1,8 +1,9 @@
-// The crash test of the issue, with the real engine: 3 worker processes on a 60-job campaign of
-// tiny scenarios (4 beds, 56 drops); one worker is killed with SIGKILL in the middle of a job
-// several times and restarted. At the end every job is done exactly once, no result row is
-// duplicated, every trace exists with its recorded checksum, no file is orphaned, and
-// PRAGMA integrity_check is ok.
+// The crash test of the issue, with the real engine: 3 workers on a 60-job campaign of tiny
+// scenarios (4 beds, 56 drops), one a plain `work` process and two under a `work --workers 2`
+// supervisor; in turn the worker and the supervisor are killed with SIGKILL while a job is in the
+// middle (the supervisor's workers must die with it), and restarted. At the end every job is done
+// exactly once, no result row is duplicated, every trace exists with its recorded checksum, no
+// file is orphaned, and PRAGMA integrity_check is ok.
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -11,7 +12,9 @@
 #include <csignal>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <fstream>
 #include <set>
+#include <sstream>
 #include <thread>
 
 #include "db/sqlite.h"
@@ -26,10 +29,49 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// Runs the campaign of `doc` with 3 workers, SIGKILLs worker 0 mid-job up to max_kills times
-/// (restarting it each time), then checks the campaign end to end.
+/// True while `pid` exists and is not a zombie.
+bool process_alive(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (!std::getline(stat, line)) return false;
+  const auto close = line.rfind(')');
+  return close != std::string::npos && close + 2 < line.size() && line[close + 2] != 'Z';
+}
+
+/// The live children of `parent` (from /proc/<pid>/stat, field 4).
+std::vector<pid_t> children_of(pid_t parent) {
+  std::vector<pid_t> out;
+  for (const auto& e : fs::directory_iterator("/proc")) {
+    const std::string name = e.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream stat(e.path() / "stat");
+    std::string line;
+    if (!std::getline(stat, line)) continue;
+    const auto close = line.rfind(')');
+    if (close == std::string::npos) continue;
+    std::istringstream rest(line.substr(close + 2));
+    char state = 0;
+    long ppid = 0;
+    rest >> state >> ppid;
+    if (ppid == parent && state != 'Z') out.push_back(static_cast<pid_t>(std::stol(name)));
+  }
+  return out;
+}
+
+/// What the storm did.
+struct Storm {
+  int worker_kills = 0, supervisor_kills = 0;
+  int orphans = 0;  ///< workers that outlived their SIGKILLed supervisor by 5 s
+};
+
+/// Runs the campaign of `doc` with 3 workers: a `work` process and, when `with_supervisor`, a
+/// `work --workers 2` supervisor (else two more `work` processes). SIGKILLs up to max_kills times, each time
+/// one victim caught mid-job: worker 0, or (every other kill, when `with_supervisor`) the
+/// supervisor while one of its workers is mid-job; each victim is restarted. Then checks the
+/// campaign end to end.
 void crash_campaign(const json& doc, std::int64_t total, std::int64_t with_results,
-                    const std::vector<std::string>& param_columns, int min_kills, int max_kills) {
+                    const std::vector<std::string>& param_columns, int min_kills, int max_kills,
+                    bool with_supervisor = false) {
   TempDir d;
   write_text(d.path / "spec.json", doc.dump(2));
   auto r = run_cli({"submit", "spec.json", "--db", "c.db"}, d.path);
@@ -40,33 +82,63 @@ void crash_campaign(const json& doc, std::int64_t total, std::int64_t with_resul
   const std::vector<std::string> work_args = {"work",   "--db",        db_path, "--threads", "1",
                                               "--lease", "3",          "--heartbeat", "0.3", "--poll",
                                               "0.1",     "--backoff",  "0.1"};
-  std::vector<pid_t> workers;
-  for (int i = 0; i < 3; ++i) workers.push_back(start_cli(work_args, d.path / fmt::format("w{}.log", i)));
+  std::vector<std::string> sup_args = work_args;
+  sup_args.insert(sup_args.end(), {"--workers", "2", "--quiet"});
+  // Slot 0: a plain worker; then the supervisor of two workers, or two more plain workers.
+  std::vector<pid_t> workers{start_cli(work_args, d.path / "w0.log")};
+  if (with_supervisor) workers.push_back(start_cli(sup_args, d.path / "sup.log"));
+  else
+    for (int i = 1; i < 3; ++i) workers.push_back(start_cli(work_args, d.path / fmt::format("w{}.log", i)));
 
   db::Database db(db_path);
+  Storm storm;
   int kills = 0;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(150);
   while (kills < max_kills && std::chrono::steady_clock::now() < deadline) {
-    // Wait until the victim (worker 0) is in the middle of a job: it holds a lease and has reported progress.
+    // The victim: worker 0, or the supervisor (slot 1) on every other kill.
+    const bool sup_turn = with_supervisor && kills % 2 == 1;
+    const pid_t victim = workers[sup_turn ? 1 : 0];
+    std::vector<pid_t> watched = sup_turn ? children_of(victim) : std::vector<pid_t>{victim};
+    std::string pids;
+    for (pid_t w : watched) pids += (pids.empty() ? "" : ",") + std::to_string(w);
+    // Wait until the victim (or one of its workers) is in the middle of a job: it holds a lease
+    // and has reported progress.
     const std::string q = fmt::format(
-        "SELECT count(*) FROM attempts a JOIN jobs j ON j.job_id=a.job_id WHERE a.pid={} AND a.outcome='running' "
-        "AND j.state='running' AND j.progress > 0.2 AND j.progress < 0.9",
-        workers[0]);
+        "SELECT count(*) FROM attempts a JOIN jobs j ON j.job_id=a.job_id WHERE a.pid IN ({}) AND "
+        "a.outcome='running' AND j.state='running' AND j.progress > 0.2 AND j.progress < 0.9",
+        pids.empty() ? "-1" : pids);
     if (sql_int(db, q) == 0) {
       if (sql_int(db, "SELECT count(*) FROM jobs WHERE state!='done'") == 0) break;
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
       continue;
     }
-    kill(workers[0], SIGKILL);
-    EXPECT_EQ(wait_child(workers[0], 10), 128 + SIGKILL);
+    kill(victim, SIGKILL);
+    EXPECT_EQ(wait_child(victim, 10), 128 + SIGKILL);
     ++kills;
-    workers[0] = start_cli(work_args, d.path / "w0.log");
+    if (sup_turn) {
+      // Its workers must go with it (they would otherwise run beside the restarted supervisor's).
+      ++storm.supervisor_kills;
+      const auto t1 = std::chrono::steady_clock::now();
+      auto alive = [&] { return std::count_if(watched.begin(), watched.end(), process_alive); };
+      while (alive() > 0 && std::chrono::steady_clock::now() - t1 < std::chrono::seconds(5))
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      storm.orphans += static_cast<int>(alive());
+      for (pid_t w : watched)
+        if (process_alive(w)) kill(w, SIGKILL);  // do not leave them behind the test
+      workers[1] = start_cli(sup_args, d.path / "sup.log");
+    } else {
+      ++storm.worker_kills;
+      workers[0] = start_cli(work_args, d.path / "w0.log");
+    }
   }
-  EXPECT_GE(kills, min_kills) << "the victim was never caught mid-job often enough";
+  EXPECT_GE(kills, min_kills) << "the victims were never caught mid-job often enough";
+  if (with_supervisor) EXPECT_GE(storm.supervisor_kills, min_kills / 2) << "the supervisor was never caught";
+  EXPECT_EQ(storm.orphans, 0) << "workers outlived their SIGKILLed supervisor";
   for (pid_t w : workers) EXPECT_EQ(wait_child(w, 200), 0);
   ::testing::Test::RecordProperty("sigkills", kills);
-  std::printf("crash campaign: %lld jobs, %d SIGKILLs of a worker mid-job, all workers finished\n",
-              static_cast<long long>(total), kills);
+  std::printf("crash campaign: %lld jobs, %d SIGKILLs mid-job (%d of a worker, %d of a supervisor, %d "
+              "worker(s) outlived it), all workers finished\n",
+              static_cast<long long>(total), kills, storm.worker_kills, storm.supervisor_kills, storm.orphans);
 
   // Every job done exactly once.
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs"), total);
@@ -75,8 +147,13 @@ void crash_campaign(const json& doc, std::int64_t total, std::int64_t with_resul
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM (SELECT job_id FROM attempts WHERE outcome='done' GROUP BY job_id "
                         "HAVING count(*) > 1)"),
             0);
-  // Each kill left exactly one lost attempt, reclaimed by a surviving worker.
-  EXPECT_GE(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='lost'"), kills);  // more only if a starved heartbeat let a lease lapse (then fenced out)
+  // Each kill of a worker left one lost attempt, reclaimed by a surviving worker (more only if a
+  // starved heartbeat let a lease lapse, then fenced out); the workers of a killed supervisor got
+  // SIGTERM and released their leases (or finished the job first).
+  EXPECT_GE(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='lost'"), storm.worker_kills);
+  std::printf("attempts lost %lld, released %lld\n",
+              static_cast<long long>(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='lost'")),
+              static_cast<long long>(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='released'")));
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='running'"), 0);
   // Results: one row per drop, none duplicated, with the swept parameters and the metrics.
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results"), with_results);
@@ -112,7 +189,7 @@ void crash_campaign(const json& doc, std::int64_t total, std::int64_t with_resul
 
 }  // namespace
 
-TEST(CrashCampaign, SigkilledWorkerLosesNothingAndDuplicatesNothing) {
+TEST(CrashCampaign, SigkilledWorkersAndSupervisorsLoseNothingAndDuplicateNothing) {
   if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
   json doc = {{"sweep", "crash"},
               {"max_attempts", 6},
@@ -125,7 +202,8 @@ TEST(CrashCampaign, SigkilledWorkerLosesNothingAndDuplicatesNothing) {
                  {"range", {{"start", 0.4}, {"stop", 1.0}, {"step", 0.1}}}}}},
               {"repeats", {{"name", "projectile_seed"}, {"pointer", "/projectile/seed"}, {"count", 2}, {"start", 1}}}};
   // 4 beds (gravity x bed seed) and 56 drops (7 speeds x 2 projectile seeds per bed).
-  crash_campaign(doc, 60, 56, {"gravity_m_s2", "bed_seed", "impact_speed_m_s", "projectile_seed", "bed_job_id"}, 3, 4);
+  crash_campaign(doc, 60, 56, {"gravity_m_s2", "bed_seed", "impact_speed_m_s", "projectile_seed", "bed_job_id"}, 4, 6,
+                 /*with_supervisor=*/true);
 }
 
 TEST(CrashCampaign, NoopJobsSurviveSigkillToo) {
@@ -135,21 +213,8 @@ TEST(CrashCampaign, NoopJobsSurviveSigkillToo) {
               {"max_attempts", 6},
               {"base", {{"g", 1.5}, {"sleep_s", 0.5}}},
               {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 0.1}, {"stop", 3.0}, {"step", 0.1}}}}}}};
-  EXPECT_NO_FATAL_FAILURE(crash_campaign(doc, 30, 30, {"gravity_m_s2", "noop_value"}, 3, 3));
+  EXPECT_NO_FATAL_FAILURE(crash_campaign(doc, 30, 30, {"gravity_m_s2", "noop_value"}, 4, 4, /*with_supervisor=*/true));
 }
-
-namespace {
-
-/// True while `pid` exists and is not a zombie.
-bool process_alive(pid_t pid) {
-  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
-  std::string line;
-  if (!std::getline(stat, line)) return false;
-  const auto close = line.rfind(')');
-  return close != std::string::npos && close + 2 < line.size() && line[close + 2] != 'Z';
-}
-
-}  // namespace
 
 TEST(CrashCampaign, SigkilledSupervisorTakesItsWorkersDownAndLosesNothing) {
   // 3 SIGKILLs of `work --workers 3` mid-campaign: its workers must exit (they would otherwise
