@@ -29,14 +29,32 @@ case "${1:-}" in
     ;;
   export)
     # One measurement campaign per Table 3 row (a fit mixes every trial of a gravity level), and
-    # the drops of the other parts in results.csv of the campaign database.
+    # the result table of every sweep with finished drops. A campaign that was restarted on a new
+    # machine may hold fewer drops of a part than the committed dataset: that dataset is kept.
+    count() { [ -f "$1/trials.csv" ] && echo $(( $(wc -l < "$1/trials.csv") - 1 )) || echo 0; }
     for part in part1_chrono_1g:chrono_1g part2_chrono_lowg:chrono_0.1g part5_pkdgrav_1g:pkdgrav_1g; do
       sweep="${part%%:*}"; dir="$data/${part##*:}"
       rm -rf "$dir.tmp"
-      "$gs" export --db "$db" --sweep "$sweep" --out "$dir.tmp" --rate-hz 2000
+      if ! "$gs" export --db "$db" --sweep "$sweep" --out "$dir.tmp" --rate-hz 2000; then
+        echo "export: $sweep: nothing exported (see above); $dir kept"; rm -rf "$dir.tmp"; continue
+      fi
+      if [ "$(count "$dir.tmp")" -lt "$(count "$dir")" ]; then
+        echo "export: $sweep: $(count "$dir.tmp") drops in this campaign, $(count "$dir") in $dir: kept"
+        rm -rf "$dir.tmp"; continue
+      fi
       rm -rf "$dir" && mv "$dir.tmp" "$dir"
     done
-    "$gs" results --db "$db" --format csv --out "$data/results_all_parts.csv"
+    for spec in "$root"/examples/reproduction/part*.json; do
+      sweep=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["sweep"])' "$spec")
+      out="$data/results_$sweep.csv"
+      "$gs" results --db "$db" --where "sweep=$sweep" --where "kind=drop" --all --format csv --out "$out.tmp"
+      rows=$(( $(wc -l < "$out.tmp") - 1 ))
+      if [ "$rows" -gt 0 ] && [ "$rows" -ge "$( [ -f "$out" ] && echo $(( $(wc -l < "$out") - 1 )) || echo 0)" ]; then
+        mv "$out.tmp" "$out"; echo "export: $out ($rows drops)"
+      else
+        rm -f "$out.tmp"
+      fi
+    done
     du -sh "$data"
     ;;
   figures)
