@@ -1,0 +1,229 @@
+// The steps of the paper's trace processing (Sunday et al. 2021 Sect. 2.3), see trace_steps.h.
+#include "results/processing/trace_steps.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace gravsweep::results::trace_steps {
+
+double crossing_time(const std::vector<double>& t, const std::vector<double>& y, std::size_t i, double level) {
+  const double dy = y[i + 1] - y[i];
+  if (dy == 0.0) return t[i];
+  const double f = std::clamp((level - y[i]) / dy, 0.0, 1.0);
+  return t[i] + f * (t[i + 1] - t[i]);
+}
+
+double interp_at(const std::vector<double>& t, const std::vector<double>& y, double tq) {
+  if (tq <= t.front()) return y.front();
+  if (tq >= t.back()) return y.back();
+  const auto it = std::upper_bound(t.begin(), t.end(), tq);
+  const std::size_t j = static_cast<std::size_t>(it - t.begin());
+  const std::size_t i = j - 1;
+  const double f = (tq - t[i]) / (t[j] - t[i]);
+  return y[i] + f * (y[j] - y[i]);
+}
+
+double mean_of(const std::vector<double>& x, std::size_t b, std::size_t e) {
+  double s = 0;
+  for (std::size_t i = b; i < e; ++i) s += x[i];
+  return e > b ? s / static_cast<double>(e - b) : 0.0;
+}
+
+double stddev_of(const std::vector<double>& x, std::size_t b, std::size_t e) {
+  if (e <= b + 1) return 0.0;
+  const double m = mean_of(x, b, e);
+  double s = 0;
+  for (std::size_t i = b; i < e; ++i) s += (x[i] - m) * (x[i] - m);
+  return std::sqrt(s / static_cast<double>(e - b - 1));
+}
+
+std::vector<double> filter_acceleration(const std::vector<double>& accel_up_m_s2, double fs, const MetricOptions& o,
+                                        std::string& note) {
+  if (o.cutoff_hz > 0 && o.cutoff_hz < 0.5 * fs)
+    return butterworth_lowpass(accel_up_m_s2, fs, o.cutoff_hz, o.filter_order);
+  note = fmt::format("not filtered: cut-off {} Hz is not below the Nyquist frequency {:.0f} Hz", o.cutoff_hz,
+                     0.5 * fs);
+  return accel_up_m_s2;
+}
+
+std::size_t edge_width(double fs_hz, double cutoff_hz) {
+  return 1 + static_cast<std::size_t>(std::ceil(fs_hz / std::max(cutoff_hz, 1e-9)));
+}
+
+std::size_t contact_peak(const std::vector<double>& af, double g) {
+  const std::size_t ipk = static_cast<std::size_t>(std::max_element(af.begin(), af.end()) - af.begin());
+  if (af[ipk] < -0.5 * g)
+    throw std::invalid_argument(fmt::format(
+        "the projectile never makes contact: the acceleration never rises above -g/2 (peak {:.3g} "
+        "m/s2 with g = {} m/s2)",
+        af[ipk], g));
+  return ipk;
+}
+
+double initial_bias(const std::vector<double>& af, std::size_t ipk, double g) {
+  const std::size_t head = std::max<std::size_t>(1, ipk / 3);
+  std::vector<double> h(af.begin(), af.begin() + static_cast<std::ptrdiff_t>(head));
+  std::nth_element(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(h.size() / 2), h.end());
+  return h[h.size() / 2] + g;
+}
+
+CollisionStart contact_start(const std::vector<double>& t, double t_contact_s) {
+  const auto it = std::upper_bound(t.begin(), t.end(), t_contact_s);
+  const std::size_t i = it == t.begin() ? 0 : static_cast<std::size_t>(it - t.begin()) - 1;
+  return {i, t_contact_s, false};
+}
+
+CollisionStart free_fall_start(const std::vector<double>& t, const std::vector<double>& a, std::size_t ipk,
+                               double g, double thr, std::size_t w) {
+  const std::size_t n = t.size();
+  std::size_t i = ipk;
+  while (i > 0 && a[i] > -g + thr) --i;
+  if (i == 0 && a[0] > -g + thr)
+    throw std::invalid_argument("the record does not start in free fall (no sample reads -g before the peak)");
+  CollisionStart cs{i, crossing_time(t, a, i, -g + thr), false};
+  // Height of the edge: the level reached 2w samples after the threshold crossing.
+  const std::size_t k_hi = std::min(n - 1, i + 2 * w);
+  const double top = *std::max_element(a.begin() + static_cast<std::ptrdiff_t>(i + 1),
+                                       a.begin() + static_cast<std::ptrdiff_t>(k_hi + 1));
+  const double half = -g + 0.5 * (top + g);
+  std::size_t k = i;
+  while (k < k_hi && a[k + 1] < half) ++k;
+  if (k < k_hi && k + 1 <= i + w && top + g > 4.0 * thr) cs = {k, crossing_time(t, a, k, half), true};
+  return cs;
+}
+
+std::size_t end_hold_samples(double fs_hz) {
+  return std::max<std::size_t>(3, static_cast<std::size_t>(std::ceil(0.002 * fs_hz)));
+}
+
+std::optional<std::size_t> end_sample(const std::vector<double>& a, std::size_t ipk, const EndCriteria& c) {
+  const std::size_t n = a.size();
+  for (std::size_t j = ipk; j < n; ++j) {
+    if (c.speed && (*c.speed)[j] > c.v_end_m_s) continue;
+    bool stays = true;
+    for (std::size_t k = j; k < std::min(n, j + c.hold); ++k) stays = stays && a[k] < c.end_level_m_s2;
+    if (stays && j + std::min<std::size_t>(c.hold, 3) <= n) return j;
+  }
+  return std::nullopt;
+}
+
+CollisionEnd end_edge(const std::vector<double>& t, const std::vector<double>& a, std::size_t j,
+                      std::size_t i_start, std::size_t w, double end_level) {
+  CollisionEnd e{j, j > 0 ? crossing_time(t, a, j - 1, end_level) : t[j], false};
+  if (j > w + 1 && j - w - 1 > i_start) {
+    // Level before the edge; a fall to half of it within w samples before j is a step.
+    const double pre = a[j - w - 1];
+    if (pre > 2.0 * end_level) {
+      std::size_t k = j - w - 1;
+      while (k + 1 < j && a[k + 1] > 0.5 * pre) ++k;
+      if (k + 1 <= j) {
+        e.step = true;
+        e.t_end_s = crossing_time(t, a, k, 0.5 * pre);
+      }
+    }
+  }
+  return e;
+}
+
+std::size_t rest_begin(std::size_t i_end, std::size_t w, std::size_t n) {
+  const std::size_t after = std::min(n, i_end + w + 1);
+  return after + (n - after) / 4;
+}
+
+BiasEstimate bias_from_segments(const std::vector<double>& af, double g, std::size_t ff_end, std::size_t rb) {
+  const std::size_t n = af.size();
+  BiasEstimate b;
+  b.free_fall_samples = ff_end;
+  b.rest_samples = n - rb;
+  double b_sum = 0, w_sum = 0;
+  if (b.free_fall_samples >= 3) {
+    b_sum += static_cast<double>(ff_end) * (mean_of(af, 0, ff_end) + g);
+    w_sum += static_cast<double>(ff_end);
+    b.sigma_free_fall_m_s2 = stddev_of(af, 0, ff_end);
+  }
+  if (b.rest_samples >= 10) {
+    b_sum += static_cast<double>(b.rest_samples) * mean_of(af, rb, n);
+    w_sum += static_cast<double>(b.rest_samples);
+  }
+  b.any = w_sum > 0;
+  if (b.any) b.bias_m_s2 = b_sum / w_sum;
+  return b;
+}
+
+void integrate_from_start(const std::vector<double>& t, const std::vector<double>& a, std::size_t i_start,
+                          double t_start, double v0, std::vector<double>& v, std::vector<double>& z) {
+  const std::size_t n = t.size();
+  v.assign(n, 0.0);
+  z.assign(n, 0.0);
+  const std::size_t i0 = std::min(n - 1, i_start + 1);  // first sample after t_start
+  const double dt0 = t[i0] - t_start;
+  const double a_start = interp_at(t, a, t_start);
+  v[i0] = v0 - 0.5 * (a_start + a[i0]) * dt0;
+  z[i0] = 0.5 * (v0 + v[i0]) * dt0;
+  for (std::size_t k = i0 + 1; k < n; ++k) {
+    const double dt = t[k] - t[k - 1];
+    v[k] = v[k - 1] - 0.5 * (a[k] + a[k - 1]) * dt;
+    z[k] = z[k - 1] + 0.5 * (v[k] + v[k - 1]) * dt;
+  }
+  for (std::size_t k = i0; k-- > 0;) {
+    const double dt = t[k + 1] - t[k];
+    v[k] = v[k + 1] + 0.5 * (a[k] + a[k + 1]) * dt;
+    z[k] = z[k + 1] - 0.5 * (v[k] + v[k + 1]) * dt;
+  }
+}
+
+double peak_acceleration(const std::vector<double>& a, const std::vector<double>& v, std::size_t i_start,
+                         std::size_t i_end, bool step_start, bool step_end, std::size_t w, double vc, double g) {
+  // (a = c0 + c1 v^2 is exact for Eq. 1 with f = f0, h = m/d1, and the a-vs-v^2 view of
+  // Katsuragi & Durian 2007 near the surface for the other laws.)
+  const std::size_t n = a.size();
+  std::size_t lo = i_start + 1, hi = std::min(n - 1, i_end);
+  if (step_start) lo = std::min(hi, i_start + 1 + 2 * w);  // filtfilt rings ~2w samples
+  if (step_end && hi > lo + 2 * w) hi -= 2 * w;
+  double peak = -g;
+  for (std::size_t k = lo; k <= hi; ++k) peak = std::max(peak, a[k]);
+  if (step_start && hi >= lo + 4) {
+    const std::size_t k1 = std::min(hi, lo + 3 * w + 2);
+    Eigen::MatrixXd X(static_cast<Eigen::Index>(k1 - lo + 1), 2);
+    Eigen::VectorXd y(X.rows());
+    for (std::size_t k = lo; k <= k1; ++k) {
+      const auto r = static_cast<Eigen::Index>(k - lo);
+      X(r, 0) = 1.0;
+      X(r, 1) = v[k] * v[k];
+      y(r) = a[k];
+    }
+    const Eigen::Vector2d c = X.colPivHouseholderQr().solve(y);
+    if (std::isfinite(c(0)) && std::isfinite(c(1))) peak = std::max(peak, c(0) + c(1) * vc * vc);
+  }
+  return peak;
+}
+
+Rebound rebound_of(const std::vector<double>& v, const std::vector<double>& z, std::size_t i_start,
+                   std::size_t i_end, double vc, const MetricOptions& o) {
+  Rebound r;
+  double vmin = 0, zmax = 0;
+  for (std::size_t k = i_start; k <= std::min(v.size() - 1, i_end); ++k) {
+    vmin = std::min(vmin, v[k]);
+    zmax = std::max(zmax, z[k]);
+  }
+  auto add = [&](const std::string& s) { r.note += (r.note.empty() ? "" : "; ") + s; };
+  if (vmin < -std::max(0.1 * vc, 0.01)) {
+    r.rebound = true;
+    add(fmt::format("moved up at {:.3f} m/s", -vmin));
+  }
+  if (o.fill_height_m) {
+    const double grain = o.grain_diameter_m.value_or(0.0);
+    if (zmax >= *o.fill_height_m - grain) {
+      r.rebound = true;
+      add(fmt::format("reached {:.3f} m, within one grain of the floor at {:.3f} m", zmax, *o.fill_height_m));
+    }
+  }
+  return r;
+}
+
+}  // namespace gravsweep::results::trace_steps

@@ -1,0 +1,114 @@
+// The seams of process_trace (trace.h), one function each so that each is tested on its own
+// (tests/results/test_trace_steps.cpp): filter, contact peak, sensor bias, collision start,
+// collision end (threshold and step edge), rest segment, integration, peak, rebound. Conventions
+// as trace.h: z and v positive down, acceleration positive up (free fall -g, rest 0).
+// Not an interface for callers outside results/processing/ and its tests: use process_trace.
+#pragma once
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "results/processing/trace.h"
+
+namespace gravsweep::results::trace_steps {
+
+/// Linear interpolation of the time where y crosses `level` between samples i and i + 1.
+double crossing_time(const std::vector<double>& t, const std::vector<double>& y, std::size_t i, double level);
+/// y(tq) by linear interpolation, held constant beyond the ends.
+double interp_at(const std::vector<double>& t, const std::vector<double>& y, double tq);
+double mean_of(const std::vector<double>& x, std::size_t b, std::size_t e);    ///< of [b, e)
+double stddev_of(const std::vector<double>& x, std::size_t b, std::size_t e);  ///< sample std of [b, e)
+
+/// The options' low-pass of the raw acceleration; unfiltered (and `note` says why) when the
+/// cut-off is not below the Nyquist frequency.
+std::vector<double> filter_acceleration(const std::vector<double>& accel_up_m_s2, double fs_hz,
+                                        const MetricOptions& o, std::string& note);
+
+/// Edge width in samples: a zero-phase Butterworth spreads (and rings around) a step over about
+/// fs/fc samples on each side.
+std::size_t edge_width(double fs_hz, double cutoff_hz);
+
+/// The sample of the largest filtered acceleration; throws std::invalid_argument when it does not
+/// stand clear of free fall (above -g/2): the projectile never makes contact.
+std::size_t contact_peak(const std::vector<double>& af, double g_m_s2);
+
+/// First guess of the sensor bias (m/s2): the median of the first third of the record before the
+/// peak reads -g + bias (the record starts in free fall).
+double initial_bias(const std::vector<double>& af, std::size_t ipk, double g_m_s2);
+
+/// The collision start: the last sample before it and its time, and whether it is a step edge
+/// (faster than the filter, located at half height).
+struct CollisionStart {
+  std::size_t i_start = 0;
+  double t_start_s = 0;
+  bool step = false;
+};
+/// DEM records: the engine's first contact (Trace::contact_start_s).
+CollisionStart contact_start(const std::vector<double>& t, double t_contact_s);
+/// The paper's rule (Sect. 2.3): the last sample before the peak ipk still within the free-fall
+/// band -g + thr; a step edge (rising within the edge width w) is located at its half height.
+/// Throws std::invalid_argument when no sample before the peak reads -g.
+CollisionStart free_fall_start(const std::vector<double>& t, const std::vector<double>& a, std::size_t ipk,
+                               double g_m_s2, double thr_m_s2, std::size_t w);
+
+/// What the collision end is searched with.
+struct EndCriteria {
+  double end_level_m_s2 = 0;            ///< end_threshold_g * g
+  double v_end_m_s = 0;                 ///< end_speed_fraction * |vc|
+  const std::vector<double>* speed = nullptr;  ///< downward speed per sample, when known
+  std::size_t hold = 3;                 ///< samples the acceleration must stay below the level
+};
+/// Samples to hold the end level: 2 ms, at least 3 samples.
+std::size_t end_hold_samples(double fs_hz);
+/// The first sample at or after the peak where the acceleration stays below the end level for
+/// `hold` samples with the speed below v_end; nullopt when there is none.
+std::optional<std::size_t> end_sample(const std::vector<double>& a, std::size_t ipk, const EndCriteria& c);
+
+/// The collision end: the first sample after it, its time (threshold crossing, or half height of
+/// a step edge: a fall to half the level w samples earlier), whether it is a step edge.
+struct CollisionEnd {
+  std::size_t i_end = 0;
+  double t_end_s = 0;
+  bool step = false;
+};
+CollisionEnd end_edge(const std::vector<double>& t, const std::vector<double>& a, std::size_t j,
+                      std::size_t i_start, std::size_t w, double end_level_m_s2);
+
+/// Rest segment [rest_begin, n): the last three quarters of what follows the collision end and
+/// its edge, so that late settling stays out of it.
+std::size_t rest_begin(std::size_t i_end, std::size_t w, std::size_t n);
+
+/// The sensor bias from free fall [0, ff_end) (reads -g + bias) and rest [rest_begin, n) (reads
+/// bias), weighted by sample count; segments under 3 (free fall) or 10 (rest) samples are unused.
+struct BiasEstimate {
+  double bias_m_s2 = 0;
+  bool any = false;           ///< false: neither segment long enough (keep the previous bias)
+  std::size_t free_fall_samples = 0, rest_samples = 0;
+  std::optional<double> sigma_free_fall_m_s2;  ///< noise of the free-fall segment, when used
+};
+BiasEstimate bias_from_segments(const std::vector<double>& af, double g_m_s2, std::size_t ff_end,
+                                std::size_t rest_begin);
+
+/// Velocity (positive down) and depth from the acceleration (positive up), dv_down/dt = -a_up, by
+/// trapezoids both ways from the collision start (v = v0, z = 0 at t_start, between samples
+/// i_start and i_start + 1).
+void integrate_from_start(const std::vector<double>& t, const std::vector<double>& a, std::size_t i_start,
+                          double t_start_s, double v0_m_s, std::vector<double>& v, std::vector<double>& z);
+
+/// The peak: the largest filtered acceleration of the collision [i_start + 1, i_end], leaving out
+/// the filter's ringing next to step edges; at a step-like contact the early samples beyond the
+/// ringing are extrapolated back to the contact speed vc by a least-squares line in v^2.
+double peak_acceleration(const std::vector<double>& a, const std::vector<double>& v, std::size_t i_start,
+                         std::size_t i_end, bool step_start, bool step_end, std::size_t w, double vc_m_s,
+                         double g_m_s2);
+
+/// Rebound: clearly moving up during the collision, or down to within one grain of the floor.
+struct Rebound {
+  bool rebound = false;
+  std::string note;  ///< "moved up at ... m/s; reached ... m, within one grain of the floor ..."
+};
+Rebound rebound_of(const std::vector<double>& v, const std::vector<double>& z, std::size_t i_start,
+                   std::size_t i_end, double vc_m_s, const MetricOptions& o);
+
+}  // namespace gravsweep::results::trace_steps

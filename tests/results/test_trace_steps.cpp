@@ -1,0 +1,184 @@
+// The seams of process_trace (results/processing/trace_steps.h), each on a record built for it:
+// filter, contact peak, bias, collision start, collision end and its edge, rest segment,
+// integration, peak, rebound. The whole chain is tested in test_trace.cpp.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "results/processing/trace_steps.h"
+
+using namespace gravsweep::results;
+using namespace gravsweep::results::trace_steps;
+
+namespace {
+
+constexpr double kG = 9.81;
+
+std::vector<double> times(std::size_t n, double fs) {
+  std::vector<double> t(n);
+  for (std::size_t i = 0; i < n; ++i) t[i] = static_cast<double>(i) / fs;
+  return t;
+}
+
+}  // namespace
+
+TEST(TraceSteps, FilterIsTheButterworthOrSaysWhyNot) {
+  std::vector<double> x(100, 0.0);
+  x[50] = 1.0;
+  MetricOptions o;
+  std::string note;
+  EXPECT_EQ(filter_acceleration(x, 1400, o, note), butterworth_lowpass(x, 1400, 500, 2));
+  EXPECT_TRUE(note.empty());
+  EXPECT_EQ(filter_acceleration(x, 800, o, note), x);  // 500 Hz is above the 400 Hz Nyquist
+  EXPECT_NE(note.find("not filtered"), std::string::npos) << note;
+}
+
+TEST(TraceSteps, EdgeWidthAndHoldFollowTheRates) {
+  EXPECT_EQ(edge_width(1400, 500), 4u);   // 1 + ceil(2.8)
+  EXPECT_EQ(edge_width(10000, 500), 21u);
+  EXPECT_EQ(end_hold_samples(1400), 3u);  // 2 ms is 2.8 samples: at least 3
+  EXPECT_EQ(end_hold_samples(10000), 20u);
+}
+
+TEST(TraceSteps, ContactPeakIsTheMaximumAndFreeFallOnlyNeverMakesContact) {
+  std::vector<double> a(50, -kG);
+  EXPECT_THROW(contact_peak(a, kG), std::invalid_argument);
+  a[30] = 20.0;
+  a[31] = 25.0;
+  EXPECT_EQ(contact_peak(a, kG), 31u);
+}
+
+TEST(TraceSteps, InitialBiasIsTheMedianOfTheHeadAboveMinusG) {
+  std::vector<double> a(90, 0.0);
+  for (std::size_t i = 0; i < 60; ++i) a[i] = -kG + 0.3 + (i == 5 ? 50.0 : 0.0);  // one spike
+  EXPECT_NEAR(initial_bias(a, 60, kG), 0.3, 1e-12);
+}
+
+TEST(TraceSteps, ContactStartIsTheLastSampleBefore) {
+  const auto t = times(20, 1000);
+  const CollisionStart s = contact_start(t, 0.0105);
+  EXPECT_EQ(s.i_start, 10u);
+  EXPECT_DOUBLE_EQ(s.t_start_s, 0.0105);
+  EXPECT_FALSE(s.step);
+  EXPECT_EQ(contact_start(t, -1.0).i_start, 0u);
+}
+
+TEST(TraceSteps, FreeFallStartAtTheThresholdForARampAndAtHalfHeightForAStep) {
+  const double fs = 1400, thr = 0.03 * kG;
+  const auto t = times(100, fs);
+  std::vector<double> ramp(100, -kG), step(100, -kG);
+  for (std::size_t i = 40; i < 100; ++i) ramp[i] = -kG + 0.05 * static_cast<double>(i - 40);
+  for (std::size_t i = 40; i < 100; ++i) step[i] = 20.0;
+  step[40] = -kG + 0.5 * (20.0 + kG);  // the step's half height exactly at sample 40
+  const CollisionStart r = free_fall_start(t, ramp, 99, kG, thr, 4);
+  EXPECT_EQ(r.i_start, 45u);  // -g + 0.25, the last sample below -g + thr
+  EXPECT_NEAR(r.t_start_s, t[40] + (thr / 0.05) / fs, 1e-9);
+  EXPECT_FALSE(r.step);
+  const CollisionStart s = free_fall_start(t, step, 99, kG, thr, 4);
+  EXPECT_TRUE(s.step);
+  EXPECT_NEAR(s.t_start_s, t[40], 1e-9);
+  std::vector<double> none(100, 0.0);
+  none[60] = 5.0;
+  EXPECT_THROW(free_fall_start(t, none, 60, kG, thr, 4), std::invalid_argument);
+}
+
+TEST(TraceSteps, EndSampleNeedsTheLevelHeldAndTheSpeedDown) {
+  std::vector<double> a(40, 5.0), v(40, 0.5);
+  for (std::size_t i = 25; i < 40; ++i) a[i] = 0.0, v[i] = 0.0;
+  a[12] = 0.0;  // a one-sample dip inside the collision does not end it
+  EndCriteria c;
+  c.end_level_m_s2 = 0.1 * kG;
+  c.hold = 3;
+  EXPECT_EQ(end_sample(a, 5, c), 25u);
+  for (std::size_t i = 12; i < 16; ++i) a[i] = 0.0;  // a lull of 4 samples ...
+  EXPECT_EQ(end_sample(a, 5, c), 12u);
+  c.speed = &v;  // ... is not the end while the projectile still moves
+  c.v_end_m_s = 0.05;
+  EXPECT_EQ(end_sample(a, 5, c), 25u);
+  for (std::size_t i = 25; i < 40; ++i) v[i] = 0.2;
+  EXPECT_FALSE(end_sample(a, 5, c).has_value());
+}
+
+TEST(TraceSteps, EndEdgeIsAStepWhenTheLevelFallsWithinTheEdgeWidth) {
+  const auto t = times(60, 1400);
+  std::vector<double> a(60, 0.0);
+  for (std::size_t i = 0; i < 30; ++i) a[i] = 10.0;
+  a[30] = 5.0;  // half height at sample 30
+  const CollisionEnd e = end_edge(t, a, 31, 5, 4, 0.1 * kG);
+  EXPECT_TRUE(e.step);
+  EXPECT_EQ(e.i_end, 31u);
+  EXPECT_NEAR(e.t_end_s, t[30], 1e-9);
+  std::vector<double> slow(60, 0.0);  // a gradual fall: the threshold crossing
+  for (std::size_t i = 0; i < 60; ++i) slow[i] = std::max(0.0, 1.5 - 0.05 * static_cast<double>(i));
+  const std::size_t j = 11;  // first sample below 0.981
+  const CollisionEnd g = end_edge(t, slow, j, 0, 4, 0.1 * kG);
+  EXPECT_FALSE(g.step);
+  EXPECT_NEAR(g.t_end_s, t[10] + (1.0 - 0.981) / 0.05 / 1400, 1e-9);
+}
+
+TEST(TraceSteps, RestIsTheLastThreeQuartersAfterTheEdge) {
+  EXPECT_EQ(rest_begin(100, 4, 205), 105u + 25u);
+  EXPECT_EQ(rest_begin(200, 4, 203), 203u);  // nothing after the end
+}
+
+TEST(TraceSteps, BiasFromFreeFallAndRestWeightedBySamples) {
+  std::vector<double> af(100, 0.2);                     // rest reads the bias 0.2
+  for (std::size_t i = 0; i < 20; ++i) af[i] = -kG + 0.5;  // free fall reads -g + 0.5
+  const BiasEstimate b = bias_from_segments(af, kG, 20, 60);
+  EXPECT_TRUE(b.any);
+  EXPECT_NEAR(b.bias_m_s2, (20 * 0.5 + 40 * 0.2) / 60.0, 1e-12);
+  EXPECT_EQ(b.free_fall_samples, 20u);
+  EXPECT_EQ(b.rest_samples, 40u);
+  ASSERT_TRUE(b.sigma_free_fall_m_s2.has_value());
+  EXPECT_NEAR(*b.sigma_free_fall_m_s2, 0.0, 1e-12);
+  const BiasEstimate none = bias_from_segments(af, kG, 2, 95);  // 2 and 5 samples: too few
+  EXPECT_FALSE(none.any);
+  EXPECT_FALSE(none.sigma_free_fall_m_s2.has_value());
+}
+
+TEST(TraceSteps, IntegrationIsExactForConstantDeceleration) {
+  const double fs = 1000, A = 4.0, v0 = 0.8, t0 = 0.0203;
+  const auto t = times(200, fs);
+  std::vector<double> a(200), v, z;
+  for (std::size_t i = 0; i < 200; ++i) a[i] = A;  // constant upward acceleration
+  integrate_from_start(t, a, 20, t0, v0, v, z);
+  for (std::size_t k : {0u, 19u, 21u, 100u, 199u}) {
+    const double s = t[k] - t0;
+    EXPECT_NEAR(v[k], v0 - A * s, 1e-12) << k;
+    EXPECT_NEAR(z[k], v0 * s - 0.5 * A * s * s, 1e-12) << k;
+  }
+}
+
+TEST(TraceSteps, PeakLeavesOutTheRingingAndExtrapolatesAStepContactToVc) {
+  // a = c0 + c1 v^2 along the collision; the samples next to the step contact ring.
+  const std::size_t n = 80, w = 4;
+  std::vector<double> a(n, 0.0), v(n, 0.0);
+  const double c0 = 15, c1 = 25, vc = 1.0;
+  for (std::size_t k = 10; k < 60; ++k) {
+    v[k] = vc * (1.0 - static_cast<double>(k - 10) / 50.0);
+    a[k] = c0 + c1 * v[k] * v[k];
+  }
+  a[11] = 100.0;  // ringing inside 2w of the start
+  const double p = peak_acceleration(a, v, 10, 60, true, false, w, vc, kG);
+  EXPECT_NEAR(p, c0 + c1 * vc * vc, 1e-6);
+  // A gradual contact: the largest sample of the collision, ringing included.
+  EXPECT_DOUBLE_EQ(peak_acceleration(a, v, 10, 60, false, false, w, vc, kG), 100.0);
+}
+
+TEST(TraceSteps, ReboundWhenMovingUpOrReachingTheFloor) {
+  MetricOptions o;
+  std::vector<double> v(20, 0.3), z(20, 0.05);
+  EXPECT_FALSE(rebound_of(v, z, 2, 15, 1.0, o).rebound);
+  v[10] = -0.2;
+  const Rebound up = rebound_of(v, z, 2, 15, 1.0, o);
+  EXPECT_TRUE(up.rebound);
+  EXPECT_NE(up.note.find("moved up at 0.200 m/s"), std::string::npos) << up.note;
+  v[10] = 0.3;
+  o.fill_height_m = 0.055;
+  o.grain_diameter_m = 0.01;
+  const Rebound floor = rebound_of(v, z, 2, 15, 1.0, o);
+  EXPECT_TRUE(floor.rebound);
+  EXPECT_NE(floor.note.find("within one grain of the floor"), std::string::npos) << floor.note;
+}
+
