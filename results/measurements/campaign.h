@@ -27,6 +27,10 @@ struct MeasuredTrial {
   ProcessedTrace processed;
   /// Samples used by trace-level fits: inside the collision, clear of the filter's transient.
   std::size_t fit_begin = 0, fit_end = 0;  ///< [begin, end)
+  /// A CSV trace only: the file line of each sample and the 1-based column of accel_m_s2, so
+  /// that a processing error about a sample (TraceError) names its line. Empty otherwise.
+  std::vector<int> sample_lines;
+  int accel_column = 0;
 };
 
 struct Campaign {

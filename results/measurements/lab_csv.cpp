@@ -61,8 +61,10 @@ fs::path resolve_inside(const fs::path& dir, const std::string& rel, int line, i
   return full;
 }
 
-/// A trace CSV; `declared_hz` is the row's sample_rate_hz, checked against the timestamps.
-Trace read_trace_csv(const fs::path& path, const std::string& rel, double declared_hz, int row_line, int rate_col) {
+/// A trace CSV; `declared_hz` is the row's sample_rate_hz, checked against the timestamps. The
+/// line of each sample and the acceleration's column go to `out.sample_lines`, `out.accel_column`.
+Trace read_trace_csv(const fs::path& path, const std::string& rel, double declared_hz, int row_line, int rate_col,
+                     MeasuredTrial& out) {
   std::ifstream in(path);
   if (!in) throw ParseError{{rel, 0, 0, "cannot open the trace file"}};
   CsvReader reader(in);
@@ -120,7 +122,20 @@ Trace read_trace_csv(const fs::path& path, const std::string& rel, double declar
                                     "the declared {} Hz; one sample every {:.6g} s expected",
                                     tr.t_s[i + 1], tr.t_s[i], std::lround(dt[i] * declared_hz) - 1, declared_hz,
                                     1.0 / declared_hz)}};
+  out.sample_lines = std::move(lines);
+  out.accel_column = ca + 1;
   return tr;
+}
+
+/// A processing error of a trial, at the line of the sample it is about (and the acceleration's
+/// column when the sample's value is the reason: out of range, not a number).
+ImportIssue issue_of(const MeasuredTrial& t, const TraceError& e) {
+  ImportIssue is{t.info.trace_file, 0, 0, e.what()};
+  if (e.sample() && *e.sample() < t.sample_lines.size()) {
+    is.line = t.sample_lines[*e.sample()];
+    if (e.bad_value()) is.column = t.accel_column;
+  }
+  return is;
 }
 
 /// The required columns of trials.csv, from the field table.
@@ -200,7 +215,7 @@ MeasuredTrial read_row(const fs::path& dir, const std::map<std::string, int>& co
       throw ParseError{{rel, 0, 0, e.what()}};
     }
   } else {
-    t.raw = read_trace_csv(full, rel, ti.sample_rate_hz, ln, col.at("sample_rate_hz") + 1);
+    t.raw = read_trace_csv(full, rel, ti.sample_rate_hz, ln, col.at("sample_rate_hz") + 1, t);
     t.raw.source = ti.source;
     if (ti.source == TraceSource::dem && !text("contact_start_s").empty()) {
       double s0;
@@ -253,6 +268,8 @@ Campaign load_campaign(const std::string& directory, double cutoff_hz) {
                           fmt::format("column 'trial_id': '{}' appears twice", t.info.trial_id)}};
       try {
         process_trial(t);
+      } catch (const TraceError& e) {
+        throw ParseError{issue_of(t, e)};
       } catch (const std::invalid_argument& e) {
         throw ParseError{{t.info.trace_file, 0, 0, e.what()}};
       }

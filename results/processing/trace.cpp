@@ -87,10 +87,16 @@ void validate(const Trace& tr) {
     throw std::invalid_argument(fmt::format("trace too short: {} samples, at least 8 expected", n));
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isfinite(tr.t_s[i]) || !std::isfinite(tr.accel_up_m_s2[i]))
-      throw std::invalid_argument(fmt::format("sample {} is not a finite number", i));
+      throw TraceError(fmt::format("sample {} is not a finite number", i), i, !std::isfinite(tr.accel_up_m_s2[i]));
+    if (std::abs(tr.accel_up_m_s2[i]) > kMaxAccel_m_s2)
+      throw TraceError(fmt::format("sample {} (t = {} s): acceleration {:g} m/s2 is beyond any accelerometer's "
+                                   "range; |a| <= {:g} m/s2 expected",
+                                   i, tr.t_s[i], tr.accel_up_m_s2[i], kMaxAccel_m_s2),
+                       i, true);
     if (i > 0 && !(tr.t_s[i] > tr.t_s[i - 1]))
-      throw std::invalid_argument(fmt::format(
-          "time does not increase at sample {} (t_s = {} after {})", i, tr.t_s[i], tr.t_s[i - 1]));
+      throw TraceError(fmt::format("time does not increase at sample {} (t_s = {} after {})", i, tr.t_s[i],
+                                   tr.t_s[i - 1]),
+                       i);
   }
 }
 
@@ -173,10 +179,10 @@ PassResult collision_pass(const Trace& trace, const MetricOptions& o, const std:
   ec.v_end_m_s = o.end_speed_fraction * std::abs(vc_pass);
   const std::optional<std::size_t> j = end_sample(a, ipk, ec);
   if (!j)
-    throw std::invalid_argument(fmt::format(
-        "trace shorter than the collision: after the peak at t = {:.4f} s the acceleration never "
-        "stays below {} g with the speed below {} of the collision speed",
-        t[ipk], o.end_threshold_g, o.end_speed_fraction));
+    throw TraceError(fmt::format("trace shorter than the collision: after the peak at t = {:.4f} s the acceleration "
+                                 "never stays below {} g with the speed below {} of the collision speed",
+                                 t[ipk], o.end_threshold_g, o.end_speed_fraction),
+                     n - 1);
   r.end = end_edge(t, a, *j, r.start.i_start, w, ec.end_level_m_s2);
   r.bias = bias_from_segments(af, g, ff_end, rest_begin(r.end.i_end, w, n));
   return r;
@@ -204,6 +210,7 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
   const bool sensor = trace.source == TraceSource::lab;
   const bool own_kinematics = !trace.velocity_down_m_s.empty() && !trace.depth_m.empty();
   double bias = sensor ? initial_bias(af, ipk, g) : 0.0;
+  if (sensor) check_starts_in_free_fall(t, af, ipk, g);
   // Steps faster than the filter (contact and stop in Poncelet-type laws) are located at their
   // half-height crossing, which a zero-phase filter leaves in place; gradual edges at the
   // threshold crossing, as the paper does.

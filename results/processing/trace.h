@@ -8,6 +8,7 @@
 #pragma once
 #include <cstddef>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -81,12 +82,35 @@ struct ProcessedTrace {
   std::size_t i_end = 0;                  ///< first sample after the collision end
 };
 
+/// Why a trace cannot be measured, and the sample the reason is about when there is one (the
+/// first sample of a record that does not start in free fall, the out-of-range sample, the peak of
+/// a record that never makes contact, the last sample of one that ends inside the collision), so
+/// that a reader can name the line it came from. Callers may catch it as std::invalid_argument.
+class TraceError : public std::invalid_argument {
+ public:
+  /// `bad_value`: the sample's acceleration value itself is the reason (a reader names its column).
+  explicit TraceError(const std::string& what, std::optional<std::size_t> sample = std::nullopt,
+                      bool bad_value = false)
+      : std::invalid_argument(what), sample_(sample), bad_value_(bad_value) {}
+  [[nodiscard]] std::optional<std::size_t> sample() const { return sample_; }
+  [[nodiscard]] bool bad_value() const { return bad_value_; }
+
+ private:
+  std::optional<std::size_t> sample_;
+  bool bad_value_ = false;
+};
+
+/// Largest |acceleration| a record may hold, m/s2 (1e5 g: beyond the range of shock
+/// accelerometers; granular impacts reach 1e2-1e3 g). A larger sample is a corrupt record, and
+/// one near 1e308 would overflow the filter.
+inline constexpr double kMaxAccel_m_s2 = 1e6;
 /// Zero-phase (forward-backward) Butterworth low-pass of order `order` at `cutoff_hz`.
 std::vector<double> butterworth_lowpass(const std::vector<double>& x, double sample_rate_hz,
                                         double cutoff_hz, int order = 2);
 
-/// Computes the metrics as the paper does; throws std::invalid_argument with the reason when the
-/// trace is too short, never makes contact or has non-increasing time.
+/// Computes the metrics as the paper does; throws TraceError with the reason (and the sample) when
+/// the trace is too short, holds a sample beyond kMaxAccel_m_s2, does not start in free fall,
+/// never makes contact, ends inside the collision or has non-increasing time.
 Metrics compute_metrics(const Trace& trace, const MetricOptions& options);
 
 /// The same processing, returning the processed arrays with the metrics (same errors).

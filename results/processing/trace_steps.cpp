@@ -58,10 +58,10 @@ std::size_t edge_width(double fs_hz, double cutoff_hz) {
 std::size_t contact_peak(const std::vector<double>& af, double g) {
   const std::size_t ipk = static_cast<std::size_t>(std::max_element(af.begin(), af.end()) - af.begin());
   if (af[ipk] < -0.5 * g)
-    throw std::invalid_argument(fmt::format(
-        "the projectile never makes contact: the acceleration never rises above -g/2 (peak {:.3g} "
-        "m/s2 with g = {} m/s2)",
-        af[ipk], g));
+    throw TraceError(fmt::format("the projectile never makes contact: the acceleration never rises above -g/2 "
+                                 "(peak {:.3g} m/s2 at sample {} with g = {} m/s2)",
+                                 af[ipk], ipk, g),
+                     ipk);
   return ipk;
 }
 
@@ -70,6 +70,29 @@ double initial_bias(const std::vector<double>& af, std::size_t ipk, double g) {
   std::vector<double> h(af.begin(), af.begin() + static_cast<std::ptrdiff_t>(head));
   std::nth_element(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(h.size() / 2), h.end());
   return h[h.size() / 2] + g;
+}
+
+namespace {
+
+double median_of(std::vector<double> x) {
+  std::nth_element(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(x.size() / 2), x.end());
+  return x[x.size() / 2];
+}
+
+}  // namespace
+
+void check_starts_in_free_fall(const std::vector<double>& t, const std::vector<double>& af, std::size_t ipk,
+                               double g) {
+  const std::size_t n = af.size();
+  const std::size_t k = std::clamp<std::size_t>(ipk / 3, 1, kFreeFallProbeSamples);
+  const double head = median_of({af.begin(), af.begin() + static_cast<std::ptrdiff_t>(k)});
+  const double tail = median_of({af.end() - static_cast<std::ptrdiff_t>(std::min(k, n)), af.end()});
+  if (head - tail > -kFreeFallMinDrop_g * g)
+    throw TraceError(fmt::format("the record does not start in free fall: its first {} samples read {:.4g} m/s2 "
+                                 "(median), its last {} {:.4g} m/s2; free fall reads g = {:.4g} m/s2 below rest "
+                                 "(at least {} g below expected before the peak at t = {:.4f} s)",
+                                 k, head, k, tail, g, kFreeFallMinDrop_g, t[ipk]),
+                     0);
 }
 
 CollisionStart contact_start(const std::vector<double>& t, double t_contact_s) {
@@ -84,7 +107,7 @@ CollisionStart free_fall_start(const std::vector<double>& t, const std::vector<d
   std::size_t i = ipk;
   while (i > 0 && a[i] > -g + thr) --i;
   if (i == 0 && a[0] > -g + thr)
-    throw std::invalid_argument("the record does not start in free fall (no sample reads -g before the peak)");
+    throw TraceError("the record does not start in free fall (no sample reads -g before the peak)", 0);
   CollisionStart cs{i, crossing_time(t, a, i, -g + thr), false};
   // Height of the edge: the level reached 2w samples after the threshold crossing.
   const std::size_t k_hi = std::min(n - 1, i + 2 * w);

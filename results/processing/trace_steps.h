@@ -37,6 +37,15 @@ std::size_t contact_peak(const std::vector<double>& af, double g_m_s2);
 /// peak reads -g + bias (the record starts in free fall).
 double initial_bias(const std::vector<double>& af, std::size_t ipk, double g_m_s2);
 
+/// A lab record starts in free fall and ends at rest: its first samples read about g below its
+/// last ones, whatever the sensor bias. Throws TraceError (sample 0) when the head reads less than
+/// kFreeFallMinDrop_g * g below the tail (a record that starts at rest or inside the collision).
+/// Head and tail: up to kFreeFallProbeSamples samples, and at most a third of the way to the peak.
+inline constexpr double kFreeFallMinDrop_g = 0.5;
+inline constexpr std::size_t kFreeFallProbeSamples = 10;
+void check_starts_in_free_fall(const std::vector<double>& t, const std::vector<double>& af, std::size_t ipk,
+                               double g_m_s2);
+
 /// The collision start: the last sample before it and its time, and whether it is a step edge
 /// (faster than the filter, located at half height).
 struct CollisionStart {

@@ -113,6 +113,17 @@ std::vector<Case> corpus() {
       {"never makes contact", [](V&, V& tr, const fs::path&) {
          for (std::size_t i = 1; i < tr.size(); ++i) tr[i] = tr[i].substr(0, tr[i].find(',')) + ",-9.81";
        }, "trials.csv line 2", "never makes contact"},
+      // Issue 10 item 12: each unmeasurable record gets its own reason, at the line it is about.
+      {"1e308 in a trace", [](V&, V& tr, const fs::path&) { tr[30] = tr[30].substr(0, tr[30].find(',')) + ",1e308"; },
+       "traces/A.csv:31:2", "beyond any accelerometer's range"},
+      {"no free fall (starts at rest)", [](V&, V& tr, const fs::path&) {
+         for (std::size_t i = 1; i < 30; ++i) tr[i] = tr[i].substr(0, tr[i].find(',')) + ",0";
+       }, "traces/A.csv:2: ", "does not start in free fall"},
+      {"never makes contact (a small bump)", [](V&, V& tr, const fs::path&) {
+         for (std::size_t i = 1; i < tr.size(); ++i) tr[i] = tr[i].substr(0, tr[i].find(',')) + (i == 40 ? ",-6" : ",-9.81");
+       }, "traces/A.csv:41: ", "never makes contact"},
+      {"record ends inside the collision", [](V&, V& tr, const fs::path&) { tr.resize(50); },
+       "traces/A.csv:50: ", "shorter than the collision"},
       {"a line with a column missing", [](V&, V& tr, const fs::path&) { tr[7] = tr[7].substr(0, tr[7].find(',')); },
        "traces/A.csv:8:2", "missing on this line"},
       {"empty trials.csv", [](V& t, V&, const fs::path&) { t.clear(); }, "trials.csv:1", "empty file"},

@@ -294,3 +294,59 @@ TEST(Metrics, FirstContactStartAgreesWithThePapersRuleAfterALongFreeFall) {
   EXPECT_NEAR(dem.apeak_m_s2, paper.apeak_m_s2, 0.03 * paper.apeak_m_s2);
   EXPECT_NEAR(dem.zstop_m, p.zstop(), 0.02 * p.zstop());
 }
+
+namespace {
+
+/// The TraceError of processing `tr` (fails the test when it is measured or throws another type).
+TraceError error_of(const Trace& tr, const MetricOptions& o) {
+  try {
+    compute_metrics(tr, o);
+  } catch (const TraceError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "measured";
+  return TraceError("measured");
+}
+
+}  // namespace
+
+// Issue 10 item 12: no free fall, no contact, a 1e308 sample and a record that ends inside the
+// collision were all "trace shorter than the collision"; each has its own reason and sample.
+TEST(Metrics, EachUnmeasurableRecordGetsItsOwnReasonAndSample) {
+  Poncelet p;
+  MetricOptions o;
+  o.impact_velocity_m_s = p.v0;
+  const Trace tr = sample(p, 1400, 0.02, 0.01, 0.0, 1);
+  const std::size_t contact = static_cast<std::size_t>(0.02 * 1400);
+
+  Trace huge = tr;
+  huge.accel_up_m_s2[40] = 1e308;
+  TraceError e = error_of(huge, o);
+  EXPECT_NE(std::string(e.what()).find("beyond any accelerometer's range"), std::string::npos) << e.what();
+  EXPECT_EQ(e.sample(), 40u);
+  EXPECT_TRUE(e.bad_value());
+
+  Trace at_rest = tr;  // the record starts at rest instead of in free fall
+  for (std::size_t i = 0; i < contact; ++i) at_rest.accel_up_m_s2[i] = 0.0;
+  e = error_of(at_rest, o);
+  EXPECT_NE(std::string(e.what()).find("does not start in free fall"), std::string::npos) << e.what();
+  EXPECT_EQ(e.sample(), 0u);
+
+  Trace bump = tr;  // free fall with a bump that never reaches -g/2
+  for (double& a : bump.accel_up_m_s2) a = -p.g;
+  bump.accel_up_m_s2[50] = -6.0;
+  e = error_of(bump, o);
+  EXPECT_NE(std::string(e.what()).find("never makes contact"), std::string::npos) << e.what();
+  EXPECT_EQ(e.sample(), 50u);
+
+  Trace cut = tr;  // ends inside the collision
+  const std::size_t keep = contact + static_cast<std::size_t>(0.5 * p.tstop() * 1400);
+  cut.t_s.resize(keep);
+  cut.accel_up_m_s2.resize(keep);
+  e = error_of(cut, o);
+  EXPECT_NE(std::string(e.what()).find("shorter than the collision"), std::string::npos) << e.what();
+  EXPECT_EQ(e.sample(), keep - 1);
+
+  // A sensor bias of a few per cent of g is not mistaken for a missing free fall.
+  EXPECT_NO_THROW(compute_metrics(sample(p, 1400, 0.02, 0.01, 0.05, 1), o));
+}
