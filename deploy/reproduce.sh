@@ -38,7 +38,7 @@ case "${1:-}" in
       if ! "$gs" export --db "$db" --sweep "$sweep" --out "$dir.tmp" --rate-hz 2000; then
         echo "export: $sweep: nothing exported (see above); $dir kept"; rm -rf "$dir.tmp"; continue
       fi
-      if [ "$(count "$dir.tmp")" -lt "$(count "$dir")" ]; then
+      if [ "$(count "$dir.tmp")" -eq 0 ] || [ "$(count "$dir.tmp")" -lt "$(count "$dir")" ]; then
         echo "export: $sweep: $(count "$dir.tmp") drops in this campaign, $(count "$dir") in $dir: kept"
         rm -rf "$dir.tmp"; continue
       fi
