@@ -3,11 +3,15 @@
 // change to processing or fitting that moves them fails here.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
+#include <vector>
 
+#include "results/measurements/csv.h"
 #include "results_helpers.h"
 
 namespace {
@@ -76,4 +80,70 @@ TEST(Reproduction, ModelVerbsReadSeveralDatasetsAsOneCampaign) {
       "model table3 '" + dataset("chrono_1g") + "' '" + dataset("chrono_1g") + "'", true);
   EXPECT_EQ(twice.code, 2) << twice.out;
   EXPECT_NE(twice.out.find("is also in an earlier input"), std::string::npos) << twice.out;
+}
+
+namespace {
+
+/// The rows of a committed results CSV (the project's RFC 4180 reader: notes hold commas), by
+/// column name.
+std::vector<std::map<std::string, std::string>> csv_rows(const std::string& file) {
+  std::ifstream in(std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "data" / "reproduction" / file);
+  EXPECT_TRUE(in.good()) << file;
+  gravsweep::results::CsvReader csv(in);
+  std::vector<std::string> names, fields;
+  int line = 0;
+  std::vector<std::map<std::string, std::string>> rows;
+  if (!csv.next(names, line)) return rows;
+  while (csv.next(fields, line)) {
+    EXPECT_EQ(fields.size(), names.size()) << file << ":" << line;
+    std::map<std::string, std::string> r;
+    for (std::size_t i = 0; i < names.size() && i < fields.size(); ++i) r[names[i]] = fields[i];
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+}  // namespace
+
+// Fig. 3 (part 3, REPRODUCTION.md): rebound off the floor at fills <= 4 cm, none from 6 cm on, and a
+// plateau of the depth from 10 cm (10-14 cm within 5 % of their mean).
+TEST(Reproduction, FillHeightTrendsAsStated) {
+  const auto rows = csv_rows("results_part3_fill_height.csv");
+  ASSERT_EQ(rows.size(), 14u);
+  int shallow_rebounds = 0;
+  std::vector<double> plateau;
+  for (const auto& r : rows) {
+    const double fill = std::stod(r.at("fill_height_m"));
+    const bool rebound = r.at("rebound") == "1" || r.at("rebound") == "true";
+    if (fill <= 0.04 + 1e-9) shallow_rebounds += rebound;
+    else EXPECT_FALSE(rebound) << "fill " << fill;
+    if (fill >= 0.1 - 1e-9) plateau.push_back(std::stod(r.at("zstop_m")));
+  }
+  EXPECT_GE(shallow_rebounds, 3);
+  ASSERT_EQ(plateau.size(), 6u);
+  double mean = 0;
+  for (double z : plateau) mean += z / static_cast<double>(plateau.size());
+  EXPECT_NEAR(mean, 0.0357, 0.001);
+  for (double z : plateau) EXPECT_NEAR(z, mean, 0.05 * mean);
+}
+
+// dt check (REPRODUCTION.md): at 1 us zstop is 1.3-1.8 % shallower than part 1's 5 us drops.
+TEST(Reproduction, DtCheckMovesZstopByLessThanTwoPercent) {
+  const auto fine = csv_rows("results_part1_dt_check.csv");
+  const auto coarse = csv_rows("results_all_parts.csv");
+  ASSERT_EQ(fine.size(), 3u);
+  for (const auto& f : fine) {
+    const double v = std::stod(f.at("impact_speed_m_s"));
+    bool found = false;
+    for (const auto& c : coarse) {
+      if (c.at("sweep") != "part1_chrono_1g" || c.at("projectile_seed") != "1" ||
+          std::abs(std::stod(c.at("impact_speed_m_s")) - v) > 1e-9)
+        continue;
+      found = true;
+      const double rel = std::stod(f.at("zstop_m")) / std::stod(c.at("zstop_m")) - 1.0;
+      EXPECT_LT(rel, 0.0) << v;
+      EXPECT_GT(rel, -0.02) << v;
+    }
+    EXPECT_TRUE(found) << "no 5 us drop at " << v << " m/s";
+  }
 }
