@@ -2,7 +2,7 @@
 # The README's main job: installs the Debian packages, builds, and runs a small end-to-end
 # campaign on the embedded SQLite default, into ./runs/demo:
 #   1. submit a sweep (2 gravities x 3 speeds x 2 start offsets; bed jobs shared by their drops),
-#   2. run it with 2 worker processes, 3. show status and the result table (and export CSV),
+#   2. run it with 2 worker processes (beds kept in a bed cache), 3. show status and the result table (and export CSV),
 #   4. compare the collision model with a laboratory campaign (depth-friction-dev, if present):
 #      import, rank the candidate terms, fit base vs base+depth_friction, write the report,
 #   5. the same questions of the gravity sweep itself: every finished drop of the campaign
@@ -23,8 +23,8 @@ db="$out/campaign.db"
 
 echo "== 1. submit"
 "$gs" submit "$root/examples/sweep_tiny.json" --db "$db"
-echo "== 2. work (2 worker processes, 1 thread each)"
-"$gs" work --db "$db" --workers 2 --threads 1
+echo "== 2. work (2 worker processes, 1 thread each; beds kept in $out/beds, shared with other campaigns)"
+"$gs" work --db "$db" --workers 2 --threads 1 --bed-cache "$out/beds"
 echo "== 3. status and results"
 "$gs" status --db "$db"
 # The table shows the job, the swept parameters and the paper's metrics; the CSV has every column.
@@ -60,9 +60,9 @@ base = json.load(open(sys.argv[1]))["base"]
 base["projectile"]["impact_speed_m_s"] = 1.0
 json.dump(base, open(sys.argv[2], "w"), indent=1)
 PY
-bed="$(sqlite3 "$db" "SELECT output_path FROM jobs WHERE kind='bed' AND state='done' AND \
-  json_extract(scenario_json, '$.gravity_m_s2') = 9.81 LIMIT 1")"
-case "$bed" in /*) ;; *) bed="$out/campaign.files/$bed" ;; esac
+# The bed cache's copy (<bed job id>.h5 + .sha256): `run --bed` verifies it against its checksum.
+bed="$out/beds/$(sqlite3 "$db" "SELECT job_id FROM jobs WHERE kind='bed' AND state='done' AND \
+  json_extract(scenario_json, '$.gravity_m_s2') = 9.81 LIMIT 1").h5"
 "$gs" run "$out/drop.json" --out "$out/drop" --bed "$bed" --threads 2 --quiet
 "$gs" plot bed "$bed" --trace "$out/drop/trace.h5" --snapshots "$out/drop/snapshots.h5" --out "$out/drop/fig1.png"
 "$gs" plot trace "$out/drop/trace.h5" --out "$out/drop/fig2.png"

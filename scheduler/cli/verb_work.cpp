@@ -38,6 +38,7 @@ struct WorkOptions {
   double backoff_s = 2.0;
   long max_jobs = -1;
   bool quiet = false;
+  std::string bed_cache;  ///< --bed-cache: prepared beds shared between campaigns (pipeline/bed_cache.h)
 };
 
 /// Exit code after the workers stopped: 4 when some job is dead.
@@ -56,6 +57,7 @@ int supervise(const WorkOptions& o, int threads) {
                                    "--backoff", fmt::format("{}", o.backoff_s)};
   if (o.heartbeat_s > 0) args.insert(args.end(), {"--heartbeat", fmt::format("{}", o.heartbeat_s)});
   if (o.follow) args.push_back("--follow");
+  if (!o.bed_cache.empty()) args.insert(args.end(), {"--bed-cache", o.bed_cache});
   if (o.quiet) args.push_back("--quiet");
   if (o.max_jobs >= 0) args.insert(args.end(), {"--max-jobs", std::to_string(o.max_jobs)});
   // Block SIGINT/SIGTERM here while forking; the supervisor forwards them to the children.
@@ -148,6 +150,7 @@ int run_work(const WorkOptions& o) {
   w.backoff_base_s = o.backoff_s;
   w.code_version = pipeline::build_version();
   w.verbose = !o.quiet;
+  w.bed_cache = o.bed_cache;
   const auto rep = queue::run_worker(w, queue::all_runners());
   if (!o.quiet)
     fmt::print(stderr, "worker {}: {} done, {} failed (will retry), {} dead, {} released, {} fenced out, {} expired leases reclaimed\n",
@@ -186,6 +189,10 @@ void setup_work(CLI::App& app) {
   sub->add_option("--poll", opt->poll_s, "wait between claims when nothing is runnable, s")->check(CLI::Range(0.01, 60.0))->capture_default_str();
   sub->add_option("--backoff", opt->backoff_s, "retry backoff base, s (base * 2^(attempt-1), capped at 300 s)")->check(CLI::Range(0.0, 3600.0))->capture_default_str();
   sub->add_option("--max-jobs", opt->max_jobs, "stop after this many jobs per worker (-1: no limit)")->capture_default_str();
+  sub->add_option("--bed-cache", opt->bed_cache,
+                  "folder of prepared beds shared between campaigns and machines: a bed job whose bed is "
+                  "there (<bed job id>.h5 + .sha256, checksum and bed key verified) copies it instead of "
+                  "preparing it; a bed job that prepares its bed stores it there");
   sub->add_flag("--quiet", opt->quiet, "no per-job log lines");
   sub->callback([opt]() {
     const int code = run_work(*opt);

@@ -134,11 +134,12 @@ BedJobResult run_bed_job(const json& scenario, const std::filesystem::path& bed_
 
 std::filesystem::path bed_checksum_path(const std::filesystem::path& bed) { return bed.string() + ".sha256"; }
 
-void write_bed_checksum(const std::filesystem::path& bed) {
-  const auto path = bed_checksum_path(bed), tmp = std::filesystem::path(path.string() + ".tmp");
+void write_bed_checksum(const std::filesystem::path& bed, const std::filesystem::path& named) {
+  const auto& as = named.empty() ? bed : named;
+  const auto path = bed_checksum_path(as), tmp = std::filesystem::path(path.string() + ".tmp");
   {
     std::ofstream f(tmp);
-    f << sweep::sha256_file(bed) << "  " << bed.filename().string() << "\n";
+    f << sweep::sha256_file(bed) << "  " << as.filename().string() << "\n";
     if (!f.flush()) throw std::runtime_error(fmt::format("{}: cannot write", tmp.string()));
   }
   std::filesystem::rename(tmp, path);
@@ -176,6 +177,23 @@ results::BedData read_user_bed(const std::filesystem::path& bed, std::string* un
   }
 }
 
+void require_bed_key(const results::BedData& bed, const json& scenario, const std::filesystem::path& bed_path) {
+  const json want = bed_key_of_validated(scenario);
+  json have;
+  try {
+    have = json::parse(bed.bed_key_json);
+  } catch (const json::exception&) {
+    throw ConfigError(fmt::format("bed {}: the bed_key attribute is not valid JSON", bed_path.string()));
+  }
+  if (have == want) return;
+  const json::json_pointer at(first_difference(have, want));
+  throw ConfigError(fmt::format(
+      "bed {} was prepared for another scenario: its bed key differs at {} (found {}, the scenario "
+      "needs {}); prepare a bed for this scenario (omit --bed)",
+      bed_path.string(), at.to_string(), have.contains(at) ? have[at].dump() : "nothing",
+      want.contains(at) ? want[at].dump() : "nothing"));
+}
+
 void load_bed(System& sys, const results::BedData& bed) {
   for (std::size_t i = 0; i < bed.size(); ++i) {
     const Vec3 x(bed.position_m[3 * i], bed.position_m[3 * i + 1], bed.position_m[3 * i + 2]);
@@ -195,24 +213,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   ScenarioParams p = scenario_params(s);
   if (threads > 0) p.drop_config.threads = threads;
   const results::BedData bed = results::read_bed(bed_in);
-  const json want = bed_key_of_validated(s);
-  json have;
-  try {
-    have = json::parse(bed.bed_key_json);
-  } catch (const json::exception&) {
-    throw ConfigError(fmt::format("bed {}: the bed_key attribute is not valid JSON", bed_in.string()));
-  }
-  if (have != want)
-    throw ConfigError(fmt::format(
-        "bed {} was prepared for another scenario: its bed key differs at {} (found {}, the scenario "
-        "needs {}); prepare a bed for this scenario (omit --bed)",
-        bed_in.string(), first_difference(have, want),
-        have.contains(json::json_pointer(first_difference(have, want)))
-            ? have[json::json_pointer(first_difference(have, want))].dump()
-            : "nothing",
-        want.contains(json::json_pointer(first_difference(have, want)))
-            ? want[json::json_pointer(first_difference(have, want))].dump()
-            : "nothing"));
+  require_bed_key(bed, s, bed_in);
   check_stop(stop, "drop");
   const auto t0 = std::chrono::steady_clock::now();
 
@@ -271,7 +272,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   td.grain_diameter_m = p.bed.grains.diameter_m;
   td.stopped = dr.stopped;
   td.scenario_json = s.dump();
-  td.bed_key_json = want.dump();
+  td.bed_key_json = bed_key_of_validated(s).dump();
   td.bed_file = std::filesystem::absolute(bed_in).string();
   td.code_version = pipeline::build_version();
 

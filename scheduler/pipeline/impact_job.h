@@ -61,14 +61,20 @@ nlohmann::json bed_key(const nlohmann::json& scenario);
 /// `<bed>.sha256`, beside a bed that `gravsweep run` prepared: the bed file's SHA-256, the checksum
 /// a campaign records for its beds (sweep::sha256_file), as sha256sum writes it ("<hex>  <name>").
 std::filesystem::path bed_checksum_path(const std::filesystem::path& bed);
-/// Writes bed_checksum_path(bed) (temporary name, then rename).
-void write_bed_checksum(const std::filesystem::path& bed);
+/// Writes bed_checksum_path(named) (temporary name, then rename) with the SHA-256 of `bed`;
+/// `named` empty: bed_checksum_path(bed).
+void write_bed_checksum(const std::filesystem::path& bed, const std::filesystem::path& named = {});
 
 /// A bed named on the command line (`run --bed`, `bench --bed`), read and verified: throws
 /// ConfigError naming the file (exit 2) when it is missing, not a gravsweep bed, cut short or
 /// corrupt, or does not match its checksum file. A bed without a checksum file (written before
 /// gravsweep recorded one, or copied without it) is read unverified and `*unverified` says why.
 results::BedData read_user_bed(const std::filesystem::path& bed, std::string* unverified);
+
+/// Throws ConfigError naming `bed_path` and the first differing field (JSON pointer) when the bed
+/// was prepared for another bed key than `scenario`'s (as validate_scenario() returns it).
+void require_bed_key(const results::BedData& bed, const nlohmann::json& scenario,
+                     const std::filesystem::path& bed_path);
 
 /// Puts a saved bed (grains, bit-exact state, no contact history) and its container walls into
 /// `sys`, whose config holds the contact parameters.

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #if __has_include("scheduler/pipeline/impact_job.h")
+#include "scheduler/pipeline/bed_cache.h"
 #include "scheduler/pipeline/impact_job.h"
 #define GRAVSWEEP_HAVE_PIPELINE 1
 #else
@@ -24,9 +25,16 @@ sweep::BedKeyFn impact_bed_key() {
 void add_impact_runners(RunnerTable& table) {
 #if GRAVSWEEP_HAVE_PIPELINE
   table["bed"] = [](const RunContext& ctx) {
+    RunOutput out;
+    if (!ctx.bed_cache.empty()) {
+      if (auto cached = pipeline::take_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.claim.scenario, ctx.output_tmp)) {
+        out.report = *cached;
+        return out;
+      }
+    }
     auto r = pipeline::run_bed_job(ctx.claim.scenario, ctx.output_tmp, ctx.threads, ctx.progress, ctx.stop);
     if (r.bed_path != ctx.output_tmp && !r.bed_path.empty()) std::filesystem::rename(r.bed_path, ctx.output_tmp);
-    RunOutput out;
+    if (!ctx.bed_cache.empty()) pipeline::store_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.output_tmp);
     out.report = r.report;
     return out;
   };

@@ -255,7 +255,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
                        sig.fraction = f;
                        sig.detail = detail;
                      },
-                     &sig.stop};
+                     &sig.stop, o.bed_cache};
       out = runner->second(ctx);
     } catch (const ConfigError& e) {
       error = e.what();

@@ -24,6 +24,7 @@ struct RunContext {
   int threads = 1;
   ProgressFn progress;
   const std::atomic<bool>* stop = nullptr;  ///< set when the job must end early
+  std::filesystem::path bed_cache;          ///< bed jobs: shared prepared beds (empty: none)
 };
 
 struct RunOutput {
@@ -54,6 +55,7 @@ struct WorkerOptions {
   double backoff_base_s = 2.0;
   std::string code_version = "unknown";
   bool verbose = true;
+  std::filesystem::path bed_cache;  ///< `work --bed-cache`: passed to the runners (RunContext)
 };
 
 struct WorkerReport {
