@@ -10,9 +10,16 @@
 #include <vector>
 
 #include "engine/contact/contact.h"
-#include "engine/system/system.h"
+#include "engine/core/material.h"
+#include "engine/system/force_function.h"
 
 namespace gravsweep {
+
+/// Names of the registered contact laws and rolling models, and their one-line descriptions.
+std::vector<std::string> contact_law_names();
+std::vector<std::string> rolling_model_names();
+std::string contact_law_description(const std::string& name);
+std::string rolling_model_description(const std::string& name);
 
 /// The force function for a (contact law, rolling model) pair; unknown names are ConfigErrors
 /// that list the valid names.

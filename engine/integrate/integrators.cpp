@@ -14,17 +14,17 @@ template <class Body>
 void end_loop(Particles& p, StepCheck& check, Body&& body) {
   const std::size_t n = p.size();
   long long bad = -1;
-  int cause = 0;
+  StateFault cause = StateFault::none;
   double max_d2 = 0;
 #pragma omp parallel reduction(max : max_d2)
   {
     long long my_bad = -1;
-    int my_cause = 0;
+    StateFault my_cause = StateFault::none;
 #pragma omp for schedule(static) nowait
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3 x = body(i);
-      const int c = check.visit(x, i, &max_d2);
-      if (c != 0 && my_bad < 0) {
+      const StateFault c = check.visit(x, i, &max_d2);
+      if (c != StateFault::none && my_bad < 0) {
         my_bad = static_cast<long long>(i);
         my_cause = c;
       }

@@ -13,6 +13,13 @@
 
 namespace gravsweep {
 
+/// What the end-of-step check found wrong with a particle's state.
+enum class StateFault : unsigned char {
+  none = 0,
+  non_finite,      ///< NaN or inf in the position (a bad velocity reaches it in the same step)
+  outside_domain,  ///< the centre left the domain: the particle left the container
+};
+
 /// Checks made on every particle in the integrator's last loop of a step, so the state is read
 /// once: non-finite values, a centre outside the domain, and the largest displacement since the
 /// neighbour list was built (drives the rebuild).
@@ -23,16 +30,17 @@ struct StepCheck {
   const Vec3* position_at_build = nullptr;  ///< null: no list yet (rebuild anyway)
   // Outputs (reduced over threads).
   long long bad_particle = -1;
-  int bad_cause = 0;                         ///< 1 non-finite, 2 outside the domain
+  StateFault bad_cause = StateFault::none;
   double max_displacement2_m2 = 0;
 
   /// Per-particle check on the particle's new position (a NaN or inf in a velocity reaches the
-  /// position in the same step); returns the cause (0 = fine) and updates *max_d2.
-  GRAVSWEEP_INLINE int visit(const Vec3& x, std::size_t i, double* max_d2) const {
-    if (!std::isfinite(x.x() + x.y() + x.z())) return 1;
-    if (have_domain && ((x.array() < lo_m.array()).any() || (x.array() > hi_m.array()).any())) return 2;
+  /// position in the same step); returns what is wrong (none = fine) and updates *max_d2.
+  GRAVSWEEP_INLINE StateFault visit(const Vec3& x, std::size_t i, double* max_d2) const {
+    if (!std::isfinite(x.x() + x.y() + x.z())) return StateFault::non_finite;
+    if (have_domain && ((x.array() < lo_m.array()).any() || (x.array() > hi_m.array()).any()))
+      return StateFault::outside_domain;
     if (position_at_build != nullptr) *max_d2 = std::max(*max_d2, (x - position_at_build[i]).squaredNorm());
-    return 0;
+    return StateFault::none;
   }
 };
 

@@ -204,22 +204,20 @@ void System::force_pass(bool displacement_checked) {
   force_fn_(ctx);
   stats_ = ctx.stats;
   have_forces_ = true;
-  if (ctx.failed_particle >= 0) {
-    std::string other = ctx.failed_other >= 0
-                            ? fmt::format("particle {}", ctx.failed_other)
-                            : fmt::format("wall '{}'", walls[-2 - ctx.failed_other].name);
+  if (const OverlapFailure& f = ctx.failure; f.failed()) {
+    const std::string other = f.wall >= 0 ? fmt::format("wall '{}'", walls[static_cast<std::size_t>(f.wall)].name)
+                                          : fmt::format("particle {}", f.other);
     throw NumericalFailure(
         fmt::format("step {} (t = {:.6g} s): particle {} overlaps {} by {:.0f} % of the smaller "
                     "radius (limit {:.0f} %): the time step is too large or the contact too soft",
-                    step_, time_s_, ctx.failed_particle, other, 100 * ctx.failed_overlap_ratio,
-                    100 * kMaxOverlapFraction),
-        step_, ctx.failed_particle);
+                    step_, time_s_, f.particle, other, 100 * f.ratio, 100 * kMaxOverlapFraction),
+        step_, f.particle);
   }
 }
 
-void System::raise_state_failure(long long bad, int cause) {
+void System::raise_state_failure(long long bad, StateFault cause) {
   const Vec3& x = particles.position_m[bad];
-  if (cause == 1)
+  if (cause == StateFault::non_finite)
     throw NumericalFailure(fmt::format("step {} (t = {:.6g} s): particle {} has a non-finite "
                                        "position or velocity (NaN/inf)",
                                        step_, time_s_, bad),

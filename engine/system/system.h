@@ -14,11 +14,10 @@
 #include "engine/geometry/walls.h"
 #include "engine/integrate/integrators.h"
 #include "engine/neighbor/verlet_list.h"
+#include "engine/system/force_function.h"
 
 namespace gravsweep {
 
-struct ForceContext;
-using ForceFunction = void (*)(ForceContext&);
 
 /// Axis-aligned region; a particle centre outside it is a numerical failure ("left the container").
 struct Domain {
@@ -26,8 +25,8 @@ struct Domain {
 };
 
 struct SystemConfig {
-  std::string contact_law = "hertz";               ///< see contact_law_names()
-  std::string rolling_model = "sunday";            ///< see rolling_model_names()
+  std::string contact_law = "hertz";               ///< see contact_law_names() (contact/registry.h)
+  std::string rolling_model = "sunday";            ///< see rolling_model_names() (contact/registry.h)
   std::string integrator = "semi_implicit_euler";  ///< see integrator_table()
   double dt_s = 1e-6;
   Vec3 gravity_m_s2 = Vec3(0, 0, -9.81);
@@ -130,13 +129,7 @@ class System {
   bool have_step_checks_ = false;
   void force_pass(bool displacement_checked);
   void rebuild_neighbors();
-  void raise_state_failure(long long particle, int cause);
+  void raise_state_failure(long long particle, StateFault cause);
 };
-
-/// Names of the registered contact laws and rolling models (engine/contact/registry.cpp).
-std::vector<std::string> contact_law_names();
-std::vector<std::string> rolling_model_names();
-std::string contact_law_description(const std::string& name);
-std::string rolling_model_description(const std::string& name);
 
 }  // namespace gravsweep

@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 
+#include "engine/contact/registry.h"
 #include "engine/integrate/integrators.h"
 #include "engine/scenario/paper_params.h"
 

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "engine/core/error.h"
 #include "engine/scenario/paper_params.h"
@@ -31,6 +32,30 @@ TEST(Failure, OverlapBeyondHalfRadiusNamesParticlesAndStep) {
     EXPECT_EQ(e.particle(), 0);
     EXPECT_NE(msg.find("particle 0 overlaps particle 1"), std::string::npos) << msg;
     EXPECT_NE(msg.find("step 0"), std::string::npos) << msg;
+  }
+}
+
+TEST(Failure, OverlapWithAWallNamesTheWall) {
+  for (const char* law : {"hertz", "hooke"}) {  // the batched and the scalar pair paths share the wall loop
+    SystemConfig cfg = no_gravity();
+    if (std::string(law) == "hooke") {
+      cfg.contact_law = "hooke";
+      cfg.rolling_model = "none";
+      cfg.integrator = "leapfrog_kdk";
+      for (auto& m : cfg.materials) m.kn_N_m = 7.48e5;  // dem-physics.md 2.4
+    }
+    System s(cfg);
+    s.walls.push_back(Wall::plane("floor", Vec3(0, 0, 0), Vec3(0, 0, 1), 1));
+    s.particles.add(Vec3(0.1, 0, 0.01), 0.005, 1.3e-3, 0, SizeClass::grain);     // clear of the floor
+    s.particles.add(Vec3(0, 0, 0.002), 0.005, 1.3e-3, 0, SizeClass::grain);      // 60 % into it
+    try {
+      s.step();
+      ADD_FAILURE() << law << ": expected NumericalFailure";
+    } catch (const NumericalFailure& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(e.particle(), 1) << law;
+      EXPECT_NE(msg.find("particle 1 overlaps wall 'floor' by 60 %"), std::string::npos) << law << ": " << msg;
+    }
   }
 }
 
