@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
 
 #include "scheduler_test_helpers.h"
 #include "tests/common/png_check.h"
@@ -89,6 +91,18 @@ void expect_figure(const std::filesystem::path& png, std::uintmax_t min_bytes) {
 
 /// One real `gravsweep run` of the tiny scenario (bed, trace, snapshots, fig2.png), shared by the
 /// tests below: the drop is the expensive part.
+/// Runs tests/scheduler/check_xdmf.py on an XDMF index; returns its exit status, `out` its output
+/// ("ok <grids> <items> <times>" when every dataset the index names exists with its shape).
+int check_xdmf(const std::filesystem::path& xdmf, std::string& out) {
+  const std::string cmd = "/usr/bin/python3 '" GRAVSWEEP_SOURCE_DIR "/tests/scheduler/check_xdmf.py' '" +
+                          xdmf.string() + "' 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (p == nullptr) return -1;
+  char buf[512] = {0};
+  while (fgets(buf, sizeof buf, p)) out += buf;
+  return pclose(p);
+}
+
 const std::filesystem::path& tiny_run() {
   static TempDir d("gravsweep-plot-run");
   static bool done = false;
@@ -208,14 +222,8 @@ TEST(CliPlot, RunWritesSnapshotsThatTheXdmfIndexDescribes) {
   const auto xdmf = d / "r" / "snapshots.xdmf";
   ASSERT_TRUE(std::filesystem::exists(d / "r" / "snapshots.h5"));
   ASSERT_TRUE(std::filesystem::exists(xdmf));
-  const std::string cmd = "/usr/bin/python3 '" GRAVSWEEP_SOURCE_DIR "/tests/scheduler/check_xdmf.py' '" +
-                          xdmf.string() + "' 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  ASSERT_NE(p, nullptr);
-  char buf[512] = {0};
   std::string out;
-  while (fgets(buf, sizeof buf, p)) out += buf;
-  EXPECT_EQ(pclose(p), 0) << out;
+  ASSERT_EQ(check_xdmf(xdmf, out), 0) << out;
   int grids = 0, items = 0, times = 0;
   ASSERT_EQ(std::sscanf(out.c_str(), "ok %d %d %d", &grids, &items, &times), 3) << out;
   EXPECT_GE(times, 3) << out;  // release, every 5 ms, the end
@@ -229,4 +237,35 @@ TEST(CliPlot, RunWritesSnapshotsThatTheXdmfIndexDescribes) {
   const std::string bad = "/usr/bin/python3 '" GRAVSWEEP_SOURCE_DIR "/tests/scheduler/check_xdmf.py' '" +
                           (d / "r" / "bad.xdmf").string() + "' >/dev/null 2>&1";
   EXPECT_NE(std::system(bad.c_str()), 0);
+}
+
+// Campaign drops write snapshots when their scenario asks (/output/snapshot_interval_s), into
+// <campaign>.files/snapshots/, one .h5 + .xdmf per drop that the same check reads; drops that do
+// not ask write none.
+TEST(CliPlot, CampaignDropsWriteSnapshotsWhenTheScenarioAsks) {
+  TempDir d;
+  for (const double interval_s : {0.0, 0.01}) {  // two sweeps: one drop without, one with snapshots
+    json spec;
+    spec["sweep"] = interval_s > 0 ? "snap" : "nosnap";
+    spec["base"] = json::parse(tiny_base());
+    spec["base"]["output"]["snapshot_interval_s"] = interval_s;
+    spec["axes"] = json::array({{{"name", "impact_speed_m_s"}, {"pointer", "/projectile/impact_speed_m_s"},
+                                 {"values", {interval_s > 0 ? 0.5 : 0.6}}}});
+    write_text(d.path / "spec.json", spec.dump(2));
+    ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
+  }
+  const auto r = run_cli({"work", "--db", "c.db", "--threads", "1", "--quiet"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::vector<std::filesystem::path> xdmfs;
+  for (const auto& e : std::filesystem::directory_iterator(d.path / "c.files" / "snapshots"))
+    if (e.path().extension() == ".xdmf") xdmfs.push_back(e.path());
+  ASSERT_EQ(xdmfs.size(), 1u) << "one of the two drops asked for snapshots";
+  std::string out;
+  ASSERT_EQ(check_xdmf(xdmfs[0], out), 0) << out;
+  int grids = 0, items = 0, times = 0;
+  ASSERT_EQ(std::sscanf(out.c_str(), "ok %d %d %d", &grids, &items, &times), 3) << out;
+  EXPECT_GE(times, 3) << out;
+  EXPECT_EQ(grids, 2 * times) << out;
+  auto h5 = xdmfs[0];
+  EXPECT_TRUE(std::filesystem::exists(h5.replace_extension(".h5"))) << h5;
 }
