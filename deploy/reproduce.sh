@@ -73,7 +73,10 @@ case "${1:-}" in
     done
     for d in "$data"/*/; do "$gs" model table3 "$d"; done | tee "$figs/table3.txt"
     "$gs" model rank "$db" --where 'sweep~_chrono_' | tee "$figs/model_rank_chrono.txt"
-    "$gs" report "$data/chrono_1g" --out "$figs/report"
+    # Figs. 9 and 10 with both gravity levels (Table 3's Eq. 2-4 lines and alpha fits, the models' curves).
+    reports=("$data/chrono_1g"); [ -f "$data/chrono_0.1g/trials.csv" ] && reports+=("$data/chrono_0.1g")
+    "$gs" report "${reports[@]}" --out "$figs/report"
+    cp "$figs/report/fig9_metrics_vs_vc.png" "$figs/report/fig10_zstop_vs_H.png" "$figs/"
     ;;
   *)
     sed -n '2,12p' "${BASH_SOURCE[0]}"

@@ -134,6 +134,7 @@ def plot_residuals():
 
 def plot_fig10():
     trials = read(os.path.join(D, "trials.csv"))
+    t3 = read(os.path.join(D, "table3.csv")) if os.path.exists(os.path.join(D, "table3.csv")) else []
     gs = by_g(trials)
     fig, ax = plt.subplots(figsize=(5.5, 4.5))
     for k, g in enumerate(gs):
@@ -142,6 +143,16 @@ def plot_fig10():
         z = [num(r["zstop_m"]) for r in t]
         ax.loglog([100 * h for h in H], [100 * x for x in z], "o", ms=3, color=COLORS[k % len(COLORS)],
                   label=f"g = {g:g} m/s2")
+        # Fig. 10a's lines: zstop ~ H^alpha with Table 3's alpha (table3.csv); given alpha, the
+        # least-squares intercept on log-log axes is the mean of log z - alpha log H.
+        row = [r for r in t3 if abs(num(r["gravity_m_s2"]) - g) <= 1e-6 * max(1.0, g)]
+        alpha = num(row[0]["alpha"]) if row else math.nan
+        pts = [(h, x) for h, x in zip(H, z) if h > 0 and x > 0]
+        if pts and math.isfinite(alpha):
+            c = sum(math.log(x) - alpha * math.log(h) for h, x in pts) / len(pts)
+            hs = [min(h for h, _ in pts), max(h for h, _ in pts)]
+            ax.loglog([100 * h for h in hs], [100 * math.exp(c) * h ** alpha for h in hs], "-", lw=2, alpha=0.45,
+                      color=COLORS[k % len(COLORS)], label=f"zstop ~ H^alpha, alpha = {alpha:.3f} (Table 3)")
     curves = read(os.path.join(D, "model_curves.csv"))
     models = []
     for r in curves:
@@ -155,6 +166,13 @@ def plot_fig10():
             z = [100 * num(r["zstop_m"]) for r in c]
             ax.loglog(H, z, styles[mi % len(styles)], lw=1, color=COLORS[k % len(COLORS)],
                       label=m if k == 0 else None)
+    # The axes frame the trials (the model curves start at vc -> 0, far below any trial).
+    allH = [100 * (num(r["drop_height_m"]) + num(r["zstop_m"])) for r in trials]
+    allz = [100 * num(r["zstop_m"]) for r in trials]
+    pos = [(h, x) for h, x in zip(allH, allz) if h > 0 and x > 0]
+    if pos:
+        ax.set_xlim(min(h for h, _ in pos) / 1.5, max(h for h, _ in pos) * 1.5)
+        ax.set_ylim(min(x for _, x in pos) / 1.5, max(x for _, x in pos) * 1.5)
     ax.set_xlabel("H = drop height + zstop (cm)")
     ax.set_ylabel("zstop (cm)")
     ax.set_title("Penetration depth vs total height (Fig. 10)")

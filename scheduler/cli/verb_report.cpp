@@ -2,6 +2,7 @@
 // comparison: Fig. 9 with model lines, residuals against depth and speed coloured by gravity,
 // zstop against H (Fig. 10), the candidate ranking and the error falling.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <filesystem>
 #include <fstream>
@@ -21,7 +22,8 @@ namespace gravsweep::cli {
 
 namespace {
 struct ReportOptions {
-  std::string dir, out = "report", baseline = "base", model;
+  std::vector<std::string> dirs;
+  std::string out = "report", baseline = "base", model;
   std::vector<std::string> where;
   int folds = 6;
 };
@@ -117,10 +119,12 @@ void setup_report(CLI::App& app) {
       "missing effect is searched for (as `gravsweep model rank`) and the winner is added.\n\n"
       "Examples:\n"
       "  gravsweep report ../shared/data/measurements/depth-friction-dev --out report-dev\n"
-      "  gravsweep report campaign.db --out report-sweep    # the drops of `submit` + `work`");
-  sub->add_option("dir", o->dir,
+      "  gravsweep report campaign.db --out report-sweep    # the drops of `submit` + `work`\n"
+      "  gravsweep report data/reproduction/chrono_1g data/reproduction/chrono_0.1g --out r  # both gravity levels");
+  sub->add_option("dir", o->dirs,
                   "campaign database from `submit`/`work` (every finished drop is a trial), SQLite file from "
-                  "`measurements import`, or lab campaign folder")
+                  "`measurements import`, or lab campaign folder; several are read as one campaign (e.g. one "
+                  "exported dataset per gravity level: Figs. 9 and 10 then show both)")
       ->required();
   sub->add_option("--where", o->where, "filter the trials, grammar of `gravsweep results` (e.g. 'gravity_m_s2<1')");
   sub->add_option("--out", o->out, "report folder")->capture_default_str();
@@ -128,10 +132,10 @@ void setup_report(CLI::App& app) {
   sub->add_option("--model", o->model, "the 'after' model (default: baseline + discovered terms)");
   sub->add_option("--folds", o->folds, "cross-validation folds")->check(CLI::Range(2, 100))->capture_default_str();
   sub->callback([o]() {
-    auto in = load_campaign_input(o->dir, o->where);
-    describe_input(o->dir, in);
+    const std::string inputs = fmt::format("{}", fmt::join(o->dirs, " + "));
+    auto in = load_campaign_inputs(o->dirs, o->where);
     const results::Campaign& c = in.campaign;
-    if (c.trials.size() < 6) throw UsageError(fmt::format("{}: only {} usable trials", o->dir, c.trials.size()));
+    if (c.trials.size() < 6) throw UsageError(fmt::format("{}: only {} usable trials", inputs, c.trials.size()));
     results::ModelSpec base, after;
     try {
       base = results::parse_model(o->baseline);
@@ -161,7 +165,7 @@ void setup_report(CLI::App& app) {
     if (rc != 0) throw std::runtime_error("plotting failed (python3 with matplotlib needed): " + log);
     // The same tables in summary.md and index.html.
     namespace fs = std::filesystem;
-    results::HtmlReport page = report_page(o->dir, in, d, cm);
+    results::HtmlReport page = report_page(inputs, in, d, cm);
     std::ofstream md(fs::path(o->out) / "summary.md");
     md << fmt::format("# {}\n\n{}", page.title, page.summary);
     md << fmt::format("{}\n\n", c.issues.empty() ? "" : ":");

@@ -13,6 +13,7 @@
 
 #include "results/measurements/csv.h"
 #include "results_helpers.h"
+#include "tests/common/temp_dir.h"
 
 namespace {
 
@@ -80,6 +81,30 @@ TEST(Reproduction, ModelVerbsReadSeveralDatasetsAsOneCampaign) {
       "model table3 '" + dataset("chrono_1g") + "' '" + dataset("chrono_1g") + "'", true);
   EXPECT_EQ(twice.code, 2) << twice.out;
   EXPECT_NE(twice.out.find("is also in an earlier input"), std::string::npos) << twice.out;
+}
+
+// `report` reads several inputs too: Figs. 9 and 10 of both gravity levels in one report (the
+// trials behind them are those of both datasets).
+TEST(Reproduction, ReportDrawsBothGravityLevelsFromTwoDatasets) {
+  gravsweep::test::TempDir out;
+  const std::string both = "'" + dataset("chrono_1g") + "' '" + dataset("chrono_0.1g") + "'";
+  const auto r = gravsweep::testing::run_gravsweep("report " + both + " --out '" + out.path.string() + "'", true);
+  ASSERT_EQ(r.code, 0) << r.out;
+  for (const char* f : {"fig9_metrics_vs_vc.png", "fig10_zstop_vs_H.png", "index.html"})
+    EXPECT_TRUE(std::filesystem::exists(out.path / f)) << f;
+  std::ifstream trials(out.path / "trials.csv");
+  std::string header, line;
+  std::getline(trials, header);
+  int rows = 0;
+  while (std::getline(trials, line)) ++rows;
+  const auto count = [](const std::string& d) {
+    std::ifstream f(std::filesystem::path(d) / "trials.csv");
+    std::string l;
+    int n = -1;
+    while (std::getline(f, l)) ++n;
+    return n;
+  };
+  EXPECT_EQ(rows, count(dataset("chrono_1g")) + count(dataset("chrono_0.1g"))) << header;
 }
 
 namespace {
