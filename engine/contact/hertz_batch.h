@@ -86,8 +86,8 @@ struct HertzBatch {
     w2z[b] = wj.z();
     E[b] = pc.E_eff_Pa;
     G[b] = pc.G_eff_Pa;
-    damp_n[b] = pc.damping_n;
-    damp_t[b] = pc.damping_t;
+    damp_n[b] = pc.damping_prefactor_n;
+    damp_t[b] = pc.damping_prefactor_t;
     mu_s[b] = pc.mu_static;
     mu_r[b] = pc.mu_rolling;
     mu_t[b] = pc.mu_twisting;
@@ -101,7 +101,7 @@ struct HertzBatch {
     } else {
       sx[b] = sy[b] = sz[b] = 0;
       duration[b] = 0;
-      gate[b] = gate_s(pc.E_eff_Pa, pc.damping_n, ri * rj / (ri + rj), meff);
+      gate[b] = gate_s(pc.E_eff_Pa, pc.damping_prefactor_n, ri * rj / (ri + rj), meff);
       fresh[b] = 1;
     }
   }

@@ -30,8 +30,8 @@ struct HertzChrono {
   /// Caches the damping factors of the pair. Chrono uses the normal COR for both directions:
   /// gn = f sqrt(Sn m*), gt = f sqrt(St m*) = [f sqrt(4 G*/E*)] sqrt(Sn m*) since St/Sn = 4 G*/E*.
   static void prepare(PairCoefficients& c) {
-    c.damping_n = damping_factor(c.cor_normal);
-    c.damping_t = c.damping_n * std::sqrt(4.0 * c.G_eff_Pa / c.E_eff_Pa);
+    c.damping_prefactor_n = damping_factor(c.cor_normal);
+    c.damping_prefactor_t = c.damping_prefactor_n * std::sqrt(4.0 * c.G_eff_Pa / c.E_eff_Pa);
   }
 
   /// Normal spring energy U = integral of (4/3) E* sqrt(R*) d^1.5 = (8/15) E* sqrt(R*) d^2.5,
@@ -87,10 +87,10 @@ struct HertzChrono {
     const double St = 8.0 * c.G_eff_Pa * sqrt_Rd;
     const double kn = (2.0 / 3.0) * Sn;
     const double kt = St;
-    const double damp_n = c.damping_n;
+    const double damp_n = c.damping_prefactor_n;
     const double sqrt_Sn_m = std::sqrt(Sn * g.m_eff_kg);
     const double gn = damp_n * sqrt_Sn_m;
-    const double gt = c.damping_t * sqrt_Sn_m;
+    const double gt = c.damping_prefactor_t * sqrt_Sn_m;
     double Fn = kn * delta - gn * v_n;  // unclamped, as in Chrono
     if (opt.clamp_normal && Fn < 0) Fn = 0;
 

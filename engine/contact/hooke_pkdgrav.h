@@ -28,8 +28,8 @@ struct HookePkdgrav {
 
   /// Caches the damping prefactors; C = prefactor * sqrt(k mu). eps_t = 1 gives C_T = 0.
   static void prepare(PairCoefficients& c) {
-    c.damping_n = damping_prefactor(c.cor_normal);
-    c.damping_t = c.cor_tangential >= 1.0 ? 0.0 : damping_prefactor(c.cor_tangential);
+    c.damping_prefactor_n = damping_prefactor(c.cor_normal);
+    c.damping_prefactor_t = c.cor_tangential >= 1.0 ? 0.0 : damping_prefactor(c.cor_tangential);
   }
 
   /// Normal spring energy U = kN x^2 / 2, evaluated only when energy is tracked.
@@ -89,8 +89,8 @@ struct HookePkdgrav {
     const double u_n = u.dot(n);
     const Vec3 u_T = u - u_n * n;
 
-    const double cN = c.damping_n * std::sqrt(c.kn_N_m * g.m_eff_kg);
-    const double cT = c.damping_t * std::sqrt(c.kt_N_m * g.m_eff_kg);
+    const double cN = c.damping_prefactor_n * std::sqrt(c.kn_N_m * g.m_eff_kg);
+    const double cT = c.damping_prefactor_t * std::sqrt(c.kt_N_m * g.m_eff_kg);
     // Force on body 1: F_N = -kN x n + C_N u_N (no tensile clamp).
     const Vec3 FN1 = -c.kn_N_m * g.overlap_m * n + cN * u_n * n;
 

@@ -28,7 +28,7 @@ ForceFunction select_force_function(std::string_view law, std::string_view rolli
 /// True when the law or the rolling model keeps a FrameHistory per contact (contact.h).
 bool uses_frame_history(std::string_view law, std::string_view rolling);
 
-/// Lets the named law cache its per-pair constants (PairCoefficients::damping_n, damping_t).
+/// Lets the named law cache its per-pair constants (PairCoefficients::damping_prefactor_n, _t).
 void prepare_contact_law(std::string_view law, PairTable& pairs);
 
 /// Runs the named law's parameter and time-step checks.

@@ -50,10 +50,14 @@ struct PairCoefficients {
   double mu_rolling = 0;
   double mu_twisting = 0;
   double shape_beta = 0;
-  /// Law-specific constants derived once per pair by the law's prepare() (e.g. damping factors
-  /// from the restitution coefficients), so the contact loop does no logarithms.
-  double damping_n = 0;
-  double damping_t = 0;
+  /// Dimensionless damping prefactors derived once per pair by the law's prepare() from the
+  /// restitution coefficients, so the contact loop does no logarithms. Both laws damp with
+  /// prefactor x sqrt(stiffness x m*): Hertz (Chrono) gn = damping_prefactor_n sqrt(Sn m*) and
+  /// gt = damping_prefactor_t sqrt(Sn m*) (the sqrt(4 G*/E*) of St/Sn is folded into the
+  /// prefactor); Hooke (pkdgrav) C_N = damping_prefactor_n sqrt(k_N m*), C_T =
+  /// damping_prefactor_t sqrt(k_T m*) (dem-physics.md 1.3, 2.1-2.2).
+  double damping_prefactor_n = 0;
+  double damping_prefactor_t = 0;
 };
 
 /// Symmetric table of PairCoefficients indexed by two material ids.

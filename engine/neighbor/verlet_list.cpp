@@ -18,7 +18,7 @@ constexpr std::size_t kMaxCells = std::size_t{1} << 26;
 
 void VerletList::clear() {
   offset.clear();
-  neighbor_.clear();
+  neighbor.clear();
   history.clear();
   frame_history.clear();
   position_at_build_.clear();
@@ -31,7 +31,7 @@ void VerletList::set_frame_history(bool keep) {
 }
 
 std::size_t VerletList::bytes() const {
-  return offset.capacity() * sizeof(std::uint32_t) + neighbor_.capacity() * sizeof(std::uint32_t) +
+  return offset.capacity() * sizeof(std::uint32_t) + neighbor.capacity() * sizeof(std::uint32_t) +
          history.capacity() * sizeof(ContactHistory) +
          frame_history.capacity() * sizeof(FrameHistory) + position_at_build_.capacity() * sizeof(Vec3) +
          (cell_start_.capacity() + cell_particles_.capacity() + particle_cell_.capacity() +
@@ -50,12 +50,12 @@ void VerletList::remap(const std::vector<long long>& new_index) {
   std::vector<ContactHistory> hist;
   std::vector<FrameHistory> frame;
   std::vector<Vec3> pos;
-  nb.reserve(neighbor_.size());
+  nb.reserve(neighbor.size());
   hist.reserve(history.size());
   for (std::size_t i = 0; i < n_old; ++i) {
     if (new_index[i] < 0) continue;
     for (std::uint32_t k = offset[i]; k < offset[i + 1]; ++k) {
-      const long long j = new_index[neighbor_[k]];
+      const long long j = new_index[neighbor[k]];
       if (j < 0) continue;
       nb.push_back(static_cast<std::uint32_t>(j));  // order kept: new indices are monotone
       hist.push_back(history[k]);
@@ -65,7 +65,7 @@ void VerletList::remap(const std::vector<long long>& new_index) {
     pos.push_back(position_at_build_[i]);
   }
   offset = std::move(off);
-  neighbor_ = std::move(nb);
+  neighbor = std::move(nb);
   history = std::move(hist);
   frame_history = std::move(frame);
   position_at_build_ = std::move(pos);
@@ -236,15 +236,15 @@ void VerletList::build(const Particles& p, double skin_m, int threads) {
     std::uint32_t a = offset[i];
     const std::uint32_t a_end = offset[i + 1];
     for (std::uint32_t b = new_offset[i]; b < new_offset[i + 1] && a < a_end; ++b) {
-      while (a < a_end && neighbor_[a] < new_neighbor[b]) ++a;
-      if (a < a_end && neighbor_[a] == new_neighbor[b]) {
+      while (a < a_end && neighbor[a] < new_neighbor[b]) ++a;
+      if (a < a_end && neighbor[a] == new_neighbor[b]) {
         new_history[b] = history[a];
         if (keep_frame_) new_frame[b] = frame_history[a];
       }
     }
   }
   offset = std::move(new_offset);
-  neighbor_ = std::move(new_neighbor);
+  neighbor = std::move(new_neighbor);
   history = std::move(new_history);
   frame_history = std::move(new_frame);
   position_at_build_ = p.position_m;

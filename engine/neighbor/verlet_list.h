@@ -24,7 +24,7 @@ class VerletList {
   /// True when some particle moved more than skin/2 since the last build (or nothing is built).
   [[nodiscard]] bool needs_rebuild(const Particles& p) const;
 
-  [[nodiscard]] std::size_t pairs() const { return neighbor_.size(); }
+  [[nodiscard]] std::size_t pairs() const { return neighbor.size(); }
   [[nodiscard]] long long builds() const { return builds_; }
   [[nodiscard]] double skin_m() const { return skin_m_; }
   [[nodiscard]] std::size_t bytes() const;
@@ -35,7 +35,7 @@ class VerletList {
 
   // CSR storage: pairs of particle i are [offset[i], offset[i+1]).
   std::vector<std::uint32_t> offset;
-  std::vector<std::uint32_t> neighbor_;
+  std::vector<std::uint32_t> neighbor;
   std::vector<ContactHistory> history;
   /// Beside history, only when frame histories are kept (set_frame_history); else empty.
   std::vector<FrameHistory> frame_history;

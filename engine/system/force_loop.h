@@ -77,7 +77,7 @@ void for_each_touching_pair(ForceContext& c, OverlapFailure& worst, Visit&& visi
   const double* M = p.mass_kg.data();
   const double* inv_m = p.inv_mass_1_kg.data();
   const std::uint32_t* off = c.nlist.offset.data();
-  const std::uint32_t* nbr = c.nlist.neighbor_.data();
+  const std::uint32_t* nbr = c.nlist.neighbor.data();
   ContactHistory* hist = c.nlist.history.data();
 #pragma omp for schedule(static) nowait
   for (std::size_t i = 0; i < n; ++i) {

@@ -280,7 +280,7 @@ int System::contact_count(ParticleIndex i) const {
   const std::size_t n = particles.size();
   for (std::size_t a = 0; a < n; ++a)
     for (std::uint32_t k = nlist_.offset[a]; k < nlist_.offset[a + 1]; ++k)
-      if ((a == i || nlist_.neighbor_[k] == i) && nlist_.history[k].active) ++count;
+      if ((a == i || nlist_.neighbor[k] == i) && nlist_.history[k].active) ++count;
   const std::size_t nw = wall_count_at_build_;
   const auto first = std::lower_bound(wall_candidates_.begin(), wall_candidates_.end(),
                                       static_cast<std::uint32_t>(i * nw));
@@ -294,7 +294,7 @@ std::vector<int> System::contact_counts() const {
   std::vector<int> count(n, 0);
   for (std::size_t a = 0; a + 1 < nlist_.offset.size() && a < n; ++a)
     for (std::uint32_t k = nlist_.offset[a]; k < nlist_.offset[a + 1]; ++k)
-      if (nlist_.history[k].active) ++count[a], ++count[nlist_.neighbor_[k]];
+      if (nlist_.history[k].active) ++count[a], ++count[nlist_.neighbor[k]];
   const std::size_t nw = std::max<std::size_t>(1, wall_count_at_build_);
   for (std::size_t c = 0; c < wall_candidates_.size(); ++c)
     if (wall_history_[c].active && wall_candidates_[c] / nw < n) ++count[wall_candidates_[c] / nw];

@@ -65,6 +65,14 @@ PairOverride pair_from(const json& j) {
   return o;
 }
 
+/// /contact/composition by name (schemas/scenario.schema.json); an unknown name is an error, never
+/// a silent fallback (scenario_params may be handed a scenario the schema did not see).
+Composition composition_of(const std::string& name) {
+  if (name == "explicit_pair") return Composition::explicit_pair;
+  if (name == "chrono_min") return Composition::chrono_min;
+  throw ConfigError(fmt::format("/contact/composition: found \"{}\", expected \"explicit_pair\" or \"chrono_min\"", name));
+}
+
 /// The system configuration common to preparation and drop (dt and gravity set by the caller).
 SystemConfig base_config(const json& s) {
   SystemConfig c;
@@ -72,7 +80,7 @@ SystemConfig base_config(const json& s) {
   c.contact_law = ct.at("law");
   c.rolling_model = ct.at("rolling_model");
   c.integrator = s.at("integrator");
-  c.composition = ct.at("composition") == "chrono_min" ? Composition::chrono_min : Composition::explicit_pair;
+  c.composition = composition_of(ct.at("composition").get<std::string>());
   c.options.clamp_normal = ct.at("clamp_normal");
   const json& m = s.at("materials");
   c.materials.assign(3, Material{});

@@ -62,6 +62,21 @@ TEST(ScenarioSpec, DefaultsAreThePapersChronoSetup) {
   EXPECT_EQ(p.drop_config.rolling_model, "sunday");
 }
 
+// An enum name the schema did not check (a scenario handed straight to scenario_params) is refused
+// with its pointer, never mapped silently to another value (it became explicit_pair before).
+TEST(ScenarioSpec, UnknownCompositionNameIsRefusedNotDefaulted) {
+  json s = validate_scenario(minimal());
+  s["/contact/composition"_json_pointer] = "chrono-min";
+  try {
+    (void)pipeline::scenario_params(s);
+    ADD_FAILURE() << "expected a ConfigError";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("/contact/composition: found \"chrono-min\""), std::string::npos) << e.what();
+  }
+  s["/contact/composition"_json_pointer] = "chrono_min";
+  EXPECT_EQ(pipeline::scenario_params(s).drop_config.composition, Composition::chrono_min);
+}
+
 TEST(ScenarioSpec, OffsetsAreDrawnWithinTheirBoundsFromTheSeed) {
   json s = minimal();
   s["projectile"]["lateral_offset_max_grain_diameters"] = 2;

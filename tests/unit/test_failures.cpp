@@ -113,7 +113,7 @@ TEST(Particles, AppendKeepsHistories) {
   auto pair_duration = [&] {
     const auto& l = s.neighbor_list();
     for (auto k = l.offset[0]; k < l.offset[1]; ++k)
-      if (l.neighbor_[k] == 1) return l.history[k].duration_s;
+      if (l.neighbor[k] == 1) return l.history[k].duration_s;
     return -1.0;
   };
   const double before = pair_duration();

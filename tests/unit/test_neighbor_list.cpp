@@ -23,7 +23,7 @@ Particles random_particles(int n, std::uint64_t seed) {
 std::set<std::pair<std::uint32_t, std::uint32_t>> listed(const VerletList& l) {
   std::set<std::pair<std::uint32_t, std::uint32_t>> s;
   for (std::size_t i = 0; i + 1 < l.offset.size(); ++i)
-    for (auto k = l.offset[i]; k < l.offset[i + 1]; ++k) s.insert({static_cast<std::uint32_t>(i), l.neighbor_[k]});
+    for (auto k = l.offset[i]; k < l.offset[i + 1]; ++k) s.insert({static_cast<std::uint32_t>(i), l.neighbor[k]});
   return s;
 }
 }  // namespace
@@ -55,14 +55,14 @@ TEST(VerletList, HistorySurvivesRebuild) {
   const auto before = listed(l);
   std::map<std::pair<std::uint32_t, std::uint32_t>, double> dur;
   for (std::size_t i = 0; i + 1 < l.offset.size(); ++i)
-    for (auto k = l.offset[i]; k < l.offset[i + 1]; ++k) dur[{static_cast<std::uint32_t>(i), l.neighbor_[k]}] = l.history[k].duration_s;
+    for (auto k = l.offset[i]; k < l.offset[i + 1]; ++k) dur[{static_cast<std::uint32_t>(i), l.neighbor[k]}] = l.history[k].duration_s;
   p.position_m[5] += Vec3(0.01, 0, 0);  // move one grain: some pairs change
   EXPECT_TRUE(l.needs_rebuild(p));
   l.build(p, 0.001, 2);
   int kept = 0;
   for (std::size_t i = 0; i + 1 < l.offset.size(); ++i)
     for (auto k = l.offset[i]; k < l.offset[i + 1]; ++k) {
-      auto it = dur.find({static_cast<std::uint32_t>(i), l.neighbor_[k]});
+      auto it = dur.find({static_cast<std::uint32_t>(i), l.neighbor[k]});
       if (it != dur.end()) {
         EXPECT_TRUE(l.history[k].active);
         EXPECT_EQ(l.history[k].duration_s, it->second);
