@@ -26,7 +26,8 @@ void add_container_walls(System& sys, const ContainerSpec& c, double height_m,
   const double R = 0.5 * c.diameter_m;
   sys.walls.push_back(Wall::disk("bottom", Vec3::Zero(), Vec3::UnitZ(), R, wall_material));
   sys.walls.push_back(Wall::cylinder("side", Vec3::Zero(), Vec3::UnitZ(), R, height_m, wall_material));
-  // A particle centre outside the container (with a margin of one radius) is a numerical failure.
+  // A particle centre outside this box is a numerical failure ("left the container"): the
+  // cylinder's width, 5 % of its radius below the floor, ten container radii above the wall's top.
   sys.mutable_config().domain = Domain{Vec3(-R, -R, -0.05 * R), Vec3(R, R, height_m + 10 * R)};
 }
 
