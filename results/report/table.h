@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "results/measurements/csv.h"
+
 namespace gravsweep::results {
 
 /// &, <, >, " escaped for HTML text and attributes.
@@ -29,11 +31,11 @@ class Table {
   }
   [[nodiscard]] std::string render(const std::string& format) const {
     std::string out;
-    if (format == "csv") {
-      for (std::size_t j = 0; j < cols_.size(); ++j) out += (j ? "," : "") + cols_[j];
+    if (format == "csv") {  // RFC 4180: a field with a comma, a quote or a line break is quoted
+      for (std::size_t j = 0; j < cols_.size(); ++j) out += (j ? "," : "") + csv_field(cols_[j]);
       out += "\n";
       for (const auto& r : rows_) {
-        for (std::size_t j = 0; j < r.size(); ++j) out += (j ? "," : "") + r[j];
+        for (std::size_t j = 0; j < r.size(); ++j) out += (j ? "," : "") + csv_field(r[j]);
         out += "\n";
       }
     } else if (format == "json") {

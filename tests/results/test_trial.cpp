@@ -13,6 +13,7 @@
 #include "results/io/trace_file.h"
 #include "results/measurements/campaign.h"
 #include "results/measurements/csv.h"
+#include "results/report/table.h"
 #include "results_helpers.h"
 
 using namespace gravsweep::results;
@@ -170,6 +171,25 @@ TEST(Csv, Rfc4180QuotingAndAByteOrderMark) {
   CsvReader rb(bad);
   EXPECT_THROW(rb.next(f, line), CsvSyntaxError);
   EXPECT_EQ(csv_field("x, \"y\""), "\"x, \"\"y\"\"\"");
+}
+
+// The verbs' table writer (results/report/table.h) writes CSV that the reader reads back: a comma
+// or a quote in a value does not shift the columns (it wrote them bare before).
+TEST(Csv, TableWriterQuotesCommasAndQuotesAndReadsBack) {
+  Table t({"trial_id", "note"});
+  t.add({"T1", "rebound, then rest"});
+  t.add({"T \"2\"", "plain"});
+  std::istringstream in(t.render("csv"));
+  CsvReader r(in);
+  std::vector<std::string> f;
+  int line = 0;
+  ASSERT_TRUE(r.next(f, line));
+  EXPECT_EQ(f, (std::vector<std::string>{"trial_id", "note"}));
+  ASSERT_TRUE(r.next(f, line));
+  EXPECT_EQ(f, (std::vector<std::string>{"T1", "rebound, then rest"}));
+  ASSERT_TRUE(r.next(f, line));
+  EXPECT_EQ(f, (std::vector<std::string>{"T \"2\"", "plain"}));
+  EXPECT_FALSE(r.next(f, line));
 }
 
 TEST(LabCampaign, TrialsCsvWithBomAndQuotedNumbersIsRead) {
