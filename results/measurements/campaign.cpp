@@ -9,7 +9,7 @@
 #include <set>
 #include <stdexcept>
 
-#include "db/sqlite.h"
+#include "db/database.h"
 
 namespace gravsweep::results {
 

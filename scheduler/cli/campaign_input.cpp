@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <set>
 
-#include "db/sqlite.h"
+#include "db/database.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/queue/filter.h"
 #include "scheduler/queue/queue.h"

@@ -33,6 +33,8 @@ constexpr SetupFn kVerbs[] = {
     &gravsweep::cli::setup_plot,
     &gravsweep::cli::setup_export,
     &gravsweep::cli::setup_bench_queue,
+    &gravsweep::cli::setup_campaign,
+    &gravsweep::cli::setup_slurm,
 };
 
 }  // namespace

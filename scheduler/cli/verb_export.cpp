@@ -21,6 +21,7 @@
 #include "results/measurements/trial.h"
 #include "results/processing/resample.h"
 #include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/filter.h"
@@ -36,6 +37,7 @@ using nlohmann::json;
 
 struct ExportOptions {
   std::string db = "campaign.db";
+  std::string files;
   std::string out;
   std::vector<std::string> where;
   std::string sweep;
@@ -124,8 +126,8 @@ void write_text_file(const fs::path& p, const std::string& text) {
 void run_export(const ExportOptions& o) {
   if (!fs::exists(o.db)) throw UsageError(fmt::format("--db: no campaign database at '{}'", o.db));
   if (!(o.rate_hz > 0)) throw UsageError(fmt::format("--rate-hz: expected a rate > 0 Hz, found {}", o.rate_hz));
-  db::Database db = queue::open_campaign(o.db, queue::OpenMode::read);  // refuses a non-campaign
-  const queue::CampaignPaths paths(o.db);
+  db::Database db = queue::open_campaign(o.db, queue::OpenMode::read, o.files);  // refuses a non-campaign
+  const queue::CampaignPaths paths(o.db, o.files);
   queue::ResultsTable t;
   try {
     t = queue::query_results(db, queue::ResultsQuery{o.where, {}, o.sweep, "sweep", -1});
@@ -183,7 +185,7 @@ void setup_export(CLI::App& app) {
       "measurements import` and `gravsweep model ...` read.\n\n"
       "Example:\n"
       "  gravsweep export --db paper.db --out data/reproduction --sweep part1_chrono_1g");
-  sub->add_option("--db", o->db, "campaign database")->capture_default_str();
+  add_campaign_options(sub, o->db, &o->files);
   sub->add_option("--out", o->out, "folder to write")->required();
   sub->add_option("--where", o->where, "filter, e.g. 'gravity_m_s2<1' (repeatable)");
   sub->add_option("--sweep", o->sweep, "only this sweep");

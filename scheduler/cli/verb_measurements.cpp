@@ -14,7 +14,7 @@
 #include "scheduler/cli/campaign_input.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
-#include "db/sqlite.h"
+#include "db/database.h"
 
 namespace gravsweep::cli {
 

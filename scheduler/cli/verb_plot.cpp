@@ -16,6 +16,7 @@
 #include "results/report/figures.h"
 #include "results/report/report.h"
 #include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/filter.h"
@@ -107,7 +108,7 @@ void setup_plot(CLI::App& app) {
       "Examples:\n"
       "  gravsweep plot results --db paper.db --sweep part3_fill_height --x fill_height_m --y zstop_m --out fig3.png\n"
       "  gravsweep plot results --db paper.db --x vc_m_s --y apeak_m_s2 --group gravity_m_s2 --out fig9a.png");
-  res->add_option("--db", o->db, "campaign database")->capture_default_str();
+  add_campaign_options(res, o->db, nullptr);
   res->add_option("--x", o->x, "column on the horizontal axis (e.g. fill_height_m)")->required();
   res->add_option("--y", o->y, "column on the vertical axis (e.g. zstop_m)")->required();
   res->add_option("--group", o->group, "one series per value of this column (e.g. gravity_m_s2)");

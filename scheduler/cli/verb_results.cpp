@@ -11,6 +11,7 @@
 
 #include "results/measurements/trial.h"
 #include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/filter.h"
 #include "scheduler/queue/campaign.h"
@@ -249,7 +250,7 @@ void setup_results(CLI::App& app) {
       "the number of rows and each metric's mean, sample standard deviation and count of values (the\n"
       "paper's error bars over repeats); the table shows vc, apeak, zstop and tstop unless --all or\n"
       "--columns names the metrics; CSV and JSON carry every numeric metric.");
-  sub->add_option("--db", opt->db, "campaign database")->capture_default_str();
+  add_campaign_options(sub, opt->db, nullptr);
   sub->add_option("--where", opt->where, "filter, e.g. 'gravity_m_s2<1' (repeatable)");
   sub->add_option("--columns", opt->columns, "columns to show, comma separated")->delimiter(',');
   sub->add_option("--sweep", opt->sweep, "only this sweep");

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
@@ -16,6 +17,7 @@ namespace {
 
 struct ResumeCliOptions {
   std::string db = "campaign.db";
+  std::string files;
   bool dead = false;
   int extra_attempts = 1;
   bool keep_orphans = false;
@@ -23,13 +25,13 @@ struct ResumeCliOptions {
 };
 
 void run_resume(const ResumeCliOptions& o) {
-  db::Database db = queue::open_campaign(o.db, queue::OpenMode::write);
+  db::Database db = queue::open_campaign(o.db, queue::OpenMode::write, o.files);
   queue::ResumeOptions r;
   r.retry_dead = o.dead;
   r.extra_attempts = o.extra_attempts;
   r.remove_orphans = !o.keep_orphans;
   r.dry_run = o.dry_run;
-  const auto rep = queue::resume(db, queue::CampaignPaths(o.db), r);
+  const auto rep = queue::resume(db, queue::CampaignPaths(o.db, o.files), r);
   fmt::print("expired leases: {} requeued{}, {} dead (retry budget spent)\n", rep.expired_requeued,
              o.dry_run ? " (dry run)" : "", rep.expired_dead);
   fmt::print("failed jobs requeued without waiting for their backoff: {}\n", rep.failed_requeued);
@@ -61,7 +63,7 @@ void setup_resume(CLI::App& app) {
       "  gravsweep resume --db campaign.db\n"
       "  gravsweep resume --db campaign.db --dead --extra-attempts 2   # also retry dead jobs\n"
       "  gravsweep resume --db campaign.db --dry-run");
-  sub->add_option("--db", opt->db, "campaign database")->capture_default_str();
+  add_campaign_options(sub, opt->db, &opt->files);
   sub->add_flag("--dead", opt->dead, "also requeue dead jobs (and the drops waiting on a dead bed)");
   sub->add_option("--extra-attempts", opt->extra_attempts, "attempts added to a dead job's budget")->check(CLI::Range(1, 100))->capture_default_str();
   sub->add_flag("--keep-orphans", opt->keep_orphans, "do not look for orphaned files (nor check that the folder belongs to the database)");

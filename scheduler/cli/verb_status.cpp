@@ -10,6 +10,7 @@
 #include "scheduler/pipeline/build_version.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/progress.h"
+#include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
@@ -131,11 +132,18 @@ void run_status(const StatusOptions& o) {
       if (o.watch_s > 0) fmt::print("\x1b[H\x1b[2J");
       fmt::print("{}", render_status(s, o.db, secs));
       // Provenance: results from another build of gravsweep (like Snakemake's code rerun trigger).
-      db::Statement other(db, "SELECT count(*), group_concat(DISTINCT code_version) FROM results WHERE code_version != ?");
+      db::Statement other(db, "SELECT code_version, count(*) FROM results WHERE code_version <> ? GROUP BY code_version "
+                              "ORDER BY code_version");
       other.bind(1, std::string(pipeline::build_version()));
-      if (other.step() && other.get_int(0) > 0)
-        fmt::print("{} result(s) were computed by another code version ({}); this is {}\n", other.get_int(0),
-                   other.get_text(1), pipeline::build_version());
+      std::int64_t n_other = 0;
+      std::string versions;
+      while (other.step()) {
+        n_other += other.get_int(1);
+        versions += (versions.empty() ? "" : ",") + other.get_text(0);
+      }
+      if (n_other > 0)
+        fmt::print("{} result(s) were computed by another code version ({}); this is {}\n", n_other, versions,
+                   pipeline::build_version());
     }
     std::fflush(stdout);
     if (o.watch_s <= 0) break;
@@ -159,7 +167,7 @@ void setup_status(CLI::App& app) {
       "  gravsweep status --db campaign.db\n"
       "  gravsweep status --db campaign.db --watch 2        # refresh every 2 s\n"
       "  gravsweep status --db campaign.db --format json");
-  sub->add_option("--db", opt->db, "campaign database")->capture_default_str();
+  add_campaign_options(sub, opt->db, nullptr);
   sub->add_option("--format", opt->format, "table or json")->check(CLI::IsMember({"table", "json"}))->capture_default_str();
   sub->add_option("--max-running", opt->max_running, "running jobs listed at most")->capture_default_str();
   sub->add_option("--watch", opt->watch_s, "refresh every this many seconds (0: once)")->capture_default_str();

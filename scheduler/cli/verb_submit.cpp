@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/impact.h"
 #include "scheduler/queue/campaign.h"
@@ -21,6 +22,7 @@ namespace {
 struct SubmitOptions {
   std::vector<std::string> specs;
   std::string db = "campaign.db";
+  std::string files;
   bool dry_run = false;
 };
 
@@ -45,20 +47,20 @@ void run_submit(const SubmitOptions& o) {
   if (o.dry_run) {
     for (const auto& p : planned) {
       std::size_t beds = 0;
-      for (const auto& j : p.jobs) beds += j.kind == "bed";
+      for (const auto& j : p.jobs) beds += j.kind == queue::JobKind::bed;
       fmt::print("sweep {}: {} points -> {} jobs ({} bed, {} {}) [dry run: nothing written]\n", p.spec.name,
                  p.spec.points(), p.jobs.size(), beds, p.jobs.size() - beds,
                  p.spec.job_kind == "noop" ? "noop" : "drop");
     }
     return;
   }
-  db::Database db = queue::open_campaign(o.db, queue::OpenMode::create);
+  db::Database db = queue::open_campaign(o.db, queue::OpenMode::create, o.files);
   for (const auto& p : planned) {
     const auto r = queue::submit(db, p.spec, p.jobs);
     fmt::print("sweep {} ({}): {} jobs planned ({} bed, {} {}): {} new, {} already present\n", r.sweep,
                r.sweep_new ? "new sweep" : "existing sweep", r.planned,
-               std::count_if(p.jobs.begin(), p.jobs.end(), [](const auto& j) { return j.kind == "bed"; }),
-               std::count_if(p.jobs.begin(), p.jobs.end(), [](const auto& j) { return j.kind != "bed"; }),
+               std::count_if(p.jobs.begin(), p.jobs.end(), [](const auto& j) { return j.kind == queue::JobKind::bed; }),
+               std::count_if(p.jobs.begin(), p.jobs.end(), [](const auto& j) { return j.kind != queue::JobKind::bed; }),
                p.spec.job_kind == "noop" ? "noop" : "drop", r.added, r.present);
   }
 }
@@ -79,7 +81,7 @@ void setup_submit(CLI::App& app) {
       "  gravsweep submit a.json b.json --db campaign.db      # a campaign may hold several sweeps\n"
       "  gravsweep submit spec.json --dry-run                 # validate and count, write nothing");
   sub->add_option("specs", opt->specs, "sweep spec files (JSON)")->required()->check(CLI::ExistingFile);
-  sub->add_option("--db", opt->db, "campaign database (created if missing)")->capture_default_str();
+  add_campaign_options(sub, opt->db, &opt->files, "campaign database (created if missing)");
   sub->add_flag("--dry-run", opt->dry_run, "validate and expand only; write nothing");
   sub->callback([opt]() { run_submit(*opt); });
 }

@@ -15,6 +15,7 @@
 
 #include "scheduler/pipeline/build_version.h"
 #include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/impact.h"
 #include "scheduler/queue/campaign.h"
@@ -28,6 +29,7 @@ namespace {
 
 struct WorkOptions {
   std::string db = "campaign.db";
+  std::string files;
   int workers = 1;
   int threads = 0;
   int pool_threads = 0;  ///< set by the supervisor for its workers (0: --threads)
@@ -55,6 +57,7 @@ int supervise(const WorkOptions& o, int threads) {
                                    "--pool-threads", std::to_string(threads * o.workers),
                                    "--lease", fmt::format("{}", o.lease_s), "--poll", fmt::format("{}", o.poll_s),
                                    "--backoff", fmt::format("{}", o.backoff_s)};
+  if (!o.files.empty()) args.insert(args.end(), {"--files", o.files});
   if (o.heartbeat_s > 0) args.insert(args.end(), {"--heartbeat", fmt::format("{}", o.heartbeat_s)});
   if (o.follow) args.push_back("--follow");
   if (!o.bed_cache.empty()) args.insert(args.end(), {"--bed-cache", o.bed_cache});
@@ -129,7 +132,7 @@ int supervise(const WorkOptions& o, int threads) {
 
 int run_work(const WorkOptions& o) {
   // Refuses what is not a campaign before any worker starts (migrates a version-1 campaign).
-  { db::Database db = queue::open_campaign(o.db, queue::OpenMode::write); }
+  { db::Database db = queue::open_campaign(o.db, queue::OpenMode::write, o.files); }
   if (o.heartbeat_s > 0 && o.heartbeat_s * 2 > o.lease_s)
     throw UsageError(fmt::format("--heartbeat: found {} s, expected at most half of --lease ({} s), or the lease "
                                  "lapses between heartbeats",
@@ -140,6 +143,7 @@ int run_work(const WorkOptions& o) {
   queue::install_stop_signals();
   queue::WorkerOptions w;
   w.db_path = o.db;
+  w.files = o.files;
   w.threads = threads;
   w.pool_threads = std::max(threads, o.pool_threads);
   w.lease_s = o.lease_s;
@@ -165,7 +169,7 @@ void setup_work(CLI::App& app) {
   auto opt = std::make_shared<WorkOptions>();
   auto* sub = app.add_subcommand(
       "work",
-      "Run the campaign's jobs: starts --workers worker processes (one SQLite connection each) that\n"
+      "Run the campaign's jobs: starts --workers worker processes (one database connection each) that\n"
       "claim jobs (bed preparation before the drops that need it), renew their lease with a\n"
       "heartbeat carrying progress, and record each result with its trace path and checksum. They\n"
       "stop when no job is left (--follow: keep waiting for new ones). A worker killed in any way\n"
@@ -175,8 +179,9 @@ void setup_work(CLI::App& app) {
       "threads of all the workers (--workers x --threads), so no core idles while it runs.\n\n"
       "Examples:\n"
       "  gravsweep work --db campaign.db --workers 2 --threads 1\n"
-      "  gravsweep work --db campaign.db --follow          # a worker that waits for new submissions");
-  sub->add_option("--db", opt->db, "campaign database")->capture_default_str();
+      "  gravsweep work --db campaign.db --follow          # a worker that waits for new submissions\n"
+      "  gravsweep work --db postgresql://me@dbhost:5432/sweep --files /shared/sweep --threads 4");
+  add_campaign_options(sub, opt->db, &opt->files);
   sub->add_option("--workers", opt->workers, "worker processes")->check(CLI::Range(1, 256))->capture_default_str();
   sub->add_option("--threads", opt->threads, "engine threads per worker (0: cores / workers)")->check(CLI::Range(0, 1024))->capture_default_str();
   sub->add_option("--pool-threads", opt->pool_threads,

@@ -21,5 +21,7 @@ void setup_bench_queue(CLI::App& app);
 void setup_pile(CLI::App& app);
 void setup_plot(CLI::App& app);
 void setup_export(CLI::App& app);
+void setup_campaign(CLI::App& app);
+void setup_slurm(CLI::App& app);
 
 }  // namespace gravsweep::cli

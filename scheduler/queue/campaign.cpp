@@ -4,7 +4,10 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <optional>
+
 #include "engine/core/error.h"
+#include "scheduler/queue/dialect.h"
 #include "scheduler/queue/queue.h"
 
 namespace gravsweep::queue {
@@ -16,19 +19,16 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kFileDirs[] = {"beds", "traces", "noop", "tmp"};
+constexpr const char* kQueueTables = "'queue_meta','jobs','attempts','results'";
 
 /// Number of the queue's tables present (queue_meta, jobs, attempts, results), read without
 /// writing anything to the file.
 int queue_tables(const std::string& path) {
   try {
     Database probe(path, 30000, /*read_only=*/true);
-    Statement st(probe, "SELECT count(*) FROM sqlite_master WHERE type='table' AND "
-                        "name IN ('queue_meta','jobs','attempts','results')");
-    st.step();
-    return static_cast<int>(st.get_int(0));
+    return dialect_of(probe).tables_present(probe, kQueueTables);
   } catch (const db::DbError& e) {
-    if (e.code() == SQLITE_NOTADB || e.code() == SQLITE_CORRUPT)
+    if (e.not_a_database())
       throw ConfigError(fmt::format("'{}' is not a gravsweep campaign: not a SQLite database ({})", path, e.what()));
     throw;
   }
@@ -60,7 +60,7 @@ void purge_quarantine(Database& db, const CampaignPaths& paths, OrphanReport& re
   if (!fs::is_directory(qroot, ec)) return;
   const Referenced ref = referenced_files(db);
   for (const auto& batch : fs::directory_iterator(qroot, ec)) {
-    for (const char* dir : kFileDirs) {
+    for (const char* dir : kOutputFolders) {
       const fs::path d = batch.path() / dir;
       if (!fs::is_directory(d, ec)) continue;
       for (const auto& e : fs::directory_iterator(d, ec)) {
@@ -75,6 +75,19 @@ void purge_quarantine(Database& db, const CampaignPaths& paths, OrphanReport& re
       }
     }
     fs::remove_all(batch.path(), ec);
+  }
+}
+
+/// The schema of a campaign just opened: created (create), checked, and migrated (write).
+void prepare_opened(Database& db, OpenMode mode) {
+  if (mode == OpenMode::create) {
+    ensure_schema(db);
+    return;
+  }
+  check_campaign(db);
+  if (mode == OpenMode::write) {
+    migrate_paths(db);
+    add_missing_columns(db);
   }
 }
 
@@ -142,18 +155,33 @@ void migrate_paths(Database& db) {
   tx.commit();
 }
 
-Database open_campaign(const fs::path& db_path, OpenMode mode) {
+Database open_campaign(const fs::path& db_path, OpenMode mode, const fs::path& files_root) {
   const std::string name = db_path.string();
-  const CampaignPaths paths(db_path);
+  const bool server = db::is_postgres_url(name);
+  // Reading a server campaign needs no files root (status, results); everything else does.
+  std::optional<CampaignPaths> paths;
+  if (!server || !files_root.empty() || mode != OpenMode::read) paths.emplace(db_path, files_root);
   std::error_code ec;
   if (fs::is_directory(db_path, ec))
     throw ConfigError(fmt::format("--db '{}': is a directory, expected a campaign database file", name));
-  const std::size_t files = count_files(paths.root);
+  const std::size_t files = paths ? count_files(paths->root) : 0;
   const std::string beside =
-      files > 0 ? fmt::format(" next to '{}' holding {} file(s)", paths.root.string(), files) : std::string();
+      files > 0 ? fmt::format(" next to '{}' holding {} file(s)", paths->root.string(), files) : std::string();
   const std::string keep = files > 0 ? "; refusing to start a new campaign over another one's outputs (restore the "
                                        "database from a backup, or move the folder away); nothing was changed"
                                      : "";
+  const auto refuse_tables = [&](int tables) {
+    if ((tables == 0 && (mode != OpenMode::create || files > 0)) || (tables > 0 && tables < 4))
+      throw ConfigError(fmt::format("'{}' is not a gravsweep campaign: {} of the job queue's 4 tables (queue_meta, "
+                                    "jobs, attempts, results) found{}{}",
+                                    name, tables, beside, keep));
+  };
+  if (server) {
+    Database db(name, 30000, mode == OpenMode::read);
+    refuse_tables(dialect_of(db).tables_present(db, kQueueTables));
+    prepare_opened(db, mode);
+    return db;
+  }
   if (!fs::exists(db_path, ec)) {
     if (mode != OpenMode::create || files > 0)
       throw ConfigError(fmt::format("--db: no campaign database at '{}'{}{}", name, beside,
@@ -163,19 +191,10 @@ Database open_campaign(const fs::path& db_path, OpenMode mode) {
       throw ConfigError(fmt::format("'{}' is not a gravsweep campaign: the file is empty (0 bytes){}{}", name, beside,
                                     keep));
   } else {
-    const int tables = queue_tables(name);
-    if ((tables == 0 && (mode != OpenMode::create || files > 0)) || (tables > 0 && tables < 4))
-      throw ConfigError(fmt::format("'{}' is not a gravsweep campaign: {} of the job queue's 4 tables (queue_meta, "
-                                    "jobs, attempts, results) found{}{}",
-                                    name, tables, beside, keep));
+    refuse_tables(queue_tables(name));
   }
   Database db(name);
-  if (mode == OpenMode::create) {
-    ensure_schema(db);
-  } else {
-    check_campaign(db);
-    if (mode == OpenMode::write) migrate_paths(db);
-  }
+  prepare_opened(db, mode);
   return db;
 }
 
@@ -234,7 +253,7 @@ OrphanReport quarantine_orphans(Database& db, const CampaignPaths& paths, bool d
   };
   std::vector<Candidate> found;
   std::error_code ec;
-  for (const char* dir : kFileDirs) {
+  for (const char* dir : kOutputFolders) {
     const fs::path d = paths.root / dir;
     if (!fs::is_directory(d, ec)) continue;
     for (const auto& e : fs::directory_iterator(d, ec))

@@ -11,7 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "db/sqlite.h"
+#include "db/database.h"
+#include "scheduler/queue/job_types.h"
 
 namespace gravsweep::queue {
 
@@ -24,11 +25,13 @@ enum class OpenMode {
   create,  ///< submit: a missing or new database gets the schema
 };
 
-/// Opens the campaign database at `db_path`, refusing (ConfigError, exit 2, naming the file) a
+/// Opens the campaign database at `db_path` (a file, or a `postgresql://` URL: then `files_root`
+/// must be given), refusing (ConfigError, exit 2, naming the file) a
 /// file that is not a campaign: missing (except for `create`), empty, not SQLite, or without the
 /// queue tables. `create` also refuses a missing or empty database beside a files folder that
 /// holds files (the database was lost or truncated: a new schema would orphan every output).
-db::Database open_campaign(const std::filesystem::path& db_path, OpenMode mode);
+db::Database open_campaign(const std::filesystem::path& db_path, OpenMode mode,
+                           const std::filesystem::path& files_root = {});
 
 /// Throws ConfigError unless `db` holds the queue tables with a known schema version.
 void check_campaign(db::Database& db);
@@ -39,6 +42,10 @@ std::string files_rel(const std::string& stored);
 
 /// Rewrites version-1 paths to `files_rel` form and sets schema version 2 (in one transaction).
 void migrate_paths(db::Database& db);
+
+/// Adds the columns a campaign written by an earlier gravsweep lacks (jobs.blocked_by, filled from
+/// the earlier message form once), in one transaction. Schema version 2 either way.
+void add_missing_columns(db::Database& db);
 
 /// Regular files under `dir`, recursively (0 when it does not exist).
 std::size_t count_files(const std::filesystem::path& dir);

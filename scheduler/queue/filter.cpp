@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cstdlib>
 
+#include "scheduler/queue/dialect.h"
 #include "scheduler/queue/queue.h"
 
 namespace gravsweep::queue {
@@ -148,7 +149,7 @@ ResultsTable query_results(db::Database& db, const ResultsQuery& q) {
     check(q.order_by, "--sort");
     sql += " ORDER BY " + quote_ident(q.order_by);
   } else {
-    sql += " ORDER BY sweep, rowid";
+    sql += std::string(" ORDER BY sweep, ") + dialect_of(db).insertion_order();
   }
   if (q.limit >= 0) sql += " LIMIT " + std::to_string(q.limit);  // an integer, not user text
   db::Statement st(db, sql);
@@ -164,9 +165,9 @@ ResultsTable query_results(db::Database& db, const ResultsQuery& q) {
     std::vector<json> row;
     for (int c = 0; c < st.columns(); ++c) {
       switch (st.column_type(c)) {
-        case SQLITE_NULL: row.emplace_back(nullptr); break;
-        case SQLITE_INTEGER: row.emplace_back(st.get_int(c)); break;
-        case SQLITE_FLOAT: row.emplace_back(st.get_double(c)); break;
+        case db::ColumnType::null: row.emplace_back(nullptr); break;
+        case db::ColumnType::integer: row.emplace_back(st.get_int(c)); break;
+        case db::ColumnType::real: row.emplace_back(st.get_double(c)); break;
         default: row.emplace_back(st.get_text(c));
       }
     }

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "db/sqlite.h"
+#include "db/database.h"
 
 namespace gravsweep::queue {
 

@@ -24,7 +24,7 @@ sweep::BedKeyFn impact_bed_key() {
 
 void add_impact_runners(RunnerTable& table) {
 #if GRAVSWEEP_HAVE_PIPELINE
-  table["bed"] = [](const RunContext& ctx) {
+  table[JobKind::bed] = [](const RunContext& ctx) {
     RunOutput out;
     if (!ctx.bed_cache.empty()) {
       if (auto cached = pipeline::take_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.claim.scenario, ctx.output_tmp)) {
@@ -38,7 +38,7 @@ void add_impact_runners(RunnerTable& table) {
     out.report = r.report;
     return out;
   };
-  table["drop"] = [](const RunContext& ctx) {
+  table[JobKind::drop] = [](const RunContext& ctx) {
     if (ctx.bed_path.empty())
       throw std::runtime_error(fmt::format("drop job {} has no prepared bed", ctx.claim.job_id));
     auto r = pipeline::run_drop_job(ctx.claim.scenario, ctx.bed_path, ctx.output_tmp, ctx.threads, ctx.progress,
@@ -63,7 +63,7 @@ void add_impact_runners(RunnerTable& table) {
 
 RunnerTable all_runners() {
   RunnerTable t;
-  t["noop"] = noop_runner();
+  t[JobKind::noop] = noop_runner();
   add_impact_runners(t);
   return t;
 }

@@ -17,29 +17,35 @@
 #include <string>
 #include <vector>
 
-#include "db/sqlite.h"
+#include "db/database.h"
+#include "scheduler/queue/job_types.h"
 #include "scheduler/sweep/spec.h"
 
 namespace gravsweep::queue {
 
 inline constexpr int kSchemaVersion = 2;  ///< 2: stored paths relative to the files root
 
-/// Wall-clock seconds since the Unix epoch.
+/// Wall-clock seconds since the Unix epoch, on this host.
 double now_s();
+/// Seconds since the Unix epoch on the clock the campaign's leases use: the database server's for
+/// PostgreSQL, this host's for SQLite (scheduler/queue/dialect.h).
+double clock_s(db::Database& db);
 
 /// Creates the queue tables if missing (idempotent); checks the schema version and migrates a
 /// version-1 campaign. Only `submit` (through open_campaign(create)) and tests call it: other verbs
 /// open with open_campaign (scheduler/queue/campaign.h), which never creates a schema.
 void ensure_schema(db::Database& db);
 
-/// Where a campaign keeps its files: <db dir>/<db stem>.files/{beds,traces,noop,tmp,quarantine}.
+/// Where a campaign keeps its files, {beds,traces,noop,tmp,quarantine}/ under the files root:
+/// `files_root` when given, else <db dir>/<db stem>.files/ beside an SQLite file. A PostgreSQL
+/// campaign needs it given (ConfigError otherwise): the folder every worker node mounts at the
+/// same path.
 struct CampaignPaths {
-  std::filesystem::path db_dir;
   std::filesystem::path root;  ///< paths in the database are relative to this (schema version 2)
-  explicit CampaignPaths(const std::filesystem::path& db_path);
+  explicit CampaignPaths(const std::filesystem::path& db_path, const std::filesystem::path& files_root = {});
   [[nodiscard]] std::filesystem::path tmp() const { return root / "tmp"; }
   /// Path, relative to the files root, of the output of attempt `attempt` of job `job_id` of `kind`.
-  [[nodiscard]] std::string output_rel(const std::string& kind, const std::string& job_id, int attempt) const;
+  [[nodiscard]] std::string output_rel(JobKind kind, const std::string& job_id, int attempt) const;
   /// The file of a stored path (version-1 forms `<stem>.files/...` are read as relative to root).
   [[nodiscard]] std::filesystem::path abs(const std::string& rel) const;
 };
@@ -70,7 +76,8 @@ struct WorkerIdentity {
 WorkerIdentity make_identity(const std::string& code_version, int threads);
 
 struct Claim {
-  std::string job_id, kind, sweep_id;
+  std::string job_id, sweep_id;
+  JobKind kind = JobKind::noop;
   nlohmann::json scenario, params;
   int attempt = 0;                 ///< 1-based attempt number of this claim
   std::int64_t token = 0;          ///< fencing token
@@ -177,7 +184,7 @@ struct Status {
   std::vector<RunningJob> running;
   std::vector<KindRuntime> runtimes;
   std::int64_t stale_leases = 0;
-  std::int64_t blocked = 0;       ///< waiting on a dead dependency
+  std::int64_t blocked = 0;       ///< dead because a dependency is dead (jobs.blocked_by)
   std::int64_t active_workers = 0;
   double eta_s = -1;              ///< < 0: unknown (no finished job of some remaining kind)
   std::vector<std::pair<std::string, std::string>> recent_errors;  ///< (job_id, error) of dead jobs

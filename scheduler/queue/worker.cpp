@@ -165,12 +165,12 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
   WorkerReport rep;
   db::Database db(o.db_path.string());
   check_campaign(db);  // never creates a schema: `work` opened the campaign with open_campaign
-  const CampaignPaths paths(o.db_path);
+  const CampaignPaths paths(o.db_path, o.files);
   const WorkerIdentity who = make_identity(o.code_version, o.threads);
   // Renew at least 4 times per lease, and report progress at least every 2 s.
   const double hb = o.heartbeat_s > 0 ? o.heartbeat_s : std::min(o.lease_s / 4, 2.0);
   std::error_code ec;
-  for (const char* d : {"beds", "traces", "noop", "tmp"}) fs::create_directories(paths.root / d, ec);
+  for (const char* d : kOutputFolders) fs::create_directories(paths.root / d, ec);
   std::unique_ptr<db::Database> beat_db;  // the heartbeat thread's own connection, kept across jobs
   long ran = 0;
   while (!g_stop.load() && (o.max_jobs < 0 || ran < o.max_jobs)) {
@@ -202,7 +202,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     }
     ++ran;
     const auto runner = runners.find(c->kind);
-    const std::string ext = c->kind == "noop" ? ".json" : ".h5";
+    const std::string ext = kind_info(c->kind).extension;
     const std::string prefix = fmt::format("{}.a{}.", c->job_id, c->attempt);
     const fs::path tmp = paths.tmp() / (prefix + "out" + ext);
     JobSignals sig;
@@ -221,7 +221,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     bool permanent = false;
     const auto t0 = std::chrono::steady_clock::now();
     if (o.verbose)
-      std::fprintf(stderr, "worker %d: %s job %s attempt %d\n", who.pid, c->kind.c_str(), c->job_id.c_str(), c->attempt);
+      std::fprintf(stderr, "worker %d: %s job %s attempt %d\n", who.pid, kind_name(c->kind), c->job_id.c_str(), c->attempt);
     if (!c->dep_output_rel.empty() && !c->dep_sha256.empty()) {
       // The bed is verified before the drop uses it: a changed bit changes every drop's results.
       const fs::path bed = paths.abs(c->dep_output_rel);
@@ -247,7 +247,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     }
     try {
       if (runner == runners.end())
-        throw ConfigError(fmt::format("job {}: no runner for kind '{}' in this build", c->job_id, c->kind));
+        throw ConfigError(fmt::format("job {}: no runner for kind '{}' in this build", c->job_id, kind_name(c->kind)));
       RunContext ctx{*c, tmp, c->dep_output_rel.empty() ? fs::path() : paths.abs(c->dep_output_rel), threads,
                      [&sig](const std::string& phase, double f, const std::string& detail) {
                        std::lock_guard g(sig.m);

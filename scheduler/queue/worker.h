@@ -35,14 +35,15 @@ struct RunOutput {
 /// Runs one job; throws on failure (gravsweep::ConfigError and NumericalFailure are permanent:
 /// the job goes dead at once; anything else is retried with backoff).
 using Runner = std::function<RunOutput(const RunContext&)>;
-using RunnerTable = std::map<std::string, Runner>;
+using RunnerTable = std::map<JobKind, Runner>;
 
 /// "noop" jobs, for the scheduler's own benchmark and tests: scenario fields sleep_s (default 0),
 /// fail_attempts (attempts up to this number throw), value (echoed as metric noop_value).
 Runner noop_runner();
 
 struct WorkerOptions {
-  std::filesystem::path db_path;
+  std::filesystem::path db_path;  ///< an SQLite file or a postgresql:// URL
+  std::filesystem::path files;    ///< the files root (empty: beside the SQLite file)
   int threads = 1;
   /// Threads all the workers of this campaign hold together (workers x threads): a bed job that
   /// runs alone gets them all (threads_for_claim). At most `threads` when there is one worker.

@@ -528,13 +528,13 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
         problems.push_back({np.pointer, np.found + " at point " + job.params.dump(), np.expected});
         repeats.push_back(0);
       }
-      job.kind = "noop";
-      job.job_id = job_id("noop", job.scenario);
+      job.kind = queue::JobKind::noop;
+      job.job_id = job_id(queue::kind_name(job.kind), job.scenario);
       drops.push_back(std::move(job));
       continue;
     }
-    job.kind = "drop";
-    job.job_id = job_id("drop", job.scenario);
+    job.kind = queue::JobKind::drop;
+    job.job_id = job_id(queue::kind_name(job.kind), job.scenario);
     json key;
     try {
       if (!bed_key) throw std::runtime_error("no bed key function (the impact pipeline is not built in)");
@@ -567,11 +567,11 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
       }
       continue;
     }
-    const std::string bed_id = job_id("bed", key);
+    const std::string bed_id = job_id(queue::kind_name(queue::JobKind::bed), key);
     auto [it, inserted] = bed_index.emplace(bed_id, beds.size());
     if (inserted) {
       PlannedJob bed;
-      bed.kind = "bed";
+      bed.kind = queue::JobKind::bed;
       bed.job_id = bed_id;
       bed.scenario = job.scenario;  // any scenario with this key prepares the same bed
       bed.params = json::object();

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "scheduler/pipeline/json_schema.h"
+#include "scheduler/queue/job_types.h"
 
 namespace gravsweep::sweep {
 
@@ -66,7 +67,7 @@ SweepSpec load_spec(const std::filesystem::path& path);
 
 struct PlannedJob {
   std::string job_id;
-  std::string kind;               ///< "bed", "drop" or "noop"
+  queue::JobKind kind = queue::JobKind::noop;
   nlohmann::json scenario;        ///< canonical scenario the job runs
   nlohmann::json params;          ///< swept parameter values {column name: value}
   std::vector<std::string> deps;  ///< job ids this job waits for

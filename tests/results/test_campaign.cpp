@@ -9,7 +9,7 @@
 #include "results/model/model.h"
 #include "results/model/synth.h"
 #include "results_helpers.h"
-#include "db/sqlite.h"
+#include "db/database.h"
 
 using namespace gravsweep;
 using namespace gravsweep::results;

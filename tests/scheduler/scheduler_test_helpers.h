@@ -15,7 +15,7 @@
 #include <thread>
 #include <vector>
 
-#include "db/sqlite.h"
+#include "db/database.h"
 #include "tests/common/temp_dir.h"  // TempDir
 
 namespace gravsweep::test {

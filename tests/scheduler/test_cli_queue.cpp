@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
-#include "db/sqlite.h"
+#include "db/database.h"
 #include "scheduler/queue/impact.h"
 #include "scheduler_test_helpers.h"
 

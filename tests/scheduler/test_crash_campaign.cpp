@@ -3,7 +3,8 @@
 // supervisor; in turn the worker and the supervisor are killed with SIGKILL while a job is in the
 // middle (the supervisor's workers must die with it), and restarted. At the end every job is done
 // exactly once, no result row is duplicated, every trace exists with its recorded checksum, no
-// file is orphaned, and PRAGMA integrity_check is ok.
+// file is orphaned, and PRAGMA integrity_check is ok. On both backends: SQLite, and a throwaway
+// PostgreSQL server (scheduler_postgres_tests, label postgres).
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -17,9 +18,10 @@
 #include <sstream>
 #include <thread>
 
-#include "db/sqlite.h"
+#include "db/database.h"
 #include "scheduler/queue/impact.h"
 #include "scheduler/sweep/canonical.h"
+#include "campaign_store.h"
 #include "scheduler_test_helpers.h"
 
 using namespace gravsweep;
@@ -58,6 +60,12 @@ std::vector<pid_t> children_of(pid_t parent) {
   return out;
 }
 
+/// `a` followed by `b`.
+std::vector<std::string> cat(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
 /// What the storm did.
 struct Storm {
   int worker_kills = 0, supervisor_kills = 0;
@@ -69,19 +77,21 @@ struct Storm {
 /// one victim caught mid-job: worker 0, or (every other kill, when `with_supervisor`) the
 /// supervisor while one of its workers is mid-job; each victim is restarted. Then checks the
 /// campaign end to end.
-void crash_campaign(const json& doc, std::int64_t total, std::int64_t with_results,
+void crash_campaign(Store store_kind, const json& doc, std::int64_t total, std::int64_t with_results,
                     const std::vector<std::string>& param_columns, int min_kills, int max_kills,
                     bool with_supervisor = false) {
   TempDir d;
+  const CampaignStore store(store_kind, d.path);
+  if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
   write_text(d.path / "spec.json", doc.dump(2));
-  auto r = run_cli({"submit", "spec.json", "--db", "c.db"}, d.path);
+  auto r = run_cli(cat({"submit", "spec.json"}, store.args()), d.path);
   ASSERT_EQ(r.code, 0) << r.err;
   ASSERT_NE(r.out.find(fmt::format("{} new, 0 already present", total)), std::string::npos) << r.out;
 
-  const std::string db_path = (d.path / "c.db").string();
-  const std::vector<std::string> work_args = {"work",   "--db",        db_path, "--threads", "1",
-                                              "--lease", "3",          "--heartbeat", "0.3", "--poll",
-                                              "0.1",     "--backoff",  "0.1"};
+  const std::string db_path = store.location;
+  const std::vector<std::string> work_args =
+      cat({"work", "--threads", "1", "--lease", "3", "--heartbeat", "0.3", "--poll", "0.1", "--backoff", "0.1"},
+          store.args());
   std::vector<std::string> sup_args = work_args;
   sup_args.insert(sup_args.end(), {"--workers", "2", "--quiet"});
   // Slot 0: a plain worker; then the supervisor of two workers, or two more plain workers.
@@ -145,7 +155,7 @@ void crash_campaign(const json& doc, std::int64_t total, std::int64_t with_resul
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), total);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='done'"), total);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM (SELECT job_id FROM attempts WHERE outcome='done' GROUP BY job_id "
-                        "HAVING count(*) > 1)"),
+                        "HAVING count(*) > 1) AS twice"),
             0);
   // Each kill of a worker left one lost attempt, reclaimed by a surviving worker (more only if a
   // starved heartbeat let a lease lapse, then fenced out); the workers of a killed supervisor got
@@ -166,7 +176,7 @@ void crash_campaign(const json& doc, std::int64_t total, std::int64_t with_resul
   {
     db::Statement st(db, "SELECT output_path, output_sha256, output_bytes FROM jobs");
     while (st.step()) {
-      const fs::path p = campaign_file(d.path, "c", st.get_text(0));
+      const fs::path p = store.root() / st.get_text(0);
       referenced.insert(fs::weakly_canonical(p).string());
       ASSERT_TRUE(fs::exists(p)) << "missing output " << p;
       EXPECT_EQ(fs::file_size(p), static_cast<std::uintmax_t>(st.get_int(2)));
@@ -174,22 +184,24 @@ void crash_campaign(const json& doc, std::int64_t total, std::int64_t with_resul
     }
   }
   std::vector<std::string> orphans;
-  for (const auto& e : fs::recursive_directory_iterator(d.path / "c.files"))
+  for (const auto& e : fs::recursive_directory_iterator(store.root()))
     if (e.is_regular_file() && !referenced.count(fs::weakly_canonical(e.path()).string()))
       orphans.push_back(e.path().string());
   EXPECT_TRUE(orphans.empty()) << orphans.size() << " orphaned file(s), first " << orphans.front();
-  EXPECT_EQ(sql_text(db, "PRAGMA integrity_check"), "ok");
+  if (store_kind == Store::sqlite) EXPECT_EQ(sql_text(db, "PRAGMA integrity_check"), "ok");
   // status after the storm: all done, no stale lease; resume finds nothing to repair.
-  r = run_cli({"status", "--db", "c.db"}, d.path);
+  r = run_cli({"status", "--db", store.location}, d.path);
   EXPECT_EQ(r.code, 0);
   EXPECT_NE(r.out.find(fmt::format("{} done, 0 dead, 0 running, 0 to run", total)), std::string::npos) << r.out;
-  r = run_cli({"resume", "--db", "c.db", "--dry-run"}, d.path);
+  r = run_cli(cat({"resume", "--dry-run"}, store.args()), d.path);
   EXPECT_NE(r.out.find("orphaned files found: 0"), std::string::npos) << r.out;
 }
 
 }  // namespace
 
-TEST(CrashCampaign, SigkilledWorkersAndSupervisorsLoseNothingAndDuplicateNothing) {
+struct CrashCampaign : ::testing::TestWithParam<Store> {};
+
+TEST_P(CrashCampaign, SigkilledWorkersAndSupervisorsLoseNothingAndDuplicateNothing) {
   if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
   json doc = {{"sweep", "crash"},
               {"max_attempts", 6},
@@ -202,34 +214,37 @@ TEST(CrashCampaign, SigkilledWorkersAndSupervisorsLoseNothingAndDuplicateNothing
                  {"range", {{"start", 0.4}, {"stop", 1.0}, {"step", 0.1}}}}}},
               {"repeats", {{"name", "projectile_seed"}, {"pointer", "/projectile/seed"}, {"count", 2}, {"start", 1}}}};
   // 4 beds (gravity x bed seed) and 56 drops (7 speeds x 2 projectile seeds per bed).
-  crash_campaign(doc, 60, 56, {"gravity_m_s2", "bed_seed", "impact_speed_m_s", "projectile_seed", "bed_job_id"}, 4, 6,
+  crash_campaign(GetParam(), doc, 60, 56, {"gravity_m_s2", "bed_seed", "impact_speed_m_s", "projectile_seed", "bed_job_id"}, 4, 6,
                  /*with_supervisor=*/true);
 }
 
-TEST(CrashCampaign, NoopJobsSurviveSigkillToo) {
+TEST_P(CrashCampaign, NoopJobsSurviveSigkillToo) {
   // The queue alone (no engine): 30 half-second jobs.
   json doc = {{"sweep", "crash_noop"},
               {"job", "noop"},
               {"max_attempts", 6},
               {"base", {{"g", 1.5}, {"sleep_s", 0.5}}},
               {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 0.1}, {"stop", 3.0}, {"step", 0.1}}}}}}};
-  EXPECT_NO_FATAL_FAILURE(crash_campaign(doc, 30, 30, {"gravity_m_s2", "noop_value"}, 4, 4, /*with_supervisor=*/true));
+  EXPECT_NO_FATAL_FAILURE(crash_campaign(GetParam(), doc, 30, 30, {"gravity_m_s2", "noop_value"}, 4, 4, /*with_supervisor=*/true));
 }
 
-TEST(CrashCampaign, SigkilledSupervisorTakesItsWorkersDownAndLosesNothing) {
+TEST_P(CrashCampaign, SigkilledSupervisorTakesItsWorkersDownAndLosesNothing) {
   // 3 SIGKILLs of `work --workers 3` mid-campaign: its workers must exit (they would otherwise
   // pile up beside the restarted supervisor's), and the campaign still ends with every job done once.
   TempDir d;
+  const CampaignStore store(GetParam(), d.path);
+  if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
   json doc = {{"sweep", "sup"},
               {"job", "noop"},
               {"max_attempts", 6},
               {"base", {{"g", 1.0}, {"sleep_s", 0.3}}},
               {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 0.1}, {"stop", 4.0}, {"step", 0.1}}}}}}};
   write_text(d.path / "spec.json", doc.dump());
-  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
-  const std::string db_path = (d.path / "c.db").string();
-  const std::vector<std::string> args = {"work", "--db", db_path, "--workers", "3", "--threads", "1", "--lease", "2",
-                                         "--heartbeat", "0.3", "--poll", "0.1", "--backoff", "0.1", "--quiet"};
+  ASSERT_EQ(run_cli(cat({"submit", "spec.json"}, store.args()), d.path).code, 0);
+  const std::string db_path = store.location;
+  const std::vector<std::string> args = cat({"work", "--workers", "3", "--threads", "1", "--lease", "2", "--heartbeat",
+                                             "0.3", "--poll", "0.1", "--backoff", "0.1", "--quiet"},
+                                            store.args());
   db::Database db(db_path);
   int orphans_left = 0;
   for (int kill_no = 0; kill_no < 3; ++kill_no) {
@@ -256,14 +271,22 @@ TEST(CrashCampaign, SigkilledSupervisorTakesItsWorkersDownAndLosesNothing) {
   }
   std::printf("supervisor SIGKILLed 3 times: %d worker(s) outlived it by 5 s\n", orphans_left);
   EXPECT_EQ(orphans_left, 0) << "workers outlived their supervisor";
-  const auto r = run_cli({"work", "--db", "c.db", "--workers", "2", "--quiet", "--lease", "2", "--poll", "0.1"}, d.path);
+  const auto r = run_cli(cat({"work", "--workers", "2", "--quiet", "--lease", "2", "--poll", "0.1"}, store.args()), d.path);
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), 40);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='done'"), 40);
   db::Statement st(db, "SELECT output_path, output_sha256 FROM jobs");
   while (st.step()) {
-    const fs::path p = campaign_file(d.path, "c", st.get_text(0));
+    const fs::path p = store.root() / st.get_text(0);
     ASSERT_TRUE(fs::exists(p)) << p;
     EXPECT_EQ(sweep::sha256_file(p), st.get_text(1));
   }
 }
+
+#ifdef GRAVSWEEP_QUEUE_TESTS_ON_POSTGRES
+INSTANTIATE_TEST_SUITE_P(Postgres, CrashCampaign, ::testing::Values(Store::postgres),
+                         [](const auto& info) { return store_name(info.param); });
+#else
+INSTANTIATE_TEST_SUITE_P(Sqlite, CrashCampaign, ::testing::Values(Store::sqlite),
+                         [](const auto& info) { return store_name(info.param); });
+#endif

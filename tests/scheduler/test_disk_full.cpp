@@ -8,7 +8,7 @@
 #include <cerrno>
 #include <cstring>
 
-#include "db/sqlite.h"
+#include "db/database.h"
 #include "scheduler/queue/impact.h"
 #include "scheduler/sweep/canonical.h"
 #include "scheduler_test_helpers.h"

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
-#include "db/sqlite.h"
+#include "db/database.h"
 #include "scheduler/queue/impact.h"
 #include "scheduler/sweep/canonical.h"
 #include "scheduler_test_helpers.h"

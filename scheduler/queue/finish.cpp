@@ -1,0 +1,144 @@
+// The end of an attempt: complete (fenced, with the results row), fail (backoff or dead), a bed
+// checksum mismatch (the bed is rebuilt), release (interrupted; the attempt is not counted).
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "scheduler/queue/queue_internal.h"
+#include "scheduler/sweep/canonical.h"
+
+namespace gravsweep::queue {
+
+using db::Database;
+using db::Statement;
+using db::Transaction;
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+bool complete(Database& db, const Claim& c, const Completion& done) {
+  const double now = clock_s(db);
+  Transaction tx(db);
+  {
+    Statement st(db,
+                 "UPDATE jobs SET state='done', output_path=?1, output_sha256=?2, output_bytes=?3, finished_at=?4, "
+                 "progress=1, phase='done', detail=NULL, lease_owner=NULL, lease_expires=NULL, last_error=NULL "
+                 "WHERE job_id=?5 AND lease_token=?6 AND state='running'");
+    st.bind(1, done.output_rel).bind(2, done.sha256).bind(3, done.bytes).bind(4, now).bind(5, c.job_id).bind(6, c.token);
+    st.run();
+    if (db.changes() != 1) return false;  // fenced out: another worker holds the job now
+  }
+  std::string code_version;
+  {
+    Statement st(db,
+                 "UPDATE attempts SET outcome='done', ended_at=?1, runtime_s=?1-started_at, exit_code=0, "
+                 "report_json=?2, output_path=?3 WHERE attempt_id=?4 RETURNING code_version");
+    st.bind(1, now).bind(2, sweep::canonical_json(done.report.is_null() ? json::object() : done.report));
+    st.bind(3, done.output_rel).bind(4, c.attempt_row);
+    if (st.step()) code_version = st.get_text(0);
+    st.run();
+  }
+  {  // release dependents
+    Statement st(db,
+                 "UPDATE jobs SET deps_pending=deps_pending-1, state=CASE WHEN deps_pending<=1 AND state='waiting' "
+                 "THEN 'queued' ELSE state END WHERE job_id IN (SELECT job_id FROM job_deps WHERE dep_id=?) "
+                 "AND deps_pending>0");
+    st.bind(1, c.job_id);
+    st.run();
+  }
+  if (c.kind != JobKind::bed) detail::insert_results_row(db, c, done, now, code_version);
+  tx.commit();
+  return true;
+}
+
+std::string fail(Database& db, const Claim& c, const std::string& error, int exit_code, bool permanent,
+                 double backoff_base_s, double backoff_cap_s) {
+  const double now = clock_s(db);
+  thread_local std::mt19937_64 rng(std::random_device{}());
+  const double delay = std::min(backoff_cap_s, backoff_base_s * std::pow(2.0, std::max(0, c.attempt - 1)));
+  const double jitter = std::uniform_real_distribution<double>(0, 0.25 * delay)(rng);
+  Transaction tx(db);
+  std::string state;
+  {
+    Statement st(db,
+                 "UPDATE jobs SET state=CASE WHEN ?1 <> 0 OR attempts>=max_attempts THEN 'dead' ELSE 'failed' END, "
+                 "not_before=?2, last_error=?3, lease_owner=NULL, lease_expires=NULL, phase=NULL, detail=NULL, "
+                 "finished_at=?4 WHERE job_id=?5 AND lease_token=?6 AND state='running' RETURNING state");
+    st.bind(1, permanent ? 1 : 0).bind(2, now + delay + jitter).bind(3, error).bind(4, now).bind(5, c.job_id);
+    st.bind(6, c.token);
+    if (!st.step()) return "";
+    state = st.get_text(0);
+    st.run();
+  }
+  {
+    Statement st(db,
+                 "UPDATE attempts SET outcome=?1, ended_at=?2, runtime_s=?2-started_at, exit_code=?3, error=?4 "
+                 "WHERE attempt_id=?5");
+    st.bind(1, state).bind(2, now).bind(3, exit_code).bind(4, error).bind(5, c.attempt_row);
+    st.run();
+  }
+  if (state == "dead") detail::cascade_dead(db, c.job_id, now);
+  tx.commit();
+  return state;
+}
+
+bool bed_mismatch(Database& db, const Claim& c, const std::string& reason) {
+  const double now = clock_s(db);
+  Transaction tx(db);
+  {
+    Statement st(db,
+                 "UPDATE jobs SET state='waiting', deps_pending=1, last_error=?1, lease_owner=NULL, "
+                 "lease_expires=NULL, phase=NULL, detail=NULL, progress=NULL, attempts=CASE WHEN attempts>0 THEN attempts-1 ELSE 0 END "
+                 "WHERE job_id=?2 AND lease_token=?3 AND state='running'");
+    st.bind(1, reason).bind(2, c.job_id).bind(3, c.token);
+    st.run();
+    if (db.changes() != 1) return false;
+  }
+  {
+    Statement st(db, "UPDATE attempts SET outcome='failed', ended_at=?1, runtime_s=?1-started_at, exit_code=1, "
+                     "error=?2 WHERE attempt_id=?3");
+    st.bind(1, now).bind(2, reason).bind(3, c.attempt_row);
+    st.run();
+  }
+  {  // the bed is rebuilt once, by whichever drop noticed first
+    Statement st(db,
+                 "UPDATE jobs SET state='queued', output_path=NULL, output_sha256=NULL, output_bytes=NULL, "
+                 "finished_at=NULL, last_error=?1, not_before=0, max_attempts=CASE WHEN max_attempts>attempts THEN max_attempts ELSE attempts+1 END "
+                 "WHERE job_id=?2 AND state='done' AND output_sha256=?3");
+    st.bind(1, reason).bind(2, c.dep_job_id).bind(3, c.dep_sha256);
+    st.run();
+  }
+  {  // its other drops that have not started wait for the new bed
+    Statement st(db,
+                 "UPDATE jobs SET state='waiting', deps_pending=deps_pending+1 WHERE state IN ('queued','failed') "
+                 "AND job_id IN (SELECT job_id FROM job_deps WHERE dep_id=?)");
+    st.bind(1, c.dep_job_id);
+    st.run();
+  }
+  tx.commit();
+  return true;
+}
+
+
+bool release(Database& db, const Claim& c, const std::string& why) {
+  const double now = clock_s(db);
+  Transaction tx(db);
+  {
+    Statement st(db,
+                 "UPDATE jobs SET state='queued', attempts=CASE WHEN attempts>0 THEN attempts-1 ELSE 0 END, lease_owner=NULL, lease_expires=NULL, "
+                 "progress=NULL, phase=NULL, detail=NULL WHERE job_id=? AND lease_token=? AND state='running'");
+    st.bind(1, c.job_id).bind(2, c.token);
+    st.run();
+    if (db.changes() != 1) return false;
+  }
+  Statement st(db,
+               "UPDATE attempts SET outcome='released', ended_at=?1, runtime_s=?1-started_at, exit_code=130, "
+               "error=?2 WHERE attempt_id=?3");
+  st.bind(1, now).bind(2, why).bind(3, c.attempt_row);
+  st.run();
+  tx.commit();
+  return true;
+}
+
+}  // namespace gravsweep::queue

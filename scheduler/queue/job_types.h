@@ -1,0 +1,41 @@
+// The job kinds and states of the queue, typed, each with its one table of names (the names are
+// what the database stores: jobs.kind, jobs.state). A kind's folder under the files root and its
+// output file extension live in the same table row.
+#pragma once
+#include <ostream>
+#include <string>
+#include <string_view>
+
+namespace gravsweep::queue {
+
+enum class JobKind { bed, drop, noop };
+enum class JobState { waiting, queued, running, failed, done, dead };
+
+struct JobKindInfo {
+  JobKind kind;
+  const char* name;       ///< stored in jobs.kind
+  const char* folder;     ///< outputs under <files root>/<folder>/
+  const char* extension;  ///< of the output file, with the dot
+};
+
+/// The one table of kinds (in enum order).
+const JobKindInfo& kind_info(JobKind k);
+inline const char* kind_name(JobKind k) { return kind_info(k).name; }
+/// The kind named `name`; throws ConfigError listing the valid names.
+JobKind parse_kind(std::string_view name);
+
+const char* state_name(JobState s);
+/// The state named `name`; throws ConfigError listing the valid names.
+JobState parse_state(std::string_view name);
+
+/// Folders of the files root that hold job outputs and temporary files, in kind order, then tmp.
+inline constexpr const char* kOutputFolders[] = {"beds", "traces", "noop", "tmp"};
+
+inline bool operator==(JobKind k, std::string_view name) { return name == kind_name(k); }
+inline bool operator!=(JobKind k, std::string_view name) { return !(k == name); }
+inline bool operator==(JobState s, std::string_view name) { return name == state_name(s); }
+inline bool operator!=(JobState s, std::string_view name) { return !(s == name); }
+inline std::ostream& operator<<(std::ostream& os, JobKind k) { return os << kind_name(k); }
+inline std::ostream& operator<<(std::ostream& os, JobState s) { return os << state_name(s); }
+
+}  // namespace gravsweep::queue

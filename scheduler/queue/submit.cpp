@@ -1,0 +1,95 @@
+// Sweep expansion into the queue: idempotent inserts, dependencies and sweep memberships.
+#include "scheduler/queue/queue_internal.h"
+#include "scheduler/sweep/canonical.h"
+
+namespace gravsweep::queue {
+
+using db::Database;
+using db::Statement;
+using db::Transaction;
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+SubmitReport submit(Database& db, const sweep::SweepSpec& spec, const std::vector<sweep::PlannedJob>& jobs) {
+  SubmitReport rep;
+  rep.sweep = spec.name;
+  rep.planned = jobs.size();
+  const double now = clock_s(db);
+  const std::string spec_text = sweep::canonical_json(spec.source);
+  Transaction tx(db);
+  {
+    Statement exists(db, "SELECT 1 FROM sweeps WHERE sweep_id=?");
+    exists.bind(1, spec.name);
+    rep.sweep_new = !exists.step();
+  }
+  {
+    Statement st(db,
+                 "INSERT INTO sweeps(sweep_id, job_kind, spec_json, spec_sha256, submitted_at, updated_at) "
+                 "VALUES(?1, ?2, ?3, ?4, ?5, ?5) ON CONFLICT(sweep_id) DO UPDATE SET spec_json=excluded.spec_json, "
+                 "spec_sha256=excluded.spec_sha256, updated_at=excluded.updated_at, submits=sweeps.submits+1");
+    st.bind(1, spec.name).bind(2, spec.job_kind).bind(3, spec_text).bind(4, sweep::sha256_hex(spec_text)).bind(5, now);
+    st.run();
+  }
+  // One results column per swept parameter.
+  auto cols = detail::result_extra_columns(db);
+  for (const auto& g : spec.groups) {
+    for (const auto& a : g.axes) {
+      if (cols.count(a.name)) continue;
+      // The type fits every value of the axis: 1, 1.5 (canonical 1 is an integer) needs REAL.
+      std::string type = detail::sql_type_of(a.values.front());
+      for (const auto& v : a.values)
+        if (type == "INTEGER" && v.is_number_float()) type = "REAL";
+      detail::add_result_column(db, a.name, "param", type);
+      cols[a.name] = "param";
+    }
+  }
+  Statement ins(db,
+                "INSERT INTO jobs(job_id, kind, sweep_id, state, priority, deps_pending, max_attempts, params_json, "
+                "scenario_json, created_at) VALUES(?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10) "
+                "ON CONFLICT(job_id) DO NOTHING");
+  Statement dep(db, "INSERT INTO job_deps(job_id, dep_id) VALUES(?, ?) ON CONFLICT DO NOTHING");
+  Statement pending(db,
+                    "UPDATE jobs SET deps_pending=(SELECT count(*) FROM job_deps d JOIN jobs j ON j.job_id=d.dep_id "
+                    "WHERE d.job_id=?1 AND j.state!='done'), state=CASE WHEN (SELECT count(*) FROM job_deps d JOIN "
+                    "jobs j ON j.job_id=d.dep_id WHERE d.job_id=?1 AND j.state='dead') > 0 THEN 'dead' WHEN "
+                    "(SELECT count(*) FROM job_deps d JOIN jobs j ON j.job_id=d.dep_id WHERE d.job_id=?1 AND "
+                    "j.state!='done') > 0 THEN 'waiting' ELSE 'queued' END, blocked_by=(SELECT d.dep_id FROM job_deps d JOIN "
+                    "jobs j ON j.job_id=d.dep_id WHERE d.job_id=?1 AND j.state='dead' ORDER BY d.dep_id LIMIT 1) "
+                    "WHERE job_id=?1");
+  Statement member(db,
+                   "INSERT INTO sweep_jobs(sweep_id, job_id, shared) VALUES(?1, ?2, (SELECT CASE WHEN sweep_id <> ?1 THEN 1 ELSE 0 END FROM jobs "
+                   "WHERE job_id=?2)) ON CONFLICT DO NOTHING");
+  for (const auto& j : jobs) {
+    ins.reset();
+    ins.bind(1, j.job_id).bind(2, kind_name(j.kind)).bind(3, spec.name);
+    ins.bind(4, state_name(j.deps.empty() ? JobState::queued : JobState::waiting));
+    ins.bind(5, j.priority).bind(6, static_cast<std::int64_t>(j.deps.size())).bind(7, spec.max_attempts);
+    ins.bind(8, sweep::canonical_json(j.params)).bind(9, sweep::canonical_json(j.scenario)).bind(10, now);
+    ins.run();
+    const bool added = db.changes() == 1;
+    if (added) {
+      ++rep.added;
+      if (j.kind == JobKind::bed) ++rep.beds_added;
+      else ++rep.drops_added;
+      if (!j.deps.empty()) {
+        for (const auto& d : j.deps) {
+          dep.reset();
+          dep.bind(1, j.job_id).bind(2, d);
+          dep.run();
+        }
+        pending.reset();
+        pending.bind(1, j.job_id);
+        pending.run();
+      }
+    } else {
+      ++rep.present;
+    }
+    member.reset();
+    member.bind(1, spec.name).bind(2, j.job_id);
+    member.run();
+  }
+  tx.commit();
+  return rep;
+}
+
+}  // namespace gravsweep::queue
