@@ -38,6 +38,9 @@ class Dialect {
   [[nodiscard]] virtual std::string add_column_sql(const std::string& table, const std::string& column,
                                                    const std::string& sql_type) const = 0;
 
+  /// Changes `column` (unquoted) of `table` from INTEGER to REAL, keeping its values.
+  virtual void widen_to_real(db::Database& db, const std::string& table, const std::string& column) const = 0;
+
   /// The column that orders results rows as they were written (for listings without --sort).
   [[nodiscard]] virtual const char* insertion_order() const = 0;
   /// After rows were copied in with their keys (campaign copy): generated keys continue after them.

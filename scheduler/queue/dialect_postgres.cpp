@@ -42,6 +42,9 @@ class PostgresDialect final : public Dialect {
                                            const std::string& sql_type) const override {
     return fmt::format("ALTER TABLE {} ADD COLUMN IF NOT EXISTS {} {}", table, column, sql_type);
   }
+  void widen_to_real(db::Database& db, const std::string& table, const std::string& column) const override {
+    db.exec(fmt::format("ALTER TABLE {} ALTER COLUMN \"{}\" TYPE DOUBLE PRECISION", table, column));
+  }
   [[nodiscard]] const char* insertion_order() const override { return "finished_at, job_id"; }
   void after_copy(db::Database& db) const override {
     db.exec("SELECT setval(pg_get_serial_sequence('jobs', 'seq'), coalesce((SELECT max(seq) FROM jobs), 0) + 1, false); "

@@ -32,6 +32,29 @@ class SqliteDialect final : public Dialect {
                                            const std::string& sql_type) const override {
     return fmt::format("ALTER TABLE {} ADD COLUMN {} {}", table, column, sql_type);
   }
+  void widen_to_real(db::Database& db, const std::string& table, const std::string& column) const override {
+    // A STRICT table has no ALTER COLUMN: the table is rebuilt from its own definition with the
+    // column's type changed (sqlite.org/lang_altertable.html, "other kinds of table schema
+    // changes"); no other table refers to the results table, and it has no other index.
+    std::string sql;
+    {
+      db::Statement st(db, "SELECT sql FROM sqlite_master WHERE type='table' AND name=?");
+      st.bind(1, table);
+      if (!st.step()) throw db::DbError("no table " + table);
+      sql = st.get_text(0);
+    }
+    // "CREATE TABLE results(" at first, "CREATE TABLE \"results\"(" after a rebuild's rename.
+    const std::string from = fmt::format("\"{}\" INTEGER", column);
+    const auto at = sql.find(from), head = sql.find('(');
+    if (at == std::string::npos || head == std::string::npos || head > at)
+      throw db::DbError(fmt::format("cannot find column {} INTEGER in: {}", column, sql));
+    sql.replace(at, from.size(), fmt::format("\"{}\" REAL", column));
+    sql.replace(0, head, fmt::format("CREATE TABLE {}_widened", table));
+    db.exec(sql);
+    db.exec(fmt::format("INSERT INTO {0}_widened SELECT * FROM {0} ORDER BY rowid; DROP TABLE {0}; "
+                        "ALTER TABLE {0}_widened RENAME TO {0}",
+                        table));
+  }
   [[nodiscard]] const char* insertion_order() const override { return "rowid"; }
   void after_copy(db::Database&) const override {}  // rowid keys continue after the largest
 };

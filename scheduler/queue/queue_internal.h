@@ -22,10 +22,17 @@ void reap_expired(db::Database& db, double now, Reclaimed& out, int limit);
 // ---- the results table (results_row.cpp) -------------------------------------------------------
 /// SQL type of a results column for the first value seen.
 std::string sql_type_of(const nlohmann::json& v);
-/// Existing extra columns of results: name -> role ("param" or "metric").
-std::map<std::string, std::string> result_extra_columns(db::Database& db);
+/// An extra column of results: "param" or "metric", and its queue type (INTEGER, REAL, TEXT, ANY).
+struct ResultColumn {
+  std::string role, type;
+};
+/// Existing extra columns of results by name.
+std::map<std::string, ResultColumn> result_extra_columns(db::Database& db);
 /// Adds a results column (inside the caller's transaction).
 void add_result_column(db::Database& db, const std::string& name, const std::string& role, const std::string& type);
+/// Makes an INTEGER results column REAL, keeping its values, when `v` is a non-integer number (an
+/// axis extended by 2.5 after 1, 2; a metric first seen as 0). Inside the caller's transaction.
+void widen_result_column(db::Database& db, const std::string& name, ResultColumn& col, const nlohmann::json& v);
 /// Inserts the results row of a finished drop (or noop) job, adding metric columns as they first
 /// appear. Inside the caller's transaction.
 void insert_results_row(db::Database& db, const Claim& c, const Completion& done, double now,

@@ -72,11 +72,20 @@ void flatten(const json& j, const std::string& prefix, std::vector<std::pair<std
 
 namespace detail {
 
-std::map<std::string, std::string> result_extra_columns(Database& db) {
-  std::map<std::string, std::string> out;
-  Statement st(db, "SELECT name, role FROM results_columns");
-  while (st.step()) out[st.get_text(0)] = st.get_text(1);
+std::map<std::string, ResultColumn> result_extra_columns(Database& db) {
+  std::map<std::string, ResultColumn> out;
+  Statement st(db, "SELECT name, role, sql_type FROM results_columns");
+  while (st.step()) out[st.get_text(0)] = {st.get_text(1), st.get_text(2)};
   return out;
+}
+
+void widen_result_column(Database& db, const std::string& name, ResultColumn& col, const json& v) {
+  if (col.type != "INTEGER" || !v.is_number_float()) return;
+  dialect_of(db).widen_to_real(db, "results", name);
+  Statement st(db, "UPDATE results_columns SET sql_type='REAL' WHERE name=?");
+  st.bind(1, name);
+  st.run();
+  col.type = "REAL";
 }
 
 void add_result_column(Database& db, const std::string& name, const std::string& role, const std::string& type) {
@@ -97,20 +106,24 @@ void insert_results_row(Database& db, const Claim& c, const Completion& done, do
   std::vector<std::pair<std::string, json>> values;
   std::set<std::string> used(kFixedResultColumns.begin(), kFixedResultColumns.end());
   for (auto it = c.params.begin(); it != c.params.end(); ++it) {
-    if (cols.count(it.key()) && used.insert(it.key()).second) values.emplace_back(it.key(), it.value());
+    const auto col = cols.find(it.key());
+    if (col == cols.end() || !used.insert(it.key()).second) continue;
+    widen_result_column(db, it.key(), col->second, it.value());
+    values.emplace_back(it.key(), it.value());
   }
   for (auto& [key, v] : metrics) {
     std::string name = sanitize_metric(key);
     auto col = cols.find(name);
-    if ((col != cols.end() && col->second != "metric") ||
+    if ((col != cols.end() && col->second.role != "metric") ||
         std::find(kFixedResultColumns.begin(), kFixedResultColumns.end(), name) != kFixedResultColumns.end())
       name = "metric_" + name;
     if (!cols.count(name) && v.is_null()) continue;  // the column appears with the first real value
     if (!used.insert(name).second) continue;
     if (!cols.count(name)) {
       add_result_column(db, name, "metric", sql_type_of(v));
-      cols[name] = "metric";
+      cols[name] = {"metric", sql_type_of(v)};
     }
+    widen_result_column(db, name, cols[name], v);
     values.emplace_back(name, v);
   }
   std::string bed_id;

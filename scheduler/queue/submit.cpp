@@ -30,17 +30,16 @@ SubmitReport submit(Database& db, const sweep::SweepSpec& spec, const std::vecto
     st.bind(1, spec.name).bind(2, spec.job_kind).bind(3, spec_text).bind(4, sweep::sha256_hex(spec_text)).bind(5, now);
     st.run();
   }
-  // One results column per swept parameter.
+  // One results column per swept parameter, of a type that fits every value of the axis: 1, 1.5
+  // (canonical 1 is an integer) needs REAL, and so does 2.5 added to an axis that had 1, 2.
   auto cols = detail::result_extra_columns(db);
   for (const auto& g : spec.groups) {
     for (const auto& a : g.axes) {
-      if (cols.count(a.name)) continue;
-      // The type fits every value of the axis: 1, 1.5 (canonical 1 is an integer) needs REAL.
-      std::string type = detail::sql_type_of(a.values.front());
-      for (const auto& v : a.values)
-        if (type == "INTEGER" && v.is_number_float()) type = "REAL";
-      detail::add_result_column(db, a.name, "param", type);
-      cols[a.name] = "param";
+      if (!cols.count(a.name)) {
+        detail::add_result_column(db, a.name, "param", detail::sql_type_of(a.values.front()));
+        cols[a.name] = {"param", detail::sql_type_of(a.values.front())};
+      }
+      for (const auto& v : a.values) detail::widen_result_column(db, a.name, cols[a.name], v);
     }
   }
   Statement ins(db,

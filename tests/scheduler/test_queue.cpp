@@ -97,6 +97,34 @@ TEST_P(QueueTest, SubmitTwiceAddsNothingExtensionAddsOnlyNewJobs) {
   EXPECT_NE(std::find(cols.begin(), cols.end(), "gravity_m_s2"), cols.end());
 }
 
+TEST_P(QueueTest, ANonIntegerValueWidensAnIntegerResultsColumnAndKeepsItsValues) {
+  // An axis of 1, 2 gets an INTEGER column; extended by 2.5 it must hold 2.5 (it used to refuse the
+  // row: "cannot store REAL value in INTEGER column"). The same for a metric first seen as 3.
+  submit_spec(noop_spec("s", {1, 2}));
+  auto finish = [&](const json& depth) {
+    auto c = claim(db, me, paths, 60);
+    if (!c) return false;
+    Completion d = done_for(*c);
+    d.metrics["depth_count"] = depth;
+    return complete(db, *c, d);
+  };
+  EXPECT_TRUE(finish(3));
+  EXPECT_TRUE(finish(4));
+  EXPECT_EQ(sql_text(db, "SELECT sql_type FROM results_columns WHERE name='gravity_m_s2'"), "INTEGER");
+  EXPECT_EQ(sql_text(db, "SELECT sql_type FROM results_columns WHERE name='depth_count'"), "INTEGER");
+  submit_spec(noop_spec("s", {1, 2, 2.5}));
+  EXPECT_EQ(sql_text(db, "SELECT sql_type FROM results_columns WHERE name='gravity_m_s2'"), "REAL");
+  EXPECT_TRUE(finish(3.5)) << "the row with 2.5 (and a metric of 3.5) is stored";
+  EXPECT_EQ(sql_text(db, "SELECT sql_type FROM results_columns WHERE name='depth_count'"), "REAL");
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results WHERE gravity_m_s2 IN (1, 2)"), 2);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results WHERE gravity_m_s2=2.5 AND depth_count=3.5"), 1);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results WHERE depth_count IN (3, 4)"), 2);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results WHERE apeak_m_s2=1.0"), 3) << "other columns kept";
+  // The rebuilt table still refuses a result for a job that does not exist (its foreign key).
+  EXPECT_THROW(db.exec("INSERT INTO results(job_id, sweep, kind, attempt) VALUES('nope', 's', 'noop', 1)"),
+               db::DbError);
+}
+
 TEST_P(QueueTest, DropsWaitForTheirBedAndBedsAreClaimedFirst) {
   auto r = submit_spec(impact_spec(), bed_key);
   EXPECT_EQ(r.beds_added, 2u);
