@@ -51,7 +51,7 @@ class PostgresServer {
   [[nodiscard]] int port() const { return port_; }
 
   ~PostgresServer() {
-    if (started_) run(pg_ctl() + " -D " + data() + " -m immediate -w stop");
+    if (started_) (void)run(pg_ctl() + " -D " + data() + " -m immediate -w stop");
     std::error_code ec;
     if (!dir_.empty()) std::filesystem::remove_all(dir_, ec);
   }

@@ -188,7 +188,9 @@ void crash_campaign(Store store_kind, const json& doc, std::int64_t total, std::
     if (e.is_regular_file() && !referenced.count(fs::weakly_canonical(e.path()).string()))
       orphans.push_back(e.path().string());
   EXPECT_TRUE(orphans.empty()) << orphans.size() << " orphaned file(s), first " << orphans.front();
-  if (store_kind == Store::sqlite) EXPECT_EQ(sql_text(db, "PRAGMA integrity_check"), "ok");
+  if (store_kind == Store::sqlite) {
+    EXPECT_EQ(sql_text(db, "PRAGMA integrity_check"), "ok");
+  }
   // status after the storm: all done, no stale lease; resume finds nothing to repair.
   r = run_cli({"status", "--db", store.location}, d.path);
   EXPECT_EQ(r.code, 0);

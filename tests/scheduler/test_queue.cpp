@@ -277,7 +277,9 @@ TEST_P(QueueTest, ResumeRequeuesExpiredAndFailedAndRemovesOrphans) {
   EXPECT_FALSE(std::filesystem::exists(paths.root / "noop" / "ffffffffffffffffffff.a9.json"));
   EXPECT_TRUE(std::filesystem::exists(paths.tmp() / (live->job_id + ".a1.out.json")));
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='queued'"), 2);
-  if (GetParam() == test::Store::sqlite) EXPECT_EQ(sql_text(db, "PRAGMA integrity_check"), "ok");
+  if (GetParam() == test::Store::sqlite) {
+    EXPECT_EQ(sql_text(db, "PRAGMA integrity_check"), "ok");
+  }
 }
 
 TEST_P(QueueTest, StatusCountsRunningAndEta) {
