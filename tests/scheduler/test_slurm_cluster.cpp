@@ -1,0 +1,201 @@
+// Pilot workers through a real single-node Slurm (tests/common/slurm_cluster.h) on a PostgreSQL
+// campaign (tests/common/postgres_server.h), label cluster: `gravsweep slurm submit` runs a tiny
+// impact campaign to completion while one array task is scancelled mid-job; `gravsweep slurm
+// cancel` stops every worker, which give their leases back; a task killed at its time limit loses
+// nothing. Skipped, saying why, when the Slurm daemons or the PostgreSQL server cannot start here.
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "campaign_store.h"
+#include "db/database.h"
+#include "scheduler/sweep/canonical.h"
+#include "scheduler_test_helpers.h"
+#include "tests/common/slurm_cluster.h"
+
+using namespace gravsweep;
+using namespace gravsweep::test;
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A Slurm cluster and a PostgreSQL campaign store, or why not (then the test skips).
+struct ClusterFixture : ::testing::Test {
+  TempDir dir;
+  std::string why;
+  SlurmCluster* slurm = SlurmCluster::shared(why);
+  CampaignStore store{Store::postgres, dir.path};
+  void SetUp() override {
+    if (!slurm) GTEST_SKIP() << "Slurm not available: " << why;
+    if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
+  }
+  std::vector<std::string> with_store(std::vector<std::string> args) const {
+    const auto s = store.args();
+    args.insert(args.end(), s.begin(), s.end());
+    return args;
+  }
+  /// Submits `doc`; then `slurm submit` of `workers` 1-thread pilot workers; returns the array's job id.
+  std::string submit_with_workers(const json& doc, int workers) {
+    write_text(dir.path / "spec.json", doc.dump());
+    auto r = run_cli(with_store({"submit", "spec.json"}), dir.path);
+    EXPECT_EQ(r.code, 0) << r.err;
+    r = run_cli(with_store({"slurm", "submit", "--workers", std::to_string(workers), "--threads", "1", "--lease", "5"}),
+                dir.path);
+    EXPECT_EQ(r.code, 0) << r.err;
+    const auto at = r.out.find("job array ");
+    EXPECT_NE(at, std::string::npos) << r.out;
+    return at == std::string::npos ? "" : r.out.substr(at + 10, r.out.find(' ', at + 10) - at - 10);
+  }
+  /// Waits until `sql` (a count) reaches `n`; false after `timeout_s`.
+  bool wait_count(db::Database& db, const std::string& sql, std::int64_t n, double timeout_s) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (sql_int(db, sql) < n) {
+      if (std::chrono::steady_clock::now() > end) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return true;
+  }
+  /// Every job done by exactly one attempt, no attempt left running, every output present with its checksum.
+  void expect_complete_and_exact(db::Database& db, std::int64_t jobs, std::int64_t results) {
+    EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), jobs);
+    EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='done'"), jobs);
+    EXPECT_EQ(sql_int(db, "SELECT count(DISTINCT job_id) FROM attempts WHERE outcome='done'"), jobs);
+    EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='running'"), 0);
+    EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results"), results);
+    EXPECT_EQ(sql_int(db, "SELECT count(DISTINCT job_id) FROM results"), results);
+    db::Statement st(db, "SELECT output_path, output_sha256 FROM jobs");
+    while (st.step()) {
+      const fs::path p = store.files / st.get_text(0);
+      ASSERT_TRUE(fs::exists(p)) << p;
+      EXPECT_EQ(sweep::sha256_file(p), st.get_text(1)) << p;
+    }
+  }
+};
+
+}  // namespace
+
+TEST_F(ClusterFixture, ATinyImpactCampaignCompletesThroughSlurmWithATaskScancelledMidJob) {
+  // 2 beds and 8 drops (4 speeds per bed, 1 s simulated: about 3 s each), 2 pilot workers of 1
+  // thread (this machine's cores).
+  json base = json::parse(tiny_base());
+  base["stop"]["max_time_s"] = 1.0;
+  json doc = {{"sweep", "slurm_tiny"},
+              {"max_attempts", 4},
+              {"base", base},
+              {"axes",
+               {{{"name", "bed_seed"}, {"pointer", "/bed/seed"}, {"values", {7, 8}}},
+                {{"name", "impact_speed_m_s"},
+                 {"pointer", "/projectile/impact_speed_m_s"},
+                 {"values", {0.4, 0.5, 0.6, 0.7}}}}}};
+  const std::string array = submit_with_workers(doc, 2);
+  ASSERT_FALSE(array.empty());
+  db::Database db(store.location);
+
+  // A task in the middle of a job (well before its end: the cancel must land inside it): its
+  // lease names its Slurm task, and status shows it.
+  const std::string mid_job =
+      "SELECT substr(a.worker, strpos(a.worker, ':slurm=') + 7) || ' ' || a.job_id FROM attempts a JOIN jobs j ON "
+      "j.job_id=a.job_id WHERE a.outcome='running' AND j.state='running' AND j.progress > 0.1 AND j.progress < 0.5 "
+      "AND a.worker LIKE '%:slurm=" + array + "%' ORDER BY j.progress LIMIT 1";
+  std::string found;
+  for (const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(240);
+       found.empty() && std::chrono::steady_clock::now() < end;)
+    if ((found = sql_text(db, mid_job)).empty()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_FALSE(found.empty()) << "no Slurm task was ever seen mid-job; squeue: " << slurm->client("squeue")
+                              << slurm->log_tail();
+  const std::string victim = found.substr(0, found.find(' ')), victim_job = found.substr(found.find(' ') + 1);
+  auto r = run_cli({"status", "--db", store.location}, dir.path);
+  EXPECT_NE(r.out.find(":slurm=" + victim), std::string::npos) << "status names the Slurm task:\n" << r.out;
+  int rc = 0;
+  slurm->client("scancel " + victim, &rc);
+  EXPECT_EQ(rc, 0);
+  std::printf("scancel %s while it ran job %s\n", victim.c_str(), victim_job.c_str());
+
+  // The other task finishes the campaign; the cancelled one gave its lease back on SIGTERM.
+  EXPECT_TRUE(slurm->wait_idle(300)) << "tasks still queued or running: " << slurm->client("squeue");
+  EXPECT_NO_FATAL_FAILURE(expect_complete_and_exact(db, 10, 8));
+  EXPECT_EQ(sql_text(db, "SELECT outcome FROM attempts WHERE job_id='" + victim_job + "' AND worker LIKE '%:slurm=" +
+                             victim + "'"),
+            "released")
+      << "the scancelled worker's attempt";
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='lost'"), 0) << "no lease had to expire";
+  EXPECT_EQ(sql_int(db, "SELECT count(DISTINCT substr(worker, strpos(worker, ':slurm='))) FROM attempts"), 2)
+      << "both array tasks worked";
+  for (const char* task : {"_1.log", "_2.log"})
+    EXPECT_TRUE(fs::exists(store.files / "slurm" / (array + task))) << "the task's log in <files>/slurm/";
+  r = run_cli({"status", "--db", store.location}, dir.path);
+  EXPECT_NE(r.out.find("10 done, 0 dead, 0 running, 0 to run"), std::string::npos) << r.out;
+}
+
+TEST_F(ClusterFixture, SlurmCancelStopsEveryWorkerAndTheyGiveTheirLeasesBack) {
+  json doc = {{"sweep", "slurm_cancel"},
+              {"job", "noop"},
+              {"base", {{"g", 1.0}, {"sleep_s", 1.0}}},
+              {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 1}, {"stop", 20}, {"step", 1}}}}}}};
+  const std::string array = submit_with_workers(doc, 2);
+  ASSERT_FALSE(array.empty());
+  db::Database db(store.location);
+  ASSERT_TRUE(wait_count(db, "SELECT count(*) FROM attempts WHERE outcome='running'", 2, 120))
+      << "two workers never ran at once; squeue: " << slurm->client("squeue") << slurm->log_tail();
+
+  auto r = run_cli(with_store({"slurm", "cancel"}), dir.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("scancel '" + array + "'"), std::string::npos) << r.out;
+  EXPECT_TRUE(slurm->wait_idle(60)) << "workers still running after slurm cancel: " << slurm->client("squeue");
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='running'"), 0);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='running'"), 0) << "every lease given back";
+  EXPECT_GE(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='released'"), 1);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='lost'"), 0);
+  const auto done_before = sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'");
+  EXPECT_LT(done_before, 20) << "the cancel came too late to stop anything";
+
+  std::printf("slurm cancel: %lld of 20 jobs done, %lld attempt(s) released\n", static_cast<long long>(done_before),
+              static_cast<long long>(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='released'")));
+
+  // Nothing was lost: a local worker finishes the campaign, each job exactly once.
+  r = run_cli(with_store({"work", "--workers", "2", "--quiet", "--poll", "0.1"}), dir.path);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NO_FATAL_FAILURE(expect_complete_and_exact(db, 20, 20));
+}
+
+TEST_F(ClusterFixture, ATaskKilledAtItsTimeLimitLosesNothing) {
+  // One pilot worker with a 1 minute limit on 8 jobs of 15 s: Slurm stops it mid-job (SIGTERM,
+  // then SIGKILL after KillWait); its job goes back to the queue and a later worker finishes it.
+  json doc = {{"sweep", "slurm_time"},
+              {"job", "noop"},
+              {"base", {{"g", 1.0}, {"sleep_s", 15.0}}},
+              {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 1}, {"stop", 8}, {"step", 1}}}}}}};
+  write_text(dir.path / "spec.json", doc.dump());
+  ASSERT_EQ(run_cli(with_store({"submit", "spec.json"}), dir.path).code, 0);
+  auto r = run_cli(with_store({"slurm", "submit", "--workers", "1", "--threads", "1", "--time", "00:01:00", "--lease",
+                               "5"}),
+                   dir.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto at = r.out.find("job array ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const std::string array = r.out.substr(at + 10, r.out.find(' ', at + 10) - at - 10);
+  EXPECT_TRUE(slurm->wait_idle(180)) << "the task outlived its time limit: " << slurm->client("squeue");
+
+  std::stringstream log;
+  log << std::ifstream(store.files / "slurm" / (array + "_1.log")).rdbuf();
+  EXPECT_NE(log.str().find("DUE TO TIME LIMIT"), std::string::npos) << "the task's log:\n" << log.str();
+  db::Database db(store.location);
+  const auto done_before = sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'");
+  EXPECT_GE(done_before, 3) << "a minute holds at least 3 jobs of 15 s";
+  EXPECT_LT(done_before, 8);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='released'"), 1) << "stopped mid-job";
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome IN ('running', 'lost')"), 0);
+  std::printf("time limit: %lld of 8 jobs done in the task's minute\n", static_cast<long long>(done_before));
+
+  r = run_cli(with_store({"work", "--workers", "4", "--quiet", "--poll", "0.1"}), dir.path);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NO_FATAL_FAILURE(expect_complete_and_exact(db, 8, 8));
+}
