@@ -117,7 +117,9 @@ TEST(TrialRecord, OneFieldTableGivesCsvSqlHdf5AndJsonNamesAndRoundTrips) {
   for (const auto& f : trial_fields()) {
     EXPECT_TRUE(keys.insert(f.key).second) << "field listed twice: " << f.key;
     EXPECT_TRUE((f.number != nullptr) != (f.text != nullptr)) << f.key;
-    if (f.hdf5_attr) EXPECT_NE(f.number, nullptr) << f.key;
+    if (f.hdf5_attr) {
+      EXPECT_NE(f.number, nullptr) << f.key;
+    }
   }
   // The required columns of shared/formats/measurements.md, no more, no less.
   std::set<std::string> required;

@@ -131,8 +131,9 @@ TEST(BadSpecs, EveryCaseExitsTwoNamingFileAndFieldAndWritesNothing) {
     EXPECT_EQ(r.code, 2) << r.out << r.err;
     EXPECT_NE(r.err.find("bad_spec.json"), std::string::npos) << r.err.substr(0, 600);
     EXPECT_NE(r.err.find(c.where), std::string::npos) << "expected " << c.where << " in: " << r.err.substr(0, 600);
-    if (!c.also.empty())
+    if (!c.also.empty()) {
       EXPECT_NE(r.err.find(c.also), std::string::npos) << "expected " << c.also << " in: " << r.err.substr(0, 600);
+    }
     EXPECT_FALSE(fs::exists(d.path / "c.db")) << "a refused spec must not create the database";
     EXPECT_FALSE(fs::exists(d.path / "c.files"));
     ++checked;

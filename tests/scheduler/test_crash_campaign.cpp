@@ -142,7 +142,9 @@ void crash_campaign(Store store_kind, const json& doc, std::int64_t total, std::
     }
   }
   EXPECT_GE(kills, min_kills) << "the victims were never caught mid-job often enough";
-  if (with_supervisor) EXPECT_GE(storm.supervisor_kills, min_kills / 2) << "the supervisor was never caught";
+  if (with_supervisor) {
+    EXPECT_GE(storm.supervisor_kills, min_kills / 2) << "the supervisor was never caught";
+  }
   EXPECT_EQ(storm.orphans, 0) << "workers outlived their SIGKILLed supervisor";
   for (pid_t w : workers) EXPECT_EQ(wait_child(w, 200), 0);
   ::testing::Test::RecordProperty("sigkills", kills);
