@@ -46,6 +46,11 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
   for (const auto& f : trial_fields())
     if (f.csv_required) header += (header.empty() ? "" : ",") + std::string(f.key);
   csv << header << "\n";
+  std::ofstream truth_csv(fs::path(dir) / kSynthTruthFile);
+  if (!truth_csv) throw std::runtime_error(fmt::format("{}: cannot write {}", dir, kSynthTruthFile));
+  truth_csv << "trial_id,zstop_m,tstop_s\n";
+  // The sensor's unit: the trial's g, or the standard g for a fixed-range sensor.
+  constexpr double kStandardGravity_m_s2 = 9.81;
   int id = 0;
   for (std::size_t gi = 0; gi < o.gravity_m_s2.size(); ++gi) {
     const double g = o.gravity_m_s2[gi];
@@ -75,7 +80,8 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
         c.diameter_m = o.diameter_m;
         c.mass_kg = o.mass_kg;
         c.vc_m_s = v0;
-        const double bias = o.sensor_bias_g * g * n01(rng);
+        const double g_sensor = o.noise_scales_with_g ? g : kStandardGravity_m_s2;
+        const double bias = o.sensor_bias_g * g_sensor * n01(rng);
         const double t_free = 0.01 + 0.02 * std::uniform_real_distribution<double>(0, 1)(rng);
         // Integrate with RK4 (sub-steps of the sampling period) until the stop.
         const double fs_hz = o.sample_rate_hz;
@@ -95,6 +101,7 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
         const int first = static_cast<int>(std::ceil(t_free * fs_hz));
         const double t_first = first / fs_hz - t_free;  // first sample time after contact
         bool stopped = false;
+        double zstop = NAN, tstop = NAN;  // the truth: where the integrated motion comes to rest
         double t_next = t_first;
         while (!stopped && tc < 10.0) {
           // advance to the next sample
@@ -104,14 +111,20 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
             const double k3v = accel_down(z + 0.5 * dt * k2z, v + 0.5 * dt * k2v, tc + 0.5 * dt, ou), k3z = v + 0.5 * dt * k2v;
             const double k4v = accel_down(z + dt * k3z, v + dt * k3v, tc + dt, ou), k4z = v + dt * k3v;
             const double vn = v + dt / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
-            z += dt / 6 * (k1z + 2 * k2z + 2 * k3z + k4z);
-            tc += dt;
+            const double zn = z + dt / 6 * (k1z + 2 * k2z + 2 * k3z + k4z);
             ou = ou_a * ou + ou_b * n01(rng);
-            if (vn <= 0 && tc > 1e-4) {
+            if (vn <= 0 && tc + dt > 1e-4) {
+              const double f = v > vn ? v / (v - vn) : 1.0;  // linear in the step: v = 0 at tc + f dt
+              tstop = tc + f * dt;
+              zstop = z + f * (zn - z);
+              z = zn;
+              tc += dt;
               v = 0;
               stopped = true;
               break;
             }
+            z = zn;
+            tc += dt;
             v = vn;
           }
           if (stopped) break;
@@ -124,19 +137,20 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
         const std::string rel = "traces/" + name + ".csv";
         std::ofstream tr(fs::path(dir) / rel);
         tr << "t_s,accel_m_s2\n";
-        const int n_after = static_cast<int>(0.1 * fs_hz);
+        const int n_after = static_cast<int>(std::lround(o.rest_tail_s * fs_hz));
         const int total = first + static_cast<int>(a_samples.size()) + n_after;
         for (int i = 0; i < total; ++i) {
           double a;
           if (i < first) a = -g;
           else if (i < first + static_cast<int>(a_samples.size())) a = a_samples[static_cast<std::size_t>(i - first)];
           else a = 0.0;
-          a += bias + o.sensor_noise_g * g * n01(rng);
+          a += bias + o.sensor_noise_g * g_sensor * n01(rng);
           tr << fmt::format("{:.6f},{:.5g}\n", i / fs_hz, a);
         }
         const double v_rep = v0 * (1.0 + o.speed_spread * n01(rng));
         csv << fmt::format("{},{},{},{:.4f},{},{},{},{},{},{}\n", name, rel, g, v_rep, H, o.mass_kg,
                            o.diameter_m, o.grain_diameter_m, o.bulk_density_kg_m3, fs_hz);
+        truth_csv << fmt::format("{},{:.9g},{:.9g}\n", name, zstop, tstop);
       }
     }
   }

@@ -20,8 +20,13 @@ struct SynthOptions {
   double bulk_density_kg_m3 = 1450;
   double sample_rate_hz = 1400;
   // Noise model
-  double sensor_noise_g = 0.015;   ///< white sensor noise, in units of the trial's g
-  double sensor_bias_g = 0.01;     ///< std of the constant per-trial bias, in g
+  double sensor_noise_g = 0.015;   ///< white sensor noise, in units of the trial's g (see below)
+  double sensor_bias_g = 0.01;     ///< std of the constant per-trial bias, in g (see below)
+  /// true: noise and bias scale with the trial's g (an accelerometer range chosen for each
+  /// level); false: they are in units of the standard 9.81 m/s2 at every level (one sensor for
+  /// all, so 0.1 g of a low-gravity level drowns in it).
+  bool noise_scales_with_g = true;
+  double rest_tail_s = 0.1;        ///< record length after the projectile comes to rest
   double force_fluct = 0.2;        ///< multiplicative grain-scale fluctuation (std)
   double force_fluct_tau_s = 1.5e-3;
   double bed_spread_f0 = 0.08;     ///< per-trial relative spread of friction-like terms
@@ -35,7 +40,12 @@ struct SynthOptions {
 FittedModel truth_model(const ModelSpec& spec, const std::vector<double>& gravity_m_s2,
                         double mass_kg, double diameter_m);
 
-/// Writes <dir>/trials.csv and <dir>/traces/*.csv; returns the number of trials written.
+/// The file of true metrics that write_synthetic_campaign puts beside trials.csv: trial_id,
+/// zstop_m, tstop_s (contact to rest of the integrated motion, before noise and filtering).
+inline constexpr const char* kSynthTruthFile = "truth.csv";
+
+/// Writes <dir>/trials.csv, <dir>/traces/*.csv and <dir>/truth.csv (kSynthTruthFile); returns the
+/// number of trials written.
 int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, const SynthOptions& o);
 
 }  // namespace gravsweep::results

@@ -1,8 +1,9 @@
 // The paper's processing of a projectile trace (Sunday et al. 2021 Sect. 2.3): 2nd-order
 // Butterworth low-pass at 500 Hz, collision start = no longer in free fall, collision end =
-// acceleration below 0.1 g (and the speed below 10 % of vc, see MetricOptions), velocity and
-// depth by integrating the acceleration from the impact speed, and the metrics vc, apeak, zstop,
-// tstop. Conventions in trace.h (z down, a up); the steps in trace_steps.h.
+// acceleration below 0.1 g of the local g (and the speed below 10 % of vc, see MetricOptions; for
+// lab records searched back from the rest at the record's end, at a level above the noise),
+// velocity and depth by integrating the acceleration from the impact speed, and the metrics vc,
+// apeak, zstop, tstop. Conventions in trace.h (z down, a up); the steps in trace_steps.h.
 #include "results/processing/trace.h"
 
 #include "results/processing/trace_steps.h"
@@ -150,7 +151,7 @@ struct PassResult {
 
 PassResult collision_pass(const Trace& trace, const MetricOptions& o, const std::vector<double>& af,
                           const std::vector<double>& a, std::size_t ipk, std::size_t w, double fs,
-                          double sigma_ff) {
+                          double sigma_ff, double noise) {
   const auto& t = trace.t_s;
   const std::size_t n = t.size();
   const double g = o.gravity_m_s2;
@@ -177,7 +178,16 @@ PassResult collision_pass(const Trace& trace, const MetricOptions& o, const std:
     vc_pass = *o.impact_velocity_m_s;
   }
   ec.v_end_m_s = o.end_speed_fraction * std::abs(vc_pass);
-  const std::optional<std::size_t> j = end_sample(a, ipk, ec);
+  std::optional<std::size_t> j;
+  if (!v_pass.empty() && o.end_from_rest) {
+    // A lab record (velocity integrated from the impact speed, issue 13): the end level of the
+    // local g raised above the noise, the end searched back from the rest at the record's end,
+    // accepted where the integrated speed is down too.
+    ec.end_level_m_s2 = end_level(o.end_threshold_g, g, noise);
+    const std::optional<std::size_t> jb = last_exceedance_end(a, ipk, ec.end_level_m_s2, ec.hold);
+    if (jb && v_pass[*jb] <= ec.v_end_m_s) j = jb;
+  }
+  if (!j) j = end_sample(a, ipk, ec);
   if (!j)
     throw TraceError(fmt::format("trace shorter than the collision: after the peak at t = {:.4f} s the acceleration "
                                  "never stays below {} g with the speed below {} of the collision speed",
@@ -216,11 +226,12 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
   // threshold crossing, as the paper does.
   const std::size_t w = edge_width(fs, o.cutoff_hz);
   double sigma_ff = 0;
+  const double noise = record_noise(af, ipk);
   PassResult pass;
   std::vector<double> a(n);
   for (int k = 0; k < 3; ++k) {
     for (std::size_t i = 0; i < n; ++i) a[i] = af[i] - bias;
-    pass = collision_pass(trace, o, af, a, ipk, w, fs, sigma_ff);
+    pass = collision_pass(trace, o, af, a, ipk, w, fs, sigma_ff, noise);
     if (pass.bias.sigma_free_fall_m_s2) sigma_ff = *pass.bias.sigma_free_fall_m_s2;
     if (pass.bias.any && sensor) bias = pass.bias.bias_m_s2;
     out.free_fall_samples = pass.bias.free_fall_samples;

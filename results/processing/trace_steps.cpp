@@ -135,6 +135,36 @@ std::optional<std::size_t> end_sample(const std::vector<double>& a, std::size_t 
   return std::nullopt;
 }
 
+double robust_sigma(const std::vector<double>& x, std::size_t b, std::size_t e) {
+  if (e < b + 3) return 0.0;
+  constexpr double kMadToSigma = 1.4826;  // 1 / Phi^-1(3/4)
+  const double med = median_of({x.begin() + static_cast<std::ptrdiff_t>(b), x.begin() + static_cast<std::ptrdiff_t>(e)});
+  std::vector<double> dev;
+  dev.reserve(e - b);
+  for (std::size_t i = b; i < e; ++i) dev.push_back(std::abs(x[i] - med));
+  return kMadToSigma * median_of(std::move(dev));
+}
+
+double end_level(double end_threshold_g, double g, double noise_sigma) {
+  return std::max(end_threshold_g * g, kEndNoiseSigmas * noise_sigma);
+}
+
+double record_noise(const std::vector<double>& af, std::size_t ipk) {
+  constexpr std::size_t kMinHead = 5;
+  const std::size_t head = ipk / 3;
+  if (head >= kMinHead) return robust_sigma(af, 0, head);
+  return robust_sigma(af, af.size() - af.size() / 4, af.size());
+}
+
+std::optional<std::size_t> last_exceedance_end(const std::vector<double>& a, std::size_t ipk, double level,
+                                               std::size_t hold) {
+  const std::size_t n = a.size();
+  std::size_t j = n;
+  while (j > ipk + 1 && a[j - 1] < level) --j;
+  if (n - j < hold) return std::nullopt;
+  return j;
+}
+
 CollisionEnd end_edge(const std::vector<double>& t, const std::vector<double>& a, std::size_t j,
                       std::size_t i_start, std::size_t w, double end_level) {
   CollisionEnd e{j, j > 0 ? crossing_time(t, a, j - 1, end_level) : t[j], false};

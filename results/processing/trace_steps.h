@@ -74,6 +74,28 @@ std::size_t end_hold_samples(double fs_hz);
 /// `hold` samples with the speed below v_end; nullopt when there is none.
 std::optional<std::size_t> end_sample(const std::vector<double>& a, std::size_t ipk, const EndCriteria& c);
 
+/// Robust standard deviation of x over [b, e): 1.4826 times the median absolute deviation (the
+/// std of Gaussian noise, unmoved by a minority of outliers). 0 when fewer than 3 samples.
+double robust_sigma(const std::vector<double>& x, std::size_t b, std::size_t e);
+
+/// Noise-aware end level (issue 13): the paper's end_threshold_g of the local g, raised to
+/// kEndNoiseSigmas times the filtered record's noise where 0.1 g drowns in it (low gravity), so
+/// that noise alone never reads as the projectile still decelerating.
+inline constexpr double kEndNoiseSigmas = 5.0;
+double end_level(double end_threshold_g, double g_m_s2, double noise_sigma_m_s2);
+
+/// The filtered record's noise (m/s2): robust_sigma of its head before the peak (free fall,
+/// at least 5 samples) or else of its last quarter (rest).
+double record_noise(const std::vector<double>& af, std::size_t ipk);
+
+/// Lab records with an integrated velocity: the collision end searched back from the end of the
+/// record, the paper's rule read as "the acceleration falls below the level and stays there": the
+/// sample after the last one at or above `level` at or after ipk. A grain-scale dip inside the
+/// collision cannot end it early, and the rest segment is everything after it. nullopt when fewer
+/// than `hold` samples follow (the record ends inside the collision).
+std::optional<std::size_t> last_exceedance_end(const std::vector<double>& a, std::size_t ipk, double level_m_s2,
+                                               std::size_t hold);
+
 /// The collision end: the first sample after it, its time (threshold crossing, or half height of
 /// a step edge: a fall to half the level w samples earlier), whether it is a step edge.
 struct CollisionEnd {

@@ -182,3 +182,37 @@ TEST(TraceSteps, ReboundWhenMovingUpOrReachingTheFloor) {
   EXPECT_NE(floor.note.find("within one grain of the floor"), std::string::npos) << floor.note;
 }
 
+// Issue 13: the pieces of the collision end of lab records in low gravity.
+TEST(TraceSteps, RobustSigmaIsTheNoiseWhateverAFewOutliers) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  std::vector<double> x(4000);
+  for (double& v : x) v = 2.0 + 0.05 * n01(rng);
+  for (std::size_t i = 0; i < 200; ++i) x[i * 20] = 50.0;  // 5 % outliers
+  EXPECT_NEAR(robust_sigma(x, 0, x.size()), 0.05, 0.006);
+  EXPECT_EQ(robust_sigma(x, 0, 2), 0.0);
+}
+
+TEST(TraceSteps, EndLevelIsTheLocalTenthOfGRaisedAboveTheNoise) {
+  EXPECT_DOUBLE_EQ(end_level(0.1, 9.81, 0.01), 0.981);        // quiet: the paper's 0.1 g
+  EXPECT_DOUBLE_EQ(end_level(0.1, 0.1, 0.004), 5.0 * 0.004);  // 0.1 g of 0.1 m/s2 drowns in noise
+  std::vector<double> af(100, 0.0);
+  for (std::size_t i = 0; i < 30; ++i) af[i] = 0.01 * (static_cast<double>(i % 3) - 1.0) - 9.81;  // free fall
+  af[60] = 30.0;
+  EXPECT_NEAR(record_noise(af, 60), 0.01 * 1.4826, 1e-12);
+}
+
+TEST(TraceSteps, LastExceedanceEndIgnoresDipsInsideTheCollision) {
+  // Deceleration 0.6 g with dips below 0.1 g (grain-scale lulls), then rest: the end is after the
+  // last sample above the level, however many dips came before.
+  const double level = 0.1 * kG;
+  std::vector<double> a(200, 0.6 * kG);
+  for (std::size_t i = 150; i < 200; ++i) a[i] = 0.0;
+  for (std::size_t i : {40u, 41u, 42u, 43u, 90u, 91u, 92u}) a[i] = 0.0;
+  EXPECT_EQ(last_exceedance_end(a, 10, level, 3), 150u);
+  EndCriteria c;  // the forward search stops in the first dip
+  c.end_level_m_s2 = level;
+  EXPECT_EQ(end_sample(a, 10, c), 40u);
+  a.resize(152);  // two samples of rest: the record does not hold the end
+  EXPECT_FALSE(last_exceedance_end(a, 10, level, 3).has_value());
+}
