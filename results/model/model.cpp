@@ -329,48 +329,6 @@ double trial_trace_mse(const FittedModel& m, const MeasuredTrial& t) {
   return n ? s / static_cast<double>(n) : NAN;
 }
 
-Prediction predict(const FittedModel& m, const Trial& info) { return predict(m, context(info)); }
-
-Prediction predict(const FittedModel& m, const TermContext& c0, double t_max_s) {
-  // RK4 on (z, v), z down: dv/dt = g - R/m (Eq. 1), from z = 0, v = vc.
-  Prediction p;
-  const double g = c0.g_m_s2, mass = c0.mass_kg;
-  const double dt = std::clamp(2e-5 * std::sqrt(9.81 / g), 1e-5, 2e-4);
-  TermContext c = c0;
-  auto acc = [&](double z, double v, double t) {
-    c.z_m = z;
-    c.v_m_s = v;
-    c.t_since_contact_s = t;
-    return g - m.force(c) / mass;
-  };
-  double z = 0, v = c0.vc_m_s, t = 0;
-  double apeak = -acc(0, v, 0);
-  while (t < t_max_s) {
-    const double k1v = acc(z, v, t), k1z = v;
-    const double k2v = acc(z + 0.5 * dt * k1z, v + 0.5 * dt * k1v, t + 0.5 * dt), k2z = v + 0.5 * dt * k1v;
-    const double k3v = acc(z + 0.5 * dt * k2z, v + 0.5 * dt * k2v, t + 0.5 * dt), k3z = v + 0.5 * dt * k2v;
-    const double k4v = acc(z + dt * k3z, v + dt * k3v, t + dt), k4z = v + dt * k3v;
-    const double vn = v + dt / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
-    const double zn = z + dt / 6 * (k1z + 2 * k2z + 2 * k3z + k4z);
-    if (vn <= 0) {
-      const double f = v / (v - vn);
-      p.tstop_s = t + f * dt;
-      p.zstop_m = z + f * (zn - z);
-      p.stopped = true;
-      apeak = std::max(apeak, -acc(p.zstop_m, 0.0, p.tstop_s));
-      p.apeak_m_s2 = apeak;
-      return p;
-    }
-    z = zn;
-    v = vn;
-    t += dt;
-    apeak = std::max(apeak, -acc(z, v, t));
-    if (z > 10.0 * std::max(c0.fill_height_m, c0.diameter_m)) break;
-  }
-  p.apeak_m_s2 = apeak;
-  return p;
-}
-
 HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds, unsigned seed,
                        bool with_predictions) {
   HeldOut h;
@@ -389,7 +347,7 @@ HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds, unsi
     for (std::size_t i = 0; i < mask.size(); ++i) {
       if (mask[i]) continue;
       h.trace_mse[i] = trial_trace_mse(m, c.trials[i]);
-      if (with_predictions) h.pred[i] = predict(m, c.trials[i].info);
+      if (with_predictions) h.pred[i] = predict(m, c.trials[i]);
     }
   }
   return h;

@@ -54,9 +54,18 @@ struct Prediction {
   double zstop_m = NAN, tstop_s = NAN, apeak_m_s2 = NAN;
   bool stopped = false;
 };
-/// Integrates m dv/dt = m g - R from the trial's impact speed (RK4) to the stop.
+/// Integrates m dv/dt = m g - R from the trial's impact speed (RK4) to the stop; apeak is the
+/// largest deceleration of the integrated motion.
 Prediction predict(const FittedModel& m, const Trial& info);
 Prediction predict(const FittedModel& m, const TermContext& trial, double t_max_s = 10.0);
+/// The metrics of a measured trial predicted the way it was measured (issue 13): zstop and tstop
+/// of the integrated motion, apeak read off the model's record (model_record) processed like the
+/// trial (process_trial's options), so that the 500 Hz filter rounds both peaks alike.
+Prediction predict(const FittedModel& m, const MeasuredTrial& t);
+/// The model's record of a trial: on the trial's sample grid, free fall before the measured
+/// collision start, Eq. 1 from the measured vc after it, rest after the model's stop; the trial's
+/// source, and own velocity and depth when the trial's record has them (DEM).
+Trace model_record(const FittedModel& m, const MeasuredTrial& t);
 
 /// Per-trial held-out results of grouped K-fold cross-validation (whole trials held out).
 struct HeldOut {

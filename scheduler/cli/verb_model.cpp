@@ -221,7 +221,7 @@ void setup_model(CLI::App& app) {
     results::Table t({"trial_id", "gravity_m_s2", "vc_m_s", "fill_height_m", "trace_rms_m_s2", "dzstop_mm",
                       "dtstop_ms", "dapeak_m_s2"});
     for (const auto& tr : c.trials) {
-      const auto p = results::predict(fm, tr.info);
+      const auto p = results::predict(fm, tr);  // apeak as measured (filtered like the trial)
       const auto& m = tr.processed.metrics;
       t.add({tr.info.trial_id, num(tr.info.gravity_m_s2), num(m.vc_m_s), num(tr.info.fill_height_m),
              num(std::sqrt(results::trial_trace_mse(fm, tr)), 3), p.stopped ? num(1e3 * (p.zstop_m - m.zstop_m), 3) : "nan",

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "results/model/model.h"
@@ -245,3 +246,49 @@ TEST(Discovery, StructureNoCandidateExplainsIsReportedWithWhereItLies) {
   EXPECT_NE(disc.verdict.find("structure left that no candidate explains"), std::string::npos) << disc.verdict;
   EXPECT_NE(disc.verdict.find("time_since_contact_s"), std::string::npos) << disc.verdict;
 }
+
+namespace {
+
+/// Every held-out error of base+term below that of base (issue 13 item 2), with the figures.
+void expect_every_error_falls(const Campaign& c, const std::string& term, const std::string& label) {
+  const auto b = summarize(c, cross_validate(parse_model("base"), c, 6, 1));
+  const auto a = summarize(c, cross_validate(parse_model("base+" + term), c, 6, 1));
+  SCOPED_TRACE(label + ": base -> base+" + term);
+  std::cout << label << " base -> base+" << term << ": trace " << b.trace_rel_pct << " -> " << a.trace_rel_pct
+            << " %, zstop " << b.zstop_rel_pct << " -> " << a.zstop_rel_pct << " %, tstop " << b.tstop_rel_pct
+            << " -> " << a.tstop_rel_pct << " %, apeak " << b.apeak_rel_pct << " -> " << a.apeak_rel_pct << " %\n";
+  EXPECT_LT(a.trace_rms_m_s2, b.trace_rms_m_s2);
+  EXPECT_LT(a.zstop_rms_mm, b.zstop_rms_mm);
+  EXPECT_LT(a.tstop_rms_ms, b.tstop_rms_ms);
+  EXPECT_LT(a.apeak_rms_m_s2, b.apeak_rms_m_s2);
+  EXPECT_LT(a.zstop_rel_pct, b.zstop_rel_pct);
+  EXPECT_LT(a.tstop_rel_pct, b.tstop_rel_pct);
+  EXPECT_LT(a.apeak_rel_pct, b.apeak_rel_pct);
+}
+
+}  // namespace
+
+// Issue 13 item 2: on the dev campaign the held-out apeak error rose from 22 % to 28 % when depth
+// friction was added, because the model's apeak was the unfiltered peak of Eq. 1 while the
+// measured one is read off the 500 Hz filtered record. Predicted as measured, every error falls.
+TEST(HeldOut, EveryErrorFallsWhenDepthFrictionIsAddedOnTheDevCampaign) {
+  GRAVSWEEP_REQUIRE_DEV_CAMPAIGN();
+  expect_every_error_falls(dev(), "depth_friction", "dev");
+}
+
+class HiddenTermErrors : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(HiddenTermErrors, EveryHeldOutErrorFallsWhenItIsAdded) {
+  const std::string term = GetParam();
+  TempDir d;
+  SynthOptions o = small_synth(21);
+  if (term == "bottom_stiffening") o.fill_height_m = {0.05, 0.06, 0.08};  // shallow beds, cycled
+  write_synthetic_campaign(d.str(), parse_model("base+" + term), o);
+  const Campaign c = load_campaign(d.str());
+  ASSERT_EQ(c.trials.size(), 36u);
+  expect_every_error_falls(c, term, "synth");
+}
+
+INSTANTIATE_TEST_SUITE_P(EachNamedTerm, HiddenTermErrors,
+                         ::testing::Values("depth_friction", "gravity_depth_friction", "viscous_drag",
+                                           "immersion_drag", "bottom_stiffening", "cohesion"));
