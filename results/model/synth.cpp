@@ -48,7 +48,7 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
   csv << header << "\n";
   std::ofstream truth_csv(fs::path(dir) / kSynthTruthFile);
   if (!truth_csv) throw std::runtime_error(fmt::format("{}: cannot write {}", dir, kSynthTruthFile));
-  truth_csv << "trial_id,zstop_m,tstop_s\n";
+  truth_csv << "trial_id,zstop_m,tstop_s,t_contact_s\n";
   // The sensor's unit: the trial's g, or the standard g for a fixed-range sensor.
   constexpr double kStandardGravity_m_s2 = 9.81;
   int id = 0;
@@ -150,7 +150,7 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
         const double v_rep = v0 * (1.0 + o.speed_spread * n01(rng));
         csv << fmt::format("{},{},{},{:.4f},{},{},{},{},{},{}\n", name, rel, g, v_rep, H, o.mass_kg,
                            o.diameter_m, o.grain_diameter_m, o.bulk_density_kg_m3, fs_hz);
-        truth_csv << fmt::format("{},{:.9g},{:.9g}\n", name, zstop, tstop);
+        truth_csv << fmt::format("{},{:.9g},{:.9g},{:.9g}\n", name, zstop, tstop, t_free);
       }
     }
   }

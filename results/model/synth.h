@@ -41,7 +41,8 @@ FittedModel truth_model(const ModelSpec& spec, const std::vector<double>& gravit
                         double mass_kg, double diameter_m);
 
 /// The file of true metrics that write_synthetic_campaign puts beside trials.csv: trial_id,
-/// zstop_m, tstop_s (contact to rest of the integrated motion, before noise and filtering).
+/// zstop_m, tstop_s (contact to rest of the integrated motion, before noise and filtering) and
+/// t_contact_s (the contact on the trace's clock).
 inline constexpr const char* kSynthTruthFile = "truth.csv";
 
 /// Writes <dir>/trials.csv, <dir>/traces/*.csv and <dir>/truth.csv (kSynthTruthFile); returns the

@@ -2,8 +2,9 @@
 // Butterworth low-pass at 500 Hz, collision start = no longer in free fall, collision end =
 // acceleration below 0.1 g of the local g (and the speed below 10 % of vc, see MetricOptions; for
 // lab records searched back from the rest at the record's end, at a level above the noise),
-// velocity and depth by integrating the acceleration from the impact speed, and the metrics vc,
-// apeak, zstop, tstop. Conventions in trace.h (z down, a up); the steps in trace_steps.h.
+// velocity and depth by integrating the acceleration from the impact speed (brought to rest
+// after the collision), and the metrics vc, apeak, zstop, tstop. Conventions in trace.h (z down,
+// a up); the steps in trace_steps.h.
 #include "results/processing/trace.h"
 
 #include "results/processing/trace_steps.h"
@@ -151,13 +152,13 @@ struct PassResult {
 
 PassResult collision_pass(const Trace& trace, const MetricOptions& o, const std::vector<double>& af,
                           const std::vector<double>& a, std::size_t ipk, std::size_t w, double fs,
-                          double sigma_ff, double noise) {
+                          double sigma_ff, double step_rise_s) {
   const auto& t = trace.t_s;
   const std::size_t n = t.size();
   const double g = o.gravity_m_s2;
   const double thr = std::max(6.0 * sigma_ff, 0.03 * g);
   PassResult r;
-  r.start = trace.contact_start_s ? contact_start(t, *trace.contact_start_s) : free_fall_start(t, a, ipk, g, thr, w);
+  r.start = trace.contact_start_s ? contact_start(t, *trace.contact_start_s) : free_fall_start(t, a, ipk, g, thr, w, step_rise_s);
   // Free-fall segment: up to the edge width before the start.
   const std::size_t ff_end = r.start.i_start > w + 1 ? r.start.i_start - w - 1 : 0;
   // End: acceleration below end_threshold_g * g after the peak, staying there for 2 ms (at least
@@ -182,17 +183,27 @@ PassResult collision_pass(const Trace& trace, const MetricOptions& o, const std:
   if (!v_pass.empty() && o.end_from_rest) {
     // A lab record (velocity integrated from the impact speed, issue 13): the end level of the
     // local g raised above the noise, the end searched back from the rest at the record's end,
-    // accepted where the integrated speed is down too.
-    ec.end_level_m_s2 = end_level(o.end_threshold_g, g, noise);
+    // accepted where the integrated speed is down too. That speed is known to within g times the
+    // start's uncertainty (an edge width; 0.01 m/s for a slow impact at 1 g, 1/10 of its vc), so
+    // that much is allowed on top: after the last exceedance nothing but rest or a truncated
+    // record's coasting follows, and no projectile coasts this slowly for long at 0.1 g.
+    ec.end_level_m_s2 = end_level(o.end_threshold_g, g, record_noise(af, ff_end));
+    const double v_tol_m_s = g * static_cast<double>(w) / fs;
     const std::optional<std::size_t> jb = last_exceedance_end(a, ipk, ec.end_level_m_s2, ec.hold);
-    if (jb && v_pass[*jb] <= ec.v_end_m_s) j = jb;
+    if (jb && v_pass[*jb] <= ec.v_end_m_s + v_tol_m_s) j = jb;
   }
   if (!j) j = end_sample(a, ipk, ec);
-  if (!j)
+  if (!j) {
+    // The level, when the noise raised it above the paper's, is part of the reason.
+    const std::string level =
+        ec.end_level_m_s2 > o.end_threshold_g * g
+            ? fmt::format(" (raised to {:.3g} m/s2, {} sigma of the record's noise)", ec.end_level_m_s2, kEndNoiseSigmas)
+            : "";
     throw TraceError(fmt::format("trace shorter than the collision: after the peak at t = {:.4f} s the acceleration "
-                                 "never stays below {} g with the speed below {} of the collision speed",
-                                 t[ipk], o.end_threshold_g, o.end_speed_fraction),
+                                 "never stays below {} g{} with the speed below {} of the collision speed",
+                                 t[ipk], o.end_threshold_g, level, o.end_speed_fraction),
                      n - 1);
+  }
   r.end = end_edge(t, a, *j, r.start.i_start, w, ec.end_level_m_s2);
   r.bias = bias_from_segments(af, g, ff_end, rest_begin(r.end.i_end, w, n));
   return r;
@@ -226,12 +237,12 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
   // threshold crossing, as the paper does.
   const std::size_t w = edge_width(fs, o.cutoff_hz);
   double sigma_ff = 0;
-  const double noise = record_noise(af, ipk);
+  const double step_rise_s = filter_step_rise_s(fs, o);
   PassResult pass;
   std::vector<double> a(n);
   for (int k = 0; k < 3; ++k) {
     for (std::size_t i = 0; i < n; ++i) a[i] = af[i] - bias;
-    pass = collision_pass(trace, o, af, a, ipk, w, fs, sigma_ff, noise);
+    pass = collision_pass(trace, o, af, a, ipk, w, fs, sigma_ff, step_rise_s);
     if (pass.bias.sigma_free_fall_m_s2) sigma_ff = *pass.bias.sigma_free_fall_m_s2;
     if (pass.bias.any && sensor) bias = pass.bias.bias_m_s2;
     out.free_fall_samples = pass.bias.free_fall_samples;
@@ -256,9 +267,13 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
           "no velocity in the trace and no impact velocity given: cannot integrate a into v and z");
     m.vc_m_s = *o.impact_velocity_m_s;
     integrate_from_start(t, a, i_start, m.t_start_s, m.vc_m_s, out.velocity_down_m_s, out.depth_m);
+    // At rest the integrated speed reads zero (trace_steps.h): what it reads is removed from v and z.
+    const double end_tolerance_m_s = 0.5 * pass.end.step_height_m_s2 / fs;  // half a sample of the end step
+    out.rest_speed_offset_m_s = bring_to_rest(t, rest_begin(i_end, w, n), m.t_start_s, end_tolerance_m_s,
+                                              out.velocity_down_m_s, out.depth_m);
   }
   m.apeak_m_s2 = peak_acceleration(a, out.velocity_down_m_s, i_start, i_end, pass.start.step, pass.end.step, w,
-                                   m.vc_m_s, g);
+                                   m.vc_m_s - out.rest_speed_offset_m_s, g);
   m.zstop_m = interp_at(t, out.depth_m, m.t_end_s);
   const Rebound rb = rebound_of(out.velocity_down_m_s, out.depth_m, i_start, i_end, m.vc_m_s, o);
   m.rebound = rb.rebound;

@@ -82,6 +82,9 @@ struct ProcessedTrace {
   double bias_m_s2 = 0;                   ///< removed sensor bias
   std::size_t free_fall_samples = 0;      ///< samples used for the bias from free fall
   std::size_t rest_samples = 0;           ///< samples used for the bias from rest
+  /// Lab records integrated from the impact speed: the speed the integration still read at rest,
+  /// removed from velocity and depth (trace_steps::bring_to_rest); 0 for a record with its own.
+  double rest_speed_offset_m_s = 0;
   std::size_t i_start = 0;                ///< last sample before the collision start
   std::size_t i_end = 0;                  ///< first sample after the collision end
 };

@@ -66,7 +66,7 @@ std::size_t contact_peak(const std::vector<double>& af, double g) {
 }
 
 double initial_bias(const std::vector<double>& af, std::size_t ipk, double g) {
-  const std::size_t head = std::max<std::size_t>(1, ipk / 3);
+  const std::size_t head = std::clamp<std::size_t>(ipk / 3, 1, kFreeFallProbeSamples);
   std::vector<double> h(af.begin(), af.begin() + static_cast<std::ptrdiff_t>(head));
   std::nth_element(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(h.size() / 2), h.end());
   return h[h.size() / 2] + g;
@@ -101,8 +101,32 @@ CollisionStart contact_start(const std::vector<double>& t, double t_contact_s) {
   return {i, t_contact_s, false};
 }
 
+double filter_step_rise_s(double fs_hz, const MetricOptions& o) {
+  if (!(o.cutoff_hz > 0 && o.cutoff_hz < 0.5 * fs_hz)) return 0.8 / fs_hz;  // a jump between two samples
+  const std::size_t half = 10 * edge_width(fs_hz, o.cutoff_hz);
+  std::vector<double> x(2 * half, 0.0), t(2 * half);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    t[i] = static_cast<double>(i) / fs_hz;
+    if (i >= half) x[i] = 1.0;
+  }
+  const std::vector<double> y = butterworth_lowpass(x, fs_hz, o.cutoff_hz, o.filter_order);
+  // Up to its overshoot, as free_fall_start measures an edge.
+  return rise_10_90_s(t, y, 0, y.size() - 1, 0.0, *std::max_element(y.begin(), y.end()));
+}
+
+double rise_10_90_s(const std::vector<double>& t, const std::vector<double>& y, std::size_t b, std::size_t e,
+                    double foot, double top) {
+  const double lo = foot + 0.1 * (top - foot), hi = foot + 0.9 * (top - foot);
+  std::size_t k = b;
+  while (k < e && y[k + 1] < lo) ++k;
+  const double t_lo = k < e ? crossing_time(t, y, k, lo) : t[e];
+  while (k < e && y[k + 1] < hi) ++k;
+  const double t_hi = k < e ? crossing_time(t, y, k, hi) : t[e];
+  return t_hi - t_lo;
+}
+
 CollisionStart free_fall_start(const std::vector<double>& t, const std::vector<double>& a, std::size_t ipk,
-                               double g, double thr, std::size_t w) {
+                               double g, double thr, std::size_t w, double step_rise_s) {
   const std::size_t n = t.size();
   std::size_t i = ipk;
   while (i > 0 && a[i] > -g + thr) --i;
@@ -113,11 +137,38 @@ CollisionStart free_fall_start(const std::vector<double>& t, const std::vector<d
   const std::size_t k_hi = std::min(n - 1, i + 2 * w);
   const double top = *std::max_element(a.begin() + static_cast<std::ptrdiff_t>(i + 1),
                                        a.begin() + static_cast<std::ptrdiff_t>(k_hi + 1));
+  if (!(top + g > 4.0 * thr)) return cs;
   const double half = -g + 0.5 * (top + g);
   std::size_t k = i;
   while (k < k_hi && a[k + 1] < half) ++k;
-  if (k < k_hi && k + 1 <= i + w && top + g > 4.0 * thr) cs = {k, crossing_time(t, a, k, half), true};
-  return cs;
+  if (k == k_hi) return cs;
+  // The edge's own 10-90 % rise, the filter's taken out (rise times add in quadrature), is 0.8 of
+  // a linear ramp's duration; the ramp starts half of that before its half height.
+  const double rise = rise_10_90_s(t, a, i, k_hi, -g, top);
+  const double ramp_s = std::sqrt(std::max(0.0, rise * rise - step_rise_s * step_rise_s)) / 0.8;
+  double t_onset = crossing_time(t, a, k, half) - 0.5 * ramp_s;
+  const bool step = ramp_s <= step_rise_s;
+  if (!step) {
+    // Slower than the filter: the threshold crossing lags the ramp's foot by thr over its slope
+    // (issue 13: in high gravity g times that lag, carried through the integration, is several %
+    // of a slow impact's zstop). The ramp extrapolated back to -g from its crossings of 20 and
+    // 40 % of its height (at least thr and 2 thr), above the foot that the filter rounds.
+    const double d1 = std::max(thr, 0.2 * (top + g)), d2 = std::max(2.0 * thr, 0.4 * (top + g));
+    std::size_t k1 = i;
+    while (k1 < k_hi && a[k1 + 1] < -g + d1) ++k1;
+    std::size_t k2 = k1;
+    while (k2 < k_hi && a[k2 + 1] < -g + d2) ++k2;
+    const double t1 = crossing_time(t, a, k1, -g + d1), t2 = crossing_time(t, a, k2, -g + d2);
+    t_onset = t1 - (t2 - t1) * d1 / (d2 - d1);
+    // The filter rounds the foot, so the threshold may be crossed a little before it; beyond half
+    // the filter's rise either way, or more than an edge width back, it is not a ramp out of free fall.
+    if (i < w || t_onset < t[i - w] || t_onset > cs.t_start_s + 0.5 * step_rise_s) return cs;
+  } else if (t_onset <= cs.t_start_s) {
+    return cs;
+  }
+  std::size_t j = step ? k : i;
+  while (j > 0 && t[j] > t_onset) --j;
+  return {j, t_onset, step};
 }
 
 std::size_t end_hold_samples(double fs_hz) {
@@ -149,10 +200,9 @@ double end_level(double end_threshold_g, double g, double noise_sigma) {
   return std::max(end_threshold_g * g, kEndNoiseSigmas * noise_sigma);
 }
 
-double record_noise(const std::vector<double>& af, std::size_t ipk) {
-  constexpr std::size_t kMinHead = 5;
-  const std::size_t head = ipk / 3;
-  if (head >= kMinHead) return robust_sigma(af, 0, head);
+double record_noise(const std::vector<double>& af, std::size_t ff_end) {
+  constexpr std::size_t kMinFreeFall = 5;
+  if (ff_end >= kMinFreeFall) return robust_sigma(af, 0, std::min(ff_end, af.size()));
   return robust_sigma(af, af.size() - af.size() / 4, af.size());
 }
 
@@ -177,6 +227,7 @@ CollisionEnd end_edge(const std::vector<double>& t, const std::vector<double>& a
       if (k + 1 <= j) {
         e.step = true;
         e.t_end_s = crossing_time(t, a, k, 0.5 * pre);
+        e.step_height_m_s2 = pre;
       }
     }
   }
@@ -199,7 +250,7 @@ BiasEstimate bias_from_segments(const std::vector<double>& af, double g, std::si
     w_sum += static_cast<double>(ff_end);
     b.sigma_free_fall_m_s2 = stddev_of(af, 0, ff_end);
   }
-  if (b.rest_samples >= 10) {
+  if (b.rest_samples >= kMinRestSamples) {
     b_sum += static_cast<double>(b.rest_samples) * mean_of(af, rb, n);
     w_sum += static_cast<double>(b.rest_samples);
   }
@@ -228,6 +279,19 @@ void integrate_from_start(const std::vector<double>& t, const std::vector<double
     v[k] = v[k + 1] + 0.5 * (a[k] + a[k + 1]) * dt;
     z[k] = z[k + 1] - 0.5 * (v[k] + v[k + 1]) * dt;
   }
+}
+
+double bring_to_rest(const std::vector<double>& t, std::size_t rb, double t_start, double end_tolerance,
+                     std::vector<double>& v, std::vector<double>& z) {
+  const std::size_t n = v.size();
+  if (rb + kMinRestSamples > n) return 0.0;
+  const double reading = mean_of(v, rb, n);
+  const double c = std::copysign(std::max(0.0, std::abs(reading) - end_tolerance), reading);
+  for (std::size_t k = 0; k < n; ++k) {
+    v[k] -= c;
+    z[k] -= c * (t[k] - t_start);
+  }
+  return c;
 }
 
 double peak_acceleration(const std::vector<double>& a, const std::vector<double>& v, std::size_t i_start,

@@ -33,8 +33,11 @@ std::size_t edge_width(double fs_hz, double cutoff_hz);
 /// stand clear of free fall (above -g/2): the projectile never makes contact.
 std::size_t contact_peak(const std::vector<double>& af, double g_m_s2);
 
-/// First guess of the sensor bias (m/s2): the median of the first third of the record before the
-/// peak reads -g + bias (the record starts in free fall).
+/// First guess of the sensor bias (m/s2): the record's head reads -g + bias (it starts in free
+/// fall); its median over the samples check_starts_in_free_fall probes (up to
+/// kFreeFallProbeSamples, at most a third of the way to the peak). Not the whole first third: a
+/// slow low-gravity collision peaks late, and that third held more collision than free fall
+/// (issue 13: the bias came out 1.4 m/s2 at 1.2 m/s2 and the start was placed inside the collision).
 double initial_bias(const std::vector<double>& af, std::size_t ipk, double g_m_s2);
 
 /// A lab record starts in free fall and ends at rest: its first samples read about g below its
@@ -55,11 +58,27 @@ struct CollisionStart {
 };
 /// DEM records: the engine's first contact (Trace::contact_start_s).
 CollisionStart contact_start(const std::vector<double>& t, double t_contact_s);
+/// The time (s) y takes to rise from 10 to 90 % of the way from foot to top, searched forward
+/// over [b, e] (linear interpolation between samples; t[e] for a level it does not reach).
+double rise_10_90_s(const std::vector<double>& t, const std::vector<double>& y, std::size_t b, std::size_t e,
+                    double foot, double top);
+/// The 10-90 % rise time (s), up to its overshoot, of the options' low-pass on a unit step
+/// sampled at fs_hz: the
+/// fastest an edge can rise in the filtered record (unfiltered: 0.8 sample, a jump between two
+/// samples read by linear interpolation).
+double filter_step_rise_s(double fs_hz, const MetricOptions& o);
 /// The paper's rule (Sect. 2.3): the last sample before the peak ipk still within the free-fall
-/// band -g + thr; a step edge (rising within the edge width w) is located at its half height.
-/// Throws std::invalid_argument when no sample before the peak reads -g.
+/// band -g + thr, the start at the threshold crossing. An edge as fast as the filter (the ramp it
+/// is, the filter's own rise step_rise_s taken out of its 10-90 % rise, lasts no longer than
+/// step_rise_s; its height reached within 2w samples) starts at its onset instead: its half height
+/// less half that ramp. The filter's spread and ringing cross the threshold early there (about
+/// two samples at 1.4 kHz); a contact that ramps in over several samples (a slow impact in high
+/// gravity, issue 13) starts at its foot, the threshold crossing extrapolated back along the
+/// ramp (the crossings of thr and 2 thr), not ms later at its half height. `step` says the
+/// half-height onset was used. Throws std::invalid_argument when no sample before the peak
+/// reads -g.
 CollisionStart free_fall_start(const std::vector<double>& t, const std::vector<double>& a, std::size_t ipk,
-                               double g_m_s2, double thr_m_s2, std::size_t w);
+                               double g_m_s2, double thr_m_s2, std::size_t w, double step_rise_s);
 
 /// What the collision end is searched with.
 struct EndCriteria {
@@ -84,9 +103,11 @@ double robust_sigma(const std::vector<double>& x, std::size_t b, std::size_t e);
 inline constexpr double kEndNoiseSigmas = 5.0;
 double end_level(double end_threshold_g, double g_m_s2, double noise_sigma_m_s2);
 
-/// The filtered record's noise (m/s2): robust_sigma of its head before the peak (free fall,
-/// at least 5 samples) or else of its last quarter (rest).
-double record_noise(const std::vector<double>& af, std::size_t ipk);
+/// The filtered record's noise (m/s2): robust_sigma of its free-fall segment [0, ff_end) (at
+/// least 5 samples) or else of its last quarter (rest). Not of a fixed share of the way to the
+/// peak: a slow low-gravity collision peaks late, and that share held the collision's own
+/// fluctuations, which read as noise 50 times the sensor's and raised the end level above them.
+double record_noise(const std::vector<double>& af, std::size_t ff_end);
 
 /// Lab records with an integrated velocity: the collision end searched back from the end of the
 /// record, the paper's rule read as "the acceleration falls below the level and stays there": the
@@ -102,6 +123,7 @@ struct CollisionEnd {
   std::size_t i_end = 0;
   double t_end_s = 0;
   bool step = false;
+  double step_height_m_s2 = 0;  ///< a step's height (the level before it), 0 otherwise
 };
 CollisionEnd end_edge(const std::vector<double>& t, const std::vector<double>& a, std::size_t j,
                       std::size_t i_start, std::size_t w, double end_level_m_s2);
@@ -110,8 +132,12 @@ CollisionEnd end_edge(const std::vector<double>& t, const std::vector<double>& a
 /// its edge, so that late settling stays out of it.
 std::size_t rest_begin(std::size_t i_end, std::size_t w, std::size_t n);
 
+/// Fewest samples of rest that the bias and bring_to_rest use.
+inline constexpr std::size_t kMinRestSamples = 10;
+
 /// The sensor bias from free fall [0, ff_end) (reads -g + bias) and rest [rest_begin, n) (reads
-/// bias), weighted by sample count; segments under 3 (free fall) or 10 (rest) samples are unused.
+/// bias), weighted by sample count; segments under 3 (free fall) or kMinRestSamples (rest)
+/// samples are unused.
 struct BiasEstimate {
   double bias_m_s2 = 0;
   bool any = false;           ///< false: neither segment long enough (keep the previous bias)
@@ -126,6 +152,21 @@ BiasEstimate bias_from_segments(const std::vector<double>& af, double g_m_s2, st
 /// i_start and i_start + 1).
 void integrate_from_start(const std::vector<double>& t, const std::vector<double>& a, std::size_t i_start,
                           double t_start_s, double v0_m_s, std::vector<double>& v, std::vector<double>& z);
+
+/// Lab records (issue 13): the integrated velocity brought to rest. After the collision the
+/// projectile rests, so the speed integrated from the reported impact speed must read zero over
+/// the rest segment [rest_begin, n). What it reads is, to first order, a constant offset from the
+/// contact on: the reported speed's own error (0.5 % of vc is 5 % of zstop in low gravity, where
+/// the collision lasts about ten times zstop / vc), a step contact located only to within a
+/// sample, the part of the contact the zero-phase filter spreads before the start, g times an
+/// error of the start. That offset is removed from v and, integrated from t_start, from z. One
+/// part of the reading is not such an offset: a step at the end (Eq. 1 stops with a jump of the
+/// deceleration) is located to within a sample too, which shifts v after the end only (up to
+/// half a sample times its height, `end_tolerance_m_s`); that much of the reading is left alone.
+/// Returns the offset removed (m/s); 0, and v and z unchanged, when the rest segment has fewer
+/// than kMinRestSamples samples.
+double bring_to_rest(const std::vector<double>& t, std::size_t rest_begin, double t_start_s, double end_tolerance_m_s,
+                     std::vector<double>& v, std::vector<double>& z);
 
 /// The peak: the largest filtered acceleration of the collision [i_start + 1, i_end], leaving out
 /// the filter's ringing next to step edges; at a step-like contact the early samples beyond the

@@ -3,12 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <sys/wait.h>
+#include <vector>
 
 #include "results_helpers.h"
 #include "tests/common/png_check.h"
@@ -128,4 +130,47 @@ TEST(Cli, CheckDetectionCountsRankedFirstAndNullReports) {
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("immersion_drag,1,1,1,1"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("(nothing hidden),1,-,-,0"), std::string::npos) << r.out;
+}
+
+// Issue 13: `synth --rest-tail` sets how long the record runs on after the stop, truth.csv holds
+// each trial's true stop, and `--fixed-range-sensor` keeps the noise in units of 9.81 m/s2 at a
+// low-gravity level instead of scaling it down with g.
+TEST(Cli, SynthRestTailFixedRangeSensorAndTruth) {
+  TempDir d;
+  // The last sample's time and the standard deviation of the last `n` accelerations of a trace.
+  auto tail = [](const fs::path& trace, std::size_t n, double& t_last_s) {
+    std::ifstream in(trace);
+    std::string line;
+    std::getline(in, line);
+    std::vector<double> a;
+    while (std::getline(in, line)) {
+      t_last_s = std::stod(line.substr(0, line.find(',')));
+      a.push_back(std::stod(line.substr(line.find(',') + 1)));
+    }
+    double m = 0, s = 0;
+    for (std::size_t i = a.size() - n; i < a.size(); ++i) m += a[i] / static_cast<double>(n);
+    for (std::size_t i = a.size() - n; i < a.size(); ++i) s += (a[i] - m) * (a[i] - m);
+    return std::sqrt(s / static_cast<double>(n - 1));
+  };
+  for (const bool fixed : {false, true}) {
+    const std::string c = d.str() + (fixed ? "/fixed" : "/scaled");
+    const std::string args = "synth --out '" + c + "' --gravity 0.1 --speeds 0.5 --repeats 1 --sensor-noise 0.02 --rest-tail 0.05";
+    ASSERT_EQ(run(args + (fixed ? " --fixed-range-sensor" : "")).code, 0);
+    std::ifstream truth(c + "/truth.csv");
+    std::string header, row;
+    std::getline(truth, header);
+    std::getline(truth, row);
+    EXPECT_EQ(header, "trial_id,zstop_m,tstop_s,t_contact_s");
+    ASSERT_EQ(row.rfind("S001,", 0), 0u) << row;
+    double zstop_m = 0, tstop_s = 0, t_contact_s = 0;
+    ASSERT_EQ(std::sscanf(row.c_str(), "S001,%lf,%lf,%lf", &zstop_m, &tstop_s, &t_contact_s), 3) << row;
+    EXPECT_GT(zstop_m, 0.01);  // 0.5 m/s into a bed at 0.1 m/s2: centimetres, about a second
+    EXPECT_GT(tstop_s, 0.3);
+    // 50 ms of rest at 1400 Hz after the stop: 70 samples of noise alone, 0.02 of 0.1 or of 9.81 m/s2.
+    double t_last_s = 0;
+    const double sd = tail(c + "/traces/S001.csv", 60, t_last_s);
+    EXPECT_NEAR(t_last_s, t_contact_s + tstop_s + 0.05, 2.0 / 1400);
+    if (fixed) EXPECT_NEAR(sd, 0.02 * 9.81, 0.3 * 0.02 * 9.81) << "fixed range";
+    else EXPECT_NEAR(sd, 0.02 * 0.1, 0.3 * 0.02 * 0.1) << "scaled with g";
+  }
 }
