@@ -329,6 +329,16 @@ double trial_trace_mse(const FittedModel& m, const MeasuredTrial& t) {
   return n ? s / static_cast<double>(n) : NAN;
 }
 
+std::vector<const std::vector<double>*> same_level_fluctuations(const Campaign& c,
+                                                              const std::vector<std::vector<double>>& fluct,
+                                                              std::size_t i) {
+  std::vector<const std::vector<double>*> out;
+  for (std::size_t j = 0; j < fluct.size() && out.size() < kMaxFluctuationTrials; ++j)
+    if (j != i && !fluct[j].empty() && same_gravity_level(c.trials[j].info.gravity_m_s2, c.trials[i].info.gravity_m_s2))
+      out.push_back(&fluct[j]);
+  return out;
+}
+
 HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds, unsigned seed,
                        bool with_predictions) {
   HeldOut h;
@@ -344,10 +354,14 @@ HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds, unsi
     }
     if (!any) continue;
     const FittedModel m = fit_model(spec, c, mask);
+    // The training trials' fluctuations about the model, for apeak as measured (model.h).
+    std::vector<std::vector<double>> fluct(with_predictions ? c.trials.size() : 0);
+    for (std::size_t j = 0; j < fluct.size(); ++j)
+      if (mask[j]) fluct[j] = relative_residuals(m, c.trials[j]);
     for (std::size_t i = 0; i < mask.size(); ++i) {
       if (mask[i]) continue;
       h.trace_mse[i] = trial_trace_mse(m, c.trials[i]);
-      if (with_predictions) h.pred[i] = predict(m, c.trials[i]);
+      if (with_predictions) h.pred[i] = predict(m, c.trials[i], same_level_fluctuations(c, fluct, i));
     }
   }
   return h;

@@ -62,12 +62,31 @@ Prediction predict(const FittedModel& m, const TermContext& trial, double t_max_
 /// of the integrated motion, apeak read off the model's record (model_record) processed like the
 /// trial (process_trial's options), so that the 500 Hz filter rounds both peaks alike.
 Prediction predict(const FittedModel& m, const MeasuredTrial& t);
+/// The same with the grain-scale fluctuation of other trials about the model (relative_residuals):
+/// the measured apeak is the largest value of a fluctuating record (on synth campaigns 20 % of the
+/// force, so 1.3-2 times the smooth peak), which the smooth model record never reaches; with the
+/// fluctuations the model's record has the same kind of largest value. apeak is the mean of what
+/// is read off the model's record with each sequence (of at least kMinFluctuationSamples) laid
+/// over its collision, times the model's force per mass.
+inline constexpr std::size_t kMinFluctuationSamples = 10;
+Prediction predict(const FittedModel& m, const MeasuredTrial& t, const std::vector<const std::vector<double>*>& fluct);
+/// A trial's fluctuation about the model over its fit window: (a_meas - a_model) / (R / m),
+/// clamped to [-1, 1] (samples where the model's force is not positive are left out).
+std::vector<double> relative_residuals(const FittedModel& m, const MeasuredTrial& t);
 /// The model's record of a trial: on the trial's sample grid, free fall before the measured
 /// collision start, Eq. 1 from the measured vc after it, rest after the model's stop; the trial's
 /// source, and own velocity and depth when the trial's record has them (DEM).
 Trace model_record(const FittedModel& m, const MeasuredTrial& t);
 
-/// Per-trial held-out results of grouped K-fold cross-validation (whole trials held out).
+/// Up to kMaxFluctuationTrials of the sequences in `fluct` (one per trial of c, empty for those
+/// not to use) from trials at trial i's gravity level other than i itself, in trial order.
+inline constexpr std::size_t kMaxFluctuationTrials = 12;
+std::vector<const std::vector<double>*> same_level_fluctuations(const Campaign& c,
+                                                              const std::vector<std::vector<double>>& fluct,
+                                                              std::size_t i);
+
+/// Per-trial held-out results of grouped K-fold cross-validation (whole trials held out); apeak
+/// as measured with the training trials' fluctuations at the trial's level.
 struct HeldOut {
   std::vector<double> trace_mse;   ///< per trial
   std::vector<Prediction> pred;    ///< per trial, from the model fitted without that trial

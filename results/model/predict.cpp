@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include "results/model/model.h"
 #include "results/model/model_internal.h"
@@ -75,7 +76,10 @@ Prediction predict(const FittedModel& m, const TermContext& c0, double t_max_s) 
   return p;
 }
 
-Trace model_record(const FittedModel& m, const MeasuredTrial& t) {
+namespace {
+
+/// model_record, with the samples where the model's projectile is in the collision marked.
+Trace model_record_marked(const FittedModel& m, const MeasuredTrial& t, std::vector<bool>& in_collision) {
   const auto& grid = t.raw.t_s;
   const double t0 = t.processed.metrics.t_start_s;  // contact, as measured
   TermContext c0 = context(t.info);
@@ -86,11 +90,12 @@ Trace model_record(const FittedModel& m, const MeasuredTrial& t) {
   rec.source = t.info.source;
   rec.t_s = grid;
   rec.contact_start_s = t.raw.contact_start_s;
+  in_collision.assign(grid.size(), false);
   const bool own = !t.raw.velocity_down_m_s.empty() && !t.raw.depth_m.empty();
   double z = 0, v = c0.vc_m_s, tc = 0;
   bool stopped = false;
-  for (const double ts : grid) {
-    const double target = ts - t0;
+  for (std::size_t k = 0; k < grid.size(); ++k) {
+    const double target = grid[k] - t0;
     double a_up = 0;
     if (target < 0) {  // free fall before contact
       a_up = -g;
@@ -113,6 +118,7 @@ Trace model_record(const FittedModel& m, const MeasuredTrial& t) {
         z = zn, v = vn, tc += h;
       }
       a_up = stopped ? 0.0 : -acc(z, v, tc);
+      in_collision[k] = !stopped;
       if (own) {
         rec.velocity_down_m_s.push_back(v);
         rec.depth_m.push_back(z);
@@ -123,17 +129,57 @@ Trace model_record(const FittedModel& m, const MeasuredTrial& t) {
   return rec;
 }
 
-Prediction predict(const FittedModel& m, const MeasuredTrial& t) {
-  Prediction p = predict(m, t.info);
-  // apeak as measured: the model's record processed like the trial's (filter, start, peak). When
-  // the model's record cannot be measured (it does not stop within the record), the unfiltered
-  // peak stays.
-  try {
-    const ProcessedTrace pt = process_trace(model_record(m, t), metric_options(t.info));
-    p.apeak_m_s2 = pt.metrics.apeak_m_s2;
-  } catch (const std::invalid_argument&) {
+}  // namespace
+
+Trace model_record(const FittedModel& m, const MeasuredTrial& t) {
+  std::vector<bool> in_collision;
+  return model_record_marked(m, t, in_collision);
+}
+
+std::vector<double> relative_residuals(const FittedModel& m, const MeasuredTrial& t) {
+  std::vector<double> r;
+  const double mass = t.info.projectile_mass_kg, g = t.info.gravity_m_s2;
+  for (std::size_t k = t.fit_begin; k < t.fit_end; ++k) {
+    const double r_over_m = m.force(context(t, k)) / mass;  // a_model + g
+    if (!(r_over_m > 0)) continue;
+    const double a_model = r_over_m - g;
+    r.push_back(std::clamp((t.processed.accel_up_m_s2[k] - a_model) / r_over_m, -1.0, 1.0));
   }
+  return r;
+}
+
+Prediction predict(const FittedModel& m, const MeasuredTrial& t, const std::vector<const std::vector<double>*>& fluct) {
+  Prediction p = predict(m, t.info);
+  // apeak as measured: the model's record processed like the trial's (filter, start, peak), with
+  // each of the other trials' fluctuations about the model laid over its collision in turn, and
+  // the mean of what is read off. A record that cannot be measured (the model does not stop
+  // within it) is left out; when none can be, the unfiltered peak stays.
+  std::vector<bool> in_collision;
+  const Trace clean = model_record_marked(m, t, in_collision);
+  const MetricOptions o = metric_options(t.info);
+  const double g = t.info.gravity_m_s2;
+  double sum = 0;
+  int n = 0;
+  auto measure = [&](const Trace& rec) {
+    try {
+      sum += process_trace(rec, o).metrics.apeak_m_s2;
+      ++n;
+    } catch (const std::invalid_argument&) {
+    }
+  };
+  for (const std::vector<double>* r : fluct) {
+    if (r == nullptr || r->size() < kMinFluctuationSamples) continue;
+    Trace rec = clean;
+    std::size_t q = 0;
+    for (std::size_t k = 0; k < rec.accel_up_m_s2.size(); ++k)
+      if (in_collision[k]) rec.accel_up_m_s2[k] += (rec.accel_up_m_s2[k] + g) * (*r)[q++ % r->size()];
+    measure(rec);
+  }
+  if (n == 0) measure(clean);
+  if (n > 0) p.apeak_m_s2 = sum / n;
   return p;
 }
+
+Prediction predict(const FittedModel& m, const MeasuredTrial& t) { return predict(m, t, {}); }
 
 }  // namespace gravsweep::results

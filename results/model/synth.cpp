@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -95,7 +96,9 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
           c.v_m_s = vv;
           c.t_since_contact_s = tt;
           const double ramp = o.contact_ramp_m > 0 ? std::min(1.0, c.z_m / o.contact_ramp_m) : 1.0;
-          return g - ramp * (1.0 + fl) * m.force(c) / o.mass_kg;
+          // A bed resists and never pulls: the per-trial spreads of the terms (bed_spread_*)
+          // can make their sum negative at contact (immersion_drag against base's drag).
+          return g - ramp * (1.0 + fl) * std::max(0.0, m.force(c)) / o.mass_kg;
         };
         std::vector<double> a_samples;  // upward acceleration at each sample after contact
         const int first = static_cast<int>(std::ceil(t_free * fs_hz));

@@ -147,7 +147,7 @@ CollisionStart free_fall_start(const std::vector<double>& t, const std::vector<d
   const double rise = rise_10_90_s(t, a, i, k_hi, -g, top);
   const double ramp_s = std::sqrt(std::max(0.0, rise * rise - step_rise_s * step_rise_s)) / 0.8;
   double t_onset = crossing_time(t, a, k, half) - 0.5 * ramp_s;
-  const bool step = ramp_s <= step_rise_s;
+  const bool step = ramp_s <= kStepRampRises * step_rise_s;
   if (!step) {
     // Slower than the filter: the threshold crossing lags the ramp's foot by thr over its slope
     // (issue 13: in high gravity g times that lag, carried through the integration, is several %
@@ -301,10 +301,13 @@ double peak_acceleration(const std::vector<double>& a, const std::vector<double>
   const std::size_t n = a.size();
   std::size_t lo = i_start + 1, hi = std::min(n - 1, i_end);
   if (step_start) lo = std::min(hi, i_start + 1 + 2 * w);  // filtfilt rings ~2w samples
+  // The line in v^2 only on samples clear of the end's ringing too: a collision too short for
+  // that (a slow impact at 1 g, a dozen samples) extrapolated the stop's ringing to 9 g.
+  const bool clear_of_end = !step_end || hi > lo + 2 * w;
   if (step_end && hi > lo + 2 * w) hi -= 2 * w;
   double peak = -g;
   for (std::size_t k = lo; k <= hi; ++k) peak = std::max(peak, a[k]);
-  if (step_start && hi >= lo + 4) {
+  if (step_start && clear_of_end && hi >= lo + 4) {
     const std::size_t k1 = std::min(hi, lo + 3 * w + 2);
     Eigen::MatrixXd X(static_cast<Eigen::Index>(k1 - lo + 1), 2);
     Eigen::VectorXd y(X.rows());

@@ -68,15 +68,19 @@ double rise_10_90_s(const std::vector<double>& t, const std::vector<double>& y, 
 /// samples read by linear interpolation).
 double filter_step_rise_s(double fs_hz, const MetricOptions& o);
 /// The paper's rule (Sect. 2.3): the last sample before the peak ipk still within the free-fall
-/// band -g + thr, the start at the threshold crossing. An edge as fast as the filter (the ramp it
-/// is, the filter's own rise step_rise_s taken out of its 10-90 % rise, lasts no longer than
-/// step_rise_s; its height reached within 2w samples) starts at its onset instead: its half height
-/// less half that ramp. The filter's spread and ringing cross the threshold early there (about
+/// band -g + thr, the start at the threshold crossing. An edge about as fast as the filter (the
+/// ramp it is, the filter's own rise step_rise_s taken out of its 10-90 % rise, lasts no longer
+/// than kStepRampRises times step_rise_s; its height reached within 2w samples) starts at its
+/// onset instead: its half height less half that ramp. The filter's spread and ringing cross the threshold early there (about
 /// two samples at 1.4 kHz); a contact that ramps in over several samples (a slow impact in high
 /// gravity, issue 13) starts at its foot, the threshold crossing extrapolated back along the
 /// ramp (the crossings of thr and 2 thr), not ms later at its half height. `step` says the
 /// half-height onset was used. Throws std::invalid_argument when no sample before the peak
 /// reads -g.
+/// A contact ramp up to this many filter rises long counts as a step (2 ms at 500 Hz: a 1 mm
+/// contact ramp at 0.5 m/s and faster), so that its peak is extrapolated as a step's, as a model's
+/// record of it (with no ramp) is; noise moves a ramp of about one filter rise across the line.
+inline constexpr double kStepRampRises = 2.0;
 CollisionStart free_fall_start(const std::vector<double>& t, const std::vector<double>& a, std::size_t ipk,
                                double g_m_s2, double thr_m_s2, std::size_t w, double step_rise_s);
 
@@ -170,7 +174,8 @@ double bring_to_rest(const std::vector<double>& t, std::size_t rest_begin, doubl
 
 /// The peak: the largest filtered acceleration of the collision [i_start + 1, i_end], leaving out
 /// the filter's ringing next to step edges; at a step-like contact the early samples beyond the
-/// ringing are extrapolated back to the contact speed vc by a least-squares line in v^2.
+/// ringing (and clear of a step end's ringing) are extrapolated back to the contact speed vc by a
+/// least-squares line in v^2.
 double peak_acceleration(const std::vector<double>& a, const std::vector<double>& v, std::size_t i_start,
                          std::size_t i_end, bool step_start, bool step_end, std::size_t w, double vc_m_s,
                          double g_m_s2);

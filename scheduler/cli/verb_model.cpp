@@ -220,8 +220,13 @@ void setup_model(CLI::App& app) {
     const auto fm = results::fit_model(spec_of(ores->model), c);
     results::Table t({"trial_id", "gravity_m_s2", "vc_m_s", "fill_height_m", "trace_rms_m_s2", "dzstop_mm",
                       "dtstop_ms", "dapeak_m_s2"});
-    for (const auto& tr : c.trials) {
-      const auto p = results::predict(fm, tr);  // apeak as measured (filtered like the trial)
+    // apeak as measured: the model's record filtered like the trial, with the other trials'
+    // fluctuations about the model at its level (results/model/model.h).
+    std::vector<std::vector<double>> fluct;
+    for (const auto& tr : c.trials) fluct.push_back(results::relative_residuals(fm, tr));
+    for (std::size_t i = 0; i < c.trials.size(); ++i) {
+      const auto& tr = c.trials[i];
+      const auto p = results::predict(fm, tr, results::same_level_fluctuations(c, fluct, i));
       const auto& m = tr.processed.metrics;
       t.add({tr.info.trial_id, num(tr.info.gravity_m_s2), num(m.vc_m_s), num(tr.info.fill_height_m),
              num(std::sqrt(results::trial_trace_mse(fm, tr)), 3), p.stopped ? num(1e3 * (p.zstop_m - m.zstop_m), 3) : "nan",
