@@ -87,6 +87,9 @@ TEST_F(ClusterFixture, ATinyImpactCampaignCompletesThroughSlurmWithATaskScancell
   // thread (this machine's cores).
   json base = json::parse(tiny_base());
   base["stop"]["max_time_s"] = 1.0;
+  // Every drop runs its full second: a drop that came to rest early jumped from 30 % to done
+  // between the progress reading and the scancel, and the victim's attempt read "done".
+  base["stop"]["hold_time_s"] = 10.0;
   json doc = {{"sweep", "slurm_tiny"},
               {"max_attempts", 4},
               {"base", base},
