@@ -141,9 +141,9 @@ TEST(EndAccuracy, SynthWritesTheTrueStopOfEachTrial) {
 }
 
 TEST(EndAccuracy, NoTrialLostAndStopsWithinTolerancesDownToATenthOfAG) {
-  expect_accurate("base", low_gravity_options(), 3);
+  EXPECT_NO_FATAL_FAILURE(expect_accurate("base", low_gravity_options(), 3));
 }
 
 TEST(EndAccuracy, TheSameWithAHiddenDepthFriction) {
-  expect_accurate("base+depth_friction", low_gravity_options(), 2);
+  EXPECT_NO_FATAL_FAILURE(expect_accurate("base+depth_friction", low_gravity_options(), 2));
 }

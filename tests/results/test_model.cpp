@@ -289,7 +289,7 @@ void expect_every_error_falls(const Campaign& c, const std::string& term, const 
 // reads 79 m/s2, its repeats 31 and 46, both models 40): it stays within 5 %.
 TEST(HeldOut, EveryErrorFallsWhenDepthFrictionIsAddedOnTheDevCampaign) {
   GRAVSWEEP_REQUIRE_DEV_CAMPAIGN();
-  expect_every_error_falls(dev(), "depth_friction", "dev", {"apeak_rms"});
+  EXPECT_NO_FATAL_FAILURE(expect_every_error_falls(dev(), "depth_friction", "dev", {"apeak_rms"}));
 }
 
 class HiddenTermErrors : public ::testing::TestWithParam<std::string> {};

@@ -121,9 +121,13 @@ void compare(bool rolling) {
 
 }  // namespace
 
-TEST(HertzBatch, MatchesScalarKernelWithSundayRolling) { EXPECT_NO_FATAL_FAILURE(compare<RollingSunday>(true)); }
+TEST(HertzBatch, MatchesScalarKernelWithSundayRolling) {
+  EXPECT_NO_FATAL_FAILURE(compare<RollingSunday>(true));
+}
 
-TEST(HertzBatch, MatchesScalarKernelWithoutRolling) { EXPECT_NO_FATAL_FAILURE(compare<RollingNone>(false)); }
+TEST(HertzBatch, MatchesScalarKernelWithoutRolling) {
+  EXPECT_NO_FATAL_FAILURE(compare<RollingNone>(false));
+}
 
 TEST(HertzBatch, CoversThePaperModels) {
   EXPECT_TRUE((kHasHertzBatch<HertzChrono, RollingSunday>));
