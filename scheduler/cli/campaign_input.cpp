@@ -67,49 +67,17 @@ nlohmann::json row_of(const results::MeasuredTrial& t) {
   return j;
 }
 
-bool holds(const nlohmann::json& v, const queue::Condition& c) {
-  if (c.op == "~") return v.is_string() ? v.get<std::string>().find(c.value.get<std::string>()) != std::string::npos
-                                        : v.dump().find(c.value.get<std::string>()) != std::string::npos;
-  auto cmp = [&](auto a, auto b) {
-    if (c.op == "<") return a < b;
-    if (c.op == "<=") return a <= b;
-    if (c.op == ">") return a > b;
-    if (c.op == ">=") return a >= b;
-    if (c.op == "=") return a == b;
-    return a != b;
-  };
-  if ((v.is_number() || v.is_boolean()) && (c.value.is_number() || c.value.is_boolean()))
-    return cmp(v.is_boolean() ? double(v.get<bool>()) : v.get<double>(),
-               c.value.is_boolean() ? double(c.value.get<bool>()) : c.value.get<double>());
-  const std::string a = v.is_string() ? v.get<std::string>() : v.dump();
-  const std::string b = c.value.is_string() ? c.value.get<std::string>() : c.value.dump();
-  return cmp(a, b);
-}
-
 void filter_in_memory(const std::string& path, CampaignInput& in, const std::vector<std::string>& where) {
   if (where.empty()) return;
-  std::vector<std::pair<std::string, std::vector<queue::Condition>>> conds;
-  try {
-    for (const auto& w : where) conds.emplace_back(w, queue::parse_where(w));
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(fmt::format("{}: {}", path, e.what()));
-  }
   auto& trials = in.campaign.trials;
   const std::size_t before = trials.size();
   std::vector<results::MeasuredTrial> kept;
-  for (auto& t : trials) {
-    const nlohmann::json row = row_of(t);
-    bool ok = true;
-    for (const auto& [w, cs] : conds)
-      for (const auto& c : cs) {
-        if (!row.contains(c.column)) {
-          std::string list;
-          for (auto it = row.begin(); it != row.end(); ++it) list += (list.empty() ? "" : ", ") + it.key();
-          throw UsageError(fmt::format("{}: --where '{}': found column '{}', expected one of: {}", path, w, c.column, list));
-        }
-        ok = ok && holds(row.at(c.column), c);
-      }
-    if (ok) kept.push_back(std::move(t));
+  try {
+    for (const auto& w : where) queue::parse_where(w);  // a malformed filter fails even on no trials
+    for (auto& t : trials)
+      if (queue::row_matches(row_of(t), where)) kept.push_back(std::move(t));
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("{}: {}", path, e.what()));
   }
   trials = std::move(kept);
   in.filtered_out = before - trials.size();

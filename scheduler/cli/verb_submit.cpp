@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/impact.h"
 #include "scheduler/queue/campaign.h"
+#include "scheduler/queue/filter.h"
 #include "scheduler/queue/queue.h"
 #include "scheduler/sweep/spec.h"
 
@@ -23,8 +25,39 @@ struct SubmitOptions {
   std::vector<std::string> specs;
   std::string db = "campaign.db";
   std::string files;
+  std::vector<std::string> where;  ///< keep only the points whose swept values match (ANDed)
   bool dry_run = false;
 };
+
+/// `--where` on the swept parameters: drops (or noop jobs) that fail a condition are not
+/// submitted, nor any bed that no kept drop needs. Returns how many points were left out.
+std::size_t keep_matching(const std::string& path, std::vector<sweep::PlannedJob>& jobs,
+                          const std::vector<std::string>& where) {
+  if (where.empty()) return 0;
+  std::vector<sweep::PlannedJob> kept;
+  std::set<std::string> beds_needed;
+  std::size_t left_out = 0;
+  try {
+    for (const auto& w : where) queue::parse_where(w);
+    for (auto& j : jobs) {
+      if (j.kind == queue::JobKind::bed) continue;
+      if (!queue::row_matches(j.params, where)) {
+        ++left_out;
+        continue;
+      }
+      beds_needed.insert(j.deps.begin(), j.deps.end());
+      kept.push_back(std::move(j));
+    }
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("{}: {} (the sweep's axis columns)", path, e.what()));
+  }
+  std::vector<sweep::PlannedJob> out;
+  for (auto& j : jobs)  // beds first, in their planned order, as expand() gives them
+    if (j.kind == queue::JobKind::bed && beds_needed.count(j.job_id)) out.push_back(std::move(j));
+  for (auto& j : kept) out.push_back(std::move(j));
+  jobs = std::move(out);
+  return left_out;
+}
 
 void run_submit(const SubmitOptions& o) {
   // Validate and expand every spec before the database is even opened: a bad spec writes nothing.
@@ -39,6 +72,8 @@ void run_submit(const SubmitOptions& o) {
       if (p.spec.job_kind == "impact" && !queue::impact_available())
         throw UsageError(fmt::format("{}: /job: found \"impact\", expected \"noop\" (this build has no impact pipeline)", path));
       p.jobs = sweep::expand(p.spec, queue::impact_bed_key());
+      if (const std::size_t n = keep_matching(path, p.jobs, o.where))
+        fmt::print("sweep {}: --where leaves out {} of {} points\n", p.spec.name, n, p.spec.points());
       planned.push_back(std::move(p));
     } catch (const sweep::SpecError& e) {
       throw UsageError(e.what());
@@ -79,9 +114,14 @@ void setup_submit(CLI::App& app) {
       "Examples:\n"
       "  gravsweep submit examples/sweep_tiny.json --db campaign.db\n"
       "  gravsweep submit a.json b.json --db campaign.db      # a campaign may hold several sweeps\n"
-      "  gravsweep submit spec.json --dry-run                 # validate and count, write nothing");
+      "  gravsweep submit spec.json --dry-run                 # validate and count, write nothing\n"
+      "  gravsweep submit spec.json --where 'projectile_seed>=2' --db campaign.db\n"
+      "                                  # only part of the sweep (its axis columns; beds it needs)");
   sub->add_option("specs", opt->specs, "sweep spec files (JSON)")->required()->check(CLI::ExistingFile);
   add_campaign_options(sub, opt->db, &opt->files, "campaign database (created if missing)");
+  sub->add_option("--where", opt->where,
+                  "submit only the points whose swept values match, e.g. 'impact_speed_m_s<0.5' (the "
+                  "axis column names; same grammar as `results --where`; repeat to AND)");
   sub->add_flag("--dry-run", opt->dry_run, "validate and expand only; write nothing");
   sub->callback([opt]() { run_submit(*opt); });
 }

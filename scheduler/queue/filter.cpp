@@ -112,6 +112,44 @@ std::vector<Condition> parse_where(const std::string& expr) {
   return out;
 }
 
+namespace {
+
+bool holds(const json& v, const Condition& c) {
+  if (c.op == "~") return v.is_string() ? v.get<std::string>().find(c.value.get<std::string>()) != std::string::npos
+                                        : v.dump().find(c.value.get<std::string>()) != std::string::npos;
+  auto cmp = [&](auto a, auto b) {
+    if (c.op == "<") return a < b;
+    if (c.op == "<=") return a <= b;
+    if (c.op == ">") return a > b;
+    if (c.op == ">=") return a >= b;
+    if (c.op == "=") return a == b;
+    return a != b;
+  };
+  auto number = [](const json& j) { return j.is_boolean() ? double(j.get<bool>()) : j.get<double>(); };
+  if ((v.is_number() || v.is_boolean()) && (c.value.is_number() || c.value.is_boolean()))
+    return cmp(number(v), number(c.value));
+  const std::string a = v.is_string() ? v.get<std::string>() : v.dump();
+  const std::string b = c.value.is_string() ? c.value.get<std::string>() : c.value.dump();
+  return cmp(a, b);
+}
+
+}  // namespace
+
+bool row_matches(const json& row, const std::vector<std::string>& where) {
+  bool ok = true;
+  for (const auto& w : where)
+    for (const auto& c : parse_where(w)) {
+      if (!row.contains(c.column)) {
+        std::string list;
+        for (auto it = row.begin(); it != row.end(); ++it) list += (list.empty() ? "" : ", ") + it.key();
+        throw std::invalid_argument(
+            fmt::format("--where '{}': found column '{}', expected one of: {}", w, c.column, list));
+      }
+      ok = ok && holds(row.at(c.column), c);
+    }
+  return ok;
+}
+
 ResultsTable query_results(db::Database& db, const ResultsQuery& q) {
   const std::vector<std::string> all = result_columns(db);
   auto check = [&](const std::string& col, const std::string& where) {

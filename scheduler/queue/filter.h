@@ -25,6 +25,13 @@ struct Condition {
 /// Throws std::invalid_argument naming the position and what was expected.
 std::vector<Condition> parse_where(const std::string& expr);
 
+/// The in-memory twin of query_results, for rows that are not in a database (the trials of a lab
+/// campaign, the planned jobs of `submit --where`): true when `row` ({column: value}) satisfies
+/// every condition of every expression. Numbers (and booleans) compare as numbers, everything else
+/// as text; `~` is a substring match. A column the row lacks throws std::invalid_argument naming
+/// the expression and the columns the row has.
+bool row_matches(const nlohmann::json& row, const std::vector<std::string>& where);
+
 struct ResultsQuery {
   std::vector<std::string> where;    ///< --where expressions (ANDed)
   std::vector<std::string> columns;  ///< empty: all

@@ -172,6 +172,32 @@ TEST(CliQueue, ImpactSweepSharesBedsAndExtendsIdempotently) {
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs"), 18);
 }
 
+TEST(CliQueue, SubmitWhereTakesPartOfASweepWithOnlyTheBedsItNeeds) {
+  if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
+  TempDir d;
+  const std::string example = std::string(GRAVSWEEP_SOURCE_DIR) + "/examples/sweep_tiny.json";
+  // The second repeat at 1 g only: 3 speeds, on the one 1 g bed.
+  auto r = run_cli({"submit", example, "--db", "c.db", "--where", "projectile_seed>=2", "--where", "gravity_m_s2>5"},
+                   d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("--where leaves out 9 of 12 points"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("4 jobs planned (1 bed, 3 drop): 4 new"), std::string::npos) << r.out;
+  {
+    db::Database db((d.path / "c.db").string());
+    EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE kind='drop' AND params_json LIKE '%\"projectile_seed\":2%'"), 3);
+  }
+  // The whole sweep later adds the rest and keeps what is there.
+  r = run_cli({"submit", example, "--db", "c.db"}, d.path);
+  EXPECT_NE(r.out.find("14 jobs planned (2 bed, 12 drop): 10 new, 4 already present"), std::string::npos) << r.out;
+  // A column that is not an axis is refused (exit 2) naming the axis columns; nothing is written.
+  r = run_cli({"submit", example, "--db", "d.db", "--where", "seed=2"}, d.path);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("found column 'seed', expected one of: gravity_m_s2, impact_speed_m_s, projectile_seed"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(d.path / "d.db"));
+}
+
 TEST(CliQueue, FollowingWorkersPickUpLateSubmissionsAndTheSupervisorForwardsSigterm) {
   TempDir d;
   write_text(d.path / "a.json", noop_spec({1.0}, 0.05));

@@ -36,6 +36,22 @@ TEST(WhereParser, ErrorsNamePositionFoundAndExpected) {
   EXPECT_THROW(parse_where("1<g"), std::invalid_argument);
 }
 
+TEST(WhereParser, RowsOutsideADatabaseMatchAsTheResultsTableDoes) {
+  const nlohmann::json row = {{"gravity_m_s2", 0.1}, {"sweep", "part2_chrono_lowg"}, {"rebound", false}, {"seed", 2}};
+  EXPECT_TRUE(row_matches(row, {"gravity_m_s2<1", "sweep~lowg"}));
+  EXPECT_TRUE(row_matches(row, {"seed>=2 and rebound=false"}));
+  EXPECT_FALSE(row_matches(row, {"gravity_m_s2<1", "seed!=2"}));
+  EXPECT_TRUE(row_matches(row, {}));
+  try {
+    row_matches(row, {"speed_m_s>1"});
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("found column 'speed_m_s', expected one of: gravity_m_s2, rebound, seed, sweep"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(ResultsQuery, FiltersAreBoundAndColumnsChecked) {
   test::TempDir dir;
   db::Database db((dir.path / "c.db").string());
