@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -74,9 +75,15 @@ ModelSpec parse_model(const std::string& text) {
       ModelTerm mt;
       std::string name = item;
       double scale = 1.0;
-      if (auto p = name.find('*'); p != std::string::npos) {
-        scale = std::stod(name.substr(p + 1));
-        name = name.substr(0, p);
+      // "*2.5" after a term is a synth scale; a '*' inside a generated form ("z^1*v^1") is not.
+      if (auto p = name.rfind('*'); p != std::string::npos) {
+        const std::string tail = name.substr(p + 1);
+        char* end = nullptr;
+        const double x = std::strtod(tail.c_str(), &end);
+        if (!tail.empty() && end == tail.c_str() + tail.size()) {
+          scale = x;
+          name = name.substr(0, p);
+        }
       }
       std::string mode;
       if (auto p = name.find(':'); p != std::string::npos) {

@@ -148,16 +148,34 @@ struct Candidate {
 };
 struct Discovery {
   std::string baseline;
-  std::vector<std::vector<Candidate>> rounds;  ///< ranking per forward step
-  std::vector<std::string> added;               ///< winners, in order
+  std::vector<std::vector<Candidate>> rounds;  ///< ranking of the named terms per forward step
+  std::vector<std::string> added;               ///< named winners, in order
   std::string verdict;                          ///< the sentence for users
-  bool structure_left = false;                  ///< residuals still structured after the additions
+  bool structure_left = false;                  ///< residuals structured after the named additions
   std::vector<AxisResidual> residual_before, residual_after;
+  /// The search beyond the named library (generated.h), run when the named terms were added or
+  /// left structure: the nested-CV test of choosing a form (its `term` is the form chosen on all
+  /// trials), every form by in-sample improvement, the form added (empty when the test is not
+  /// significant), the model with it, whether structure is still left with it, and the held-out
+  /// errors without and with it.
+  bool generated_searched = false;
+  Candidate generated_test;
+  std::vector<Candidate> generated_screened;
+  std::string generated;
+  std::vector<std::string> generated_equivalent;  ///< forms the trials cannot tell apart from it
+  bool generated_worsens_metrics = false;  ///< significant on the trace, but zstop or tstop worse held out
+  std::string generated_model;
+  bool structure_left_after_generated = false;
+  ErrorSummary errors_without_generated, errors_with_generated;
 };
 /// Forward selection from `baseline` over all other registered terms by grouped-CV improvement,
 /// adding a term while one is significant (signed-rank test over trials, Bonferroni over candidates, at
-/// level alpha, and at least min_improvement mean relative gain).
+/// level alpha, and at least min_improvement mean relative gain). When a named term was added or
+/// the residuals are still structured (the tests of residual_axes), one more step runs over the
+/// generated family (model_internal.h, search_generated: nested grouped CV, one signed-rank test at
+/// level alpha), and a significant form is reported by its formula: the residuals of the named
+/// winners are tested again, and structure they leave makes the verdict "partly explained".
 Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds = 6, double alpha = 0.01,
-                   double min_improvement = 0.03, int max_rounds = 2);
+                   double min_improvement = 0.03, int max_rounds = 2, bool search_generated = true);
 
 }  // namespace gravsweep::results

@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "results/measurements/campaign.h"
+#include "results/model/model.h"
 #include "results/model/term.h"
 
 namespace gravsweep::results::detail {
@@ -17,5 +18,19 @@ double binom_tail_half(int k, int n);
 double signed_rank_p(const std::vector<double>& d);
 /// Fold of each trial, stratified by gravity level (same_gravity_level).
 std::vector<int> fold_of(const Campaign& c, int folds, unsigned seed);
+
+/// One forward step over the generated family (search_generated.cpp). The form is the one that,
+/// added per gravity level to `current`, fits all trials best (shared instead when that is as good
+/// held out); `test` judges the whole procedure by nested grouped CV (in each fold the form is
+/// chosen on the training trials alone), so one signed-rank test at level alpha covers the choice
+/// among all forms; `screened` lists every form by its in-sample improvement (no test, p NaN).
+struct GeneratedSearch {
+  ModelTerm chosen;
+  Candidate test;
+  std::vector<Candidate> screened;
+  std::vector<std::string> equivalent;  ///< forms the trials cannot tell apart from the chosen one
+};
+GeneratedSearch search_generated(const ModelSpec& current, const Campaign& c, int folds, double alpha,
+                                 double min_improvement);
 
 }  // namespace gravsweep::results::detail

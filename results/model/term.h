@@ -6,6 +6,7 @@
 // Adding a term = one file in results/model/terms/ defining `TermInfo <name>_term()` and one row
 // in the GRAVSWEEP_MODEL_TERMS list below (see ARCHITECTURE.md, "Collision-model terms").
 #pragma once
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -31,9 +32,12 @@ struct TermInfo {
   std::vector<std::string> params;  ///< parameter names with units: "k_N_m"
   bool per_gravity = true;          ///< default sharing: one value per gravity level, or shared
   /// Resisting force (N, positive up, i.e. opposing a downward motion) per unit of each parameter.
-  void (*features)(const TermContext&, double* out) = nullptr;
-  /// Typical parameter values at gravity g, used as the hidden truth by `gravsweep synth`.
-  std::vector<double> (*typical)(double g_m_s2, double mass_kg, double diameter_m) = nullptr;
+  std::function<void(const TermContext&, double* out)> features;
+  /// Typical parameter values at gravity g, used as the hidden truth by `gravsweep synth` (empty
+  /// for generated terms: they have no typical size).
+  std::function<std::vector<double>(double g_m_s2, double mass_kg, double diameter_m)> typical;
+  /// A form of the generated family (generated.h), not a named effect of the library.
+  bool generated = false;
 };
 
 // The registry: one row per term (the function is defined in terms/<name>.cpp).
@@ -52,7 +56,8 @@ GRAVSWEEP_MODEL_TERMS(GRAVSWEEP_DECLARE_TERM)
 
 /// All registered terms, in registry order.
 const std::vector<TermInfo>& term_registry();
-/// The term of that name; throws std::invalid_argument listing the known names otherwise.
+/// The term of that name: a registered one, or a form of the generated family (generated.h, e.g.
+/// "z^1*v^1"); throws std::invalid_argument listing the known names otherwise.
 const TermInfo& find_term(const std::string& name);
 
 }  // namespace gravsweep::results

@@ -102,7 +102,23 @@ void print_ranking(const results::Discovery& d, const std::string& format) {
       t.add({std::to_string(r + 1), std::to_string(i + 1), c.term, num(100 * c.mean_rel_improvement, 3),
              std::to_string(c.trials_better), std::to_string(c.trials), num(c.p_value, 2), c.significant ? "yes" : "no"});
     }
+  // The search beyond the named library: the nested-CV test of choosing a form, then the forms by
+  // in-sample improvement (screening only: no test of their own).
+  if (d.generated_searched) {
+    const auto& g = d.generated_test;
+    t.add({"generated", "1", g.term, num(100 * g.mean_rel_improvement, 3), std::to_string(g.trials_better),
+           std::to_string(g.trials), num(g.p_value, 2), g.significant ? "yes" : "no"});
+  }
+  const std::size_t shown = format == "table" ? std::min<std::size_t>(6, d.generated_screened.size()) : d.generated_screened.size();
+  for (std::size_t i = 0; i < shown; ++i) {
+    const auto& c = d.generated_screened[i];
+    t.add({"screened", std::to_string(i + 1), c.term, num(100 * c.mean_rel_improvement, 3), "-", "-", "-", "-"});
+  }
   t.print(format);
+  if (format == "table" && shown < d.generated_screened.size())
+    fmt::print("(round 'generated': the held-out test of choosing a form, nested CV; 'screened': in-sample gain of "
+               "each form, {} more with --format csv)\n",
+               d.generated_screened.size() - shown);
 }
 
 }  // namespace
@@ -307,7 +323,12 @@ void setup_model(CLI::App& app) {
       "registered term by its held-out improvement with whole trials left out (grouped CV) and\n"
       "a Wilcoxon signed-rank test over trials (not samples), Bonferroni over candidates. Adds the winner and\n"
       "repeats while a term is significant, then says which effect is missing, 'no missing\n"
-      "effect found', or 'structure left that no candidate explains' with where it lies.\n\n"
+      "effect found', 'partly explained by X; structure left along <axis>', or 'structure left\n"
+      "that no named term explains' with where it lies. When structure is left, the same test runs\n"
+      "over a generated family of forms (z^a |v|^b, exp(-z/l), 1-exp(-z/l) and their products with\n"
+      "z, |v|, v^2; each per gravity level or shared) and a significant one is reported by its\n"
+      "formula, never by a physical name, with the held-out errors without and with it; fit it\n"
+      "like a named term: --model 'base+z^1*v^1'.\n\n"
       "Examples:\n  gravsweep model rank ../shared/data/measurements/depth-friction-dev\n"
       "  gravsweep model rank campaign.db          # the drops of `gravsweep submit` + `work`");
   rank->alias("discover");

@@ -62,12 +62,15 @@ TEST(Reproduction, ChronoOneGTable3RowAsStated) {
   EXPECT_NEAR(row.at("alpha"), 0.39, 0.03);
 }
 
-// Beyond the paper: the Poncelet law misses a depth-dependent friction in our DEM data at 1 g.
+// Beyond the paper: the Poncelet law misses a depth-dependent friction in our DEM data at 1 g, and
+// (the search beyond the named library, issue 13) a small speed-dependent part is left after it:
+// the verdict is "partly explained", and held-out zstop and tstop errors fall with the form found.
 TEST(Reproduction, ModelRankNamesDepthFrictionOnTheChronoOneGDrops) {
   const auto r = gravsweep::testing::run_gravsweep("model rank '" + dataset("chrono_1g") + "'", true);
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_NE(r.out.find("Verdict: missing effect: gravity_depth_friction"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Verdict: partly explained by gravity_depth_friction"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("better on 21 of 21 trials"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("a generated form fits it: c * z^0.5*v^0.5"), std::string::npos) << r.out;
 }
 
 // Chrono set at 0.1 m/s2 (part 2, partial: REPRODUCTION.md gives the drops it holds). Paper

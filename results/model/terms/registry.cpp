@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "results/model/generated.h"
 #include "results/model/term.h"
 
 namespace gravsweep::results {
@@ -19,7 +20,11 @@ const TermInfo& find_term(const std::string& name) {
     if (t.name == name) return t;
     known += (known.empty() ? "" : ", ") + t.name;
   }
-  throw std::invalid_argument(fmt::format("unknown model term '{}' (known: {})", name, known));
+  if (const TermInfo* g = generated_term(name)) return *g;
+  throw std::invalid_argument(fmt::format(
+      "unknown model term '{}' (known: {}; or a generated form such as z^1*v^1, exp(-z/0.01), "
+      "(1-exp(-z/0.01)), v^2*exp(-z/0.02))",
+      name, known));
 }
 
 }  // namespace gravsweep::results
