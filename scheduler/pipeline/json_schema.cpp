@@ -49,16 +49,6 @@ SpecError::SpecError(std::string source, std::vector<SpecProblem> problems)
   if (problems_.empty()) throw std::logic_error("SpecError without a problem");
 }
 
-std::string pointer_token(const std::string& key) {
-  std::string out;
-  for (char c : key) {
-    if (c == '~') out += "~0";
-    else if (c == '/') out += "~1";
-    else out += c;
-  }
-  return out;
-}
-
 SchemaValidator::SchemaValidator(json schema) : schema_(std::move(schema)) {}
 
 json SchemaValidator::resolve(const json& s) const {
@@ -152,7 +142,7 @@ void SchemaValidator::check(json& node, const json& schema_in, const std::string
         if (props.contains(it.key())) continue;
         std::string known;
         for (auto p = props.begin(); p != props.end(); ++p) known += (known.empty() ? "" : ", ") + p.key();
-        problems.push_back({ptr + "/" + pointer_token(it.key()), shown(it.value()) + " (unknown field)",
+        problems.push_back({pointer_child(ptr, it.key()), shown(it.value()) + " (unknown field)",
                             fmt::format("one of the fields {}", known)});
       }
     }
@@ -160,10 +150,10 @@ void SchemaValidator::check(json& node, const json& schema_in, const std::string
       for (const auto& r : s["required"]) {
         const std::string key = r.get<std::string>();
         if (!node.contains(key))
-          problems.push_back({ptr + "/" + pointer_token(key), "nothing (missing)", "a value: the field is required"});
+          problems.push_back({pointer_child(ptr, key), "nothing (missing)", "a value: the field is required"});
       }
     for (auto p = props.begin(); p != props.end(); ++p) {
-      const std::string child_ptr = ptr + "/" + pointer_token(p.key());
+      const std::string child_ptr = pointer_child(ptr, p.key());
       if (node.contains(p.key())) {
         check(node[p.key()], p.value(), child_ptr, problems);
       } else {

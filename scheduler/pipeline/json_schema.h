@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "engine/core/error.h"
+#include "scheduler/pipeline/json_pointer.h"  // pointer_token
 
 namespace gravsweep::pipeline {
 
@@ -37,9 +38,6 @@ class SpecError : public ConfigError {
   std::string source_;
   std::vector<SpecProblem> problems_;
 };
-
-/// JSON pointer escaping of one reference token (RFC 6901: ~ -> ~0, / -> ~1).
-std::string pointer_token(const std::string& key);
 
 class SchemaValidator {
  public:

@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "scheduler/pipeline/json_pointer.h"
 #include "scheduler/pipeline/json_schema.h"
 #include "scheduler/sweep/canonical.h"
 
@@ -40,15 +41,7 @@ std::string show(const json& v) {
   return s + " (" + type_name(v) + ")";
 }
 
-std::string join(const std::string& ptr, const std::string& token) {
-  std::string t;
-  for (char c : token) {
-    if (c == '~') t += "~0";
-    else if (c == '/') t += "~1";
-    else t.push_back(c);
-  }
-  return ptr + "/" + t;
-}
+std::string join(const std::string& ptr, const std::string& token) { return pipeline::pointer_child(ptr, token); }
 std::string join(const std::string& ptr, std::size_t i) { return ptr + "/" + std::to_string(i); }
 
 bool is_int(const json& v) {
