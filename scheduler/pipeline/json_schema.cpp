@@ -39,13 +39,30 @@ std::string problems_message(const std::string& source, const std::vector<SpecPr
   return m;
 }
 
+/// A sweep spec's: "FILE: invalid sweep spec (N problems); nothing was written", one line each.
+std::string sweep_problems_message(const std::string& file, const std::vector<SpecProblem>& problems) {
+  std::string m = fmt::format("{}: invalid sweep spec ({} problem{}); nothing was written", file, problems.size(),
+                              problems.size() == 1 ? "" : "s");
+  for (const auto& p : problems)
+    m += fmt::format("\n  {}: found {}, expected {}", p.pointer.empty() ? "/" : p.pointer, p.found, p.expected);
+  return m;
+}
+
 }  // namespace
 
 SpecError::SpecError(std::string source, std::string pointer, std::string found, std::string expected)
     : SpecError(std::move(source), std::vector<SpecProblem>{{std::move(pointer), std::move(found), std::move(expected)}}) {}
 
 SpecError::SpecError(std::string source, std::vector<SpecProblem> problems)
-    : ConfigError(problems_message(source, problems)), source_(std::move(source)), problems_(std::move(problems)) {
+    // Braces: the message is made before the arguments are moved (left to right).
+    : SpecError{Message{problems_message(source, problems)}, std::move(source), std::move(problems)} {}
+
+SpecError SpecError::sweep_spec(std::string file, std::vector<SpecProblem> problems) {
+  return {Message{sweep_problems_message(file, problems)}, std::move(file), std::move(problems)};
+}
+
+SpecError::SpecError(Message message, std::string source, std::vector<SpecProblem> problems)
+    : ConfigError(std::move(message.text)), source_(std::move(source)), problems_(std::move(problems)) {
   if (problems_.empty()) throw std::logic_error("SpecError without a problem");
 }
 
