@@ -1,15 +1,19 @@
-// Exit codes of `gravsweep`, stable so that scripts can trust them (documented in README.md).
+// Exit codes of `gravsweep` (README.md): the CLI's front to scheduler/queue/exit_codes.h.
 #pragma once
 #include <stdexcept>
 
+#include "scheduler/queue/exit_codes.h"
+
 namespace gravsweep::cli {
 
-inline constexpr int kExitOk = 0;           ///< success
-inline constexpr int kExitFailure = 1;      ///< runtime failure (I/O, database, internal)
-inline constexpr int kExitUsage = 2;        ///< bad command line, bad spec or bad input file
-inline constexpr int kExitNumerical = 3;    ///< the simulation broke down (NaN, overlap, escape)
-inline constexpr int kExitIncomplete = 4;   ///< finished, but some jobs/trials failed
-inline constexpr int kExitInterrupted = 130;  ///< stopped by SIGINT/SIGTERM
+using queue::kExitExecFailed;
+using queue::kExitFailure;
+using queue::kExitIncomplete;
+using queue::kExitInterrupted;
+using queue::kExitNumerical;
+using queue::kExitOk;
+using queue::kExitSignalBase;
+using queue::kExitUsage;
 
 /// Thrown by verbs for bad user input (spec, file, option value); maps to kExitUsage.
 struct UsageError : std::runtime_error {

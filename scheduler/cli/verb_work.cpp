@@ -88,7 +88,7 @@ int supervise(const WorkOptions& o, int threads) {
       for (auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
       argv.push_back(nullptr);
       execv(exe.c_str(), argv.data());
-      _exit(127);
+      _exit(kExitExecFailed);
     }
     kids.push_back(pid);
   }
@@ -115,7 +115,7 @@ int supervise(const WorkOptions& o, int threads) {
         if (k != done) continue;
         k = -1;
         --alive;
-        const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        const int code = WIFEXITED(status) ? WEXITSTATUS(status) : kExitSignalBase + WTERMSIG(status);
         if (code == kExitInterrupted) interrupted = true;
         else if (code != kExitOk && code != kExitIncomplete) {
           ++failures;
