@@ -50,7 +50,8 @@ void write_trace(const std::filesystem::path& path, const TraceData& d) {
     h5::set_attr(g, "release_speed_m_s", d.release_speed_m_s);
     h5::set_attr(g, "projectile_diameter_m", d.projectile_diameter_m);
     h5::set_attr(g, "projectile_mass_kg", d.projectile_mass_kg);
-    h5::set_attr(g, "fill_height_m", d.fill_height_m);
+    // Format version 1 had both; gravsweep reads surface_height_m, older versions fill_height_m.
+    h5::set_attr(g, "fill_height_m", d.surface_height_m);
     h5::set_attr(g, "grain_diameter_m", d.grain_diameter_m);
     h5::set_attr(g, "stopped", static_cast<long long>(d.stopped ? 1 : 0));
     h5::write_doubles(g, "t_s", d.t_s, {n}, "s", "time since release");
@@ -94,7 +95,6 @@ TraceData read_trace(const std::filesystem::path& path) {
   d.release_speed_m_s = h5::get_attr_double(g, "release_speed_m_s");
   d.projectile_diameter_m = h5::get_attr_double(g, "projectile_diameter_m");
   d.projectile_mass_kg = h5::get_attr_double(g, "projectile_mass_kg");
-  d.fill_height_m = h5::get_attr_double(g, "fill_height_m");
   d.grain_diameter_m = h5::get_attr_double(g, "grain_diameter_m");
   d.stopped = h5::get_attr_int(g, "stopped") != 0;
   d.t_s = h5::read_doubles(g, "t_s");

@@ -6,7 +6,8 @@
 //                                     scenario (JSON), bed_key (JSON), bed_file, metrics (JSON)
 //   /trace                     attrs: sample_rate_hz, dt_s, gravity_m_s2, surface_height_m,
 //                                     release_height_m, release_speed_m_s, projectile_diameter_m,
-//                                     projectile_mass_kg, fill_height_m, grain_diameter_m,
+//                                     projectile_mass_kg, fill_height_m (= surface_height_m, kept
+//                                     for older readers), grain_diameter_m,
 //                                     stopped (1: stop criterion met, 0: time cap)
 //   /trace/t_s                 (T)    time since release
 //   /trace/depth_m             (T)    depth of the projectile's lowest point below the surface
@@ -32,9 +33,13 @@ struct TraceData {
   std::vector<double> position_m;   ///< T x 3
   std::vector<std::int32_t> contacts;
   std::vector<double> grain_kinetic_energy_J;
-  double sample_rate_hz = 0, dt_s = 0, gravity_m_s2 = 0, surface_height_m = 0;
+  double sample_rate_hz = 0, dt_s = 0, gravity_m_s2 = 0;
+  /// Measured bed surface above the container floor, m (mean top of the grains in the central
+  /// 60 % of the radius, engine frame z up): depth z = 0 of the paper's frame, and the floor lies
+  /// this far below it (z positive down). A DEM trial's fill height (trial_fields()).
+  double surface_height_m = 0;
   double release_height_m = 0, release_speed_m_s = 0;
-  double projectile_diameter_m = 0, projectile_mass_kg = 0, fill_height_m = 0, grain_diameter_m = 0;
+  double projectile_diameter_m = 0, projectile_mass_kg = 0, grain_diameter_m = 0;
   bool stopped = false;
   std::string scenario_json, bed_key_json, bed_file, metrics_json, code_version;
 

@@ -22,7 +22,7 @@ namespace {
 double attr_of(const TraceData& d, const std::string& name) {
   // The trace.h5 attributes a Trial field comes from (TrialField::hdf5_attr).
   if (name == "gravity_m_s2") return d.gravity_m_s2;
-  if (name == "fill_height_m") return d.fill_height_m;
+  if (name == "surface_height_m") return d.surface_height_m;
   if (name == "projectile_mass_kg") return d.projectile_mass_kg;
   if (name == "projectile_diameter_m") return d.projectile_diameter_m;
   if (name == "grain_diameter_m") return d.grain_diameter_m;

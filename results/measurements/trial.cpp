@@ -16,7 +16,7 @@ const std::vector<TrialField>& trial_fields() {
       {"trace_file", nullptr, "", true, nullptr, &Trial::trace_file},
       {"gravity_m_s2", "gravity_m_s2", "m/s2", true, &Trial::gravity_m_s2, nullptr},
       {"impact_velocity_m_s", nullptr, "m/s", true, &Trial::impact_velocity_m_s, nullptr},
-      {"fill_height_m", "fill_height_m", "m", true, &Trial::fill_height_m, nullptr},
+      {"fill_height_m", "surface_height_m", "m", true, &Trial::fill_height_m, nullptr},  // dem: measured
       {"projectile_mass_kg", "projectile_mass_kg", "kg", true, &Trial::projectile_mass_kg, nullptr},
       {"projectile_diameter_m", "projectile_diameter_m", "m", true, &Trial::projectile_diameter_m, nullptr},
       {"grain_diameter_m", "grain_diameter_m", "m", true, &Trial::grain_diameter_m, nullptr},

@@ -21,7 +21,7 @@ struct Trial {
   std::string trace_file;             ///< relative to the campaign folder (lab) or absolute (dem)
   double gravity_m_s2 = 0;
   double impact_velocity_m_s = 0;     ///< downward speed at first contact
-  double fill_height_m = 0;
+  double fill_height_m = 0;           ///< bed depth: the floor below the surface (dem: measured surface height)
   double projectile_mass_kg = 0;
   double projectile_diameter_m = 0;
   double grain_diameter_m = 0;

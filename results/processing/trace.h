@@ -50,8 +50,9 @@ struct MetricOptions {
   bool end_from_rest = true;
   /// Speed at first contact, used to integrate a into v and z when the trace has none.
   std::optional<double> impact_velocity_m_s;
-  /// For the rebound flag: bed depth and grain diameter (a projectile within one grain of the
-  /// floor has "hit the bottom").
+  /// For the rebound flag: bed depth (the floor's depth below the surface, m: a lab trial's fill
+  /// height, a DEM drop's measured surface height) and grain diameter (a projectile within one
+  /// grain of the floor has "hit the bottom").
   std::optional<double> fill_height_m;
   std::optional<double> grain_diameter_m;
   double projectile_diameter_m = 0.1;

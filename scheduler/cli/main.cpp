@@ -1,5 +1,5 @@
 // `gravsweep`: one binary, one subcommand per verb (see verbs.h). main() only wires them up and
-// turns exceptions into the exit codes of exit_codes.h.
+// turns exceptions (and a verb's ExitWith) into the exit codes of exit_codes.h.
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -71,6 +71,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     app.exit(e);
     return cli::kExitUsage;
+  } catch (const cli::ExitWith& e) {  // a verb that finished with another outcome than success
+    std::fflush(nullptr);
+    if (e.skip_exit_handlers) _exit(e.code);
+    return e.code;
   } catch (const cli::UsageError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return cli::kExitUsage;

@@ -82,10 +82,7 @@ void setup_measurements(CLI::App& app) {
     fmt::print("{} DEM trials written to {}/trials.csv\n", n, *runs_out);
     if (n == 0)
       throw UsageError("no readable trace.h5 (run folders) or <campaign>.files/traces/*.h5 under the given folders");
-    if (!issues.empty()) {
-      std::fflush(stdout);
-      std::exit(kExitIncomplete);
-    }
+    if (!issues.empty()) throw ExitWith{kExitIncomplete};
   });
 
   imp->callback([o]() {
@@ -120,10 +117,7 @@ void setup_measurements(CLI::App& app) {
     t.print(o->format);
     std::fprintf(stderr, "%d trials stored in %s (read from %s: %s), %zu not usable\n", stored, o->db.c_str(),
                  o->dir.c_str(), in.kind.c_str(), c.issues.size());
-    if (!c.issues.empty()) {  // finished, but some trials failed: exit code 4
-      std::fflush(stdout);
-      std::exit(kExitIncomplete);
-    }
+    if (!c.issues.empty()) throw ExitWith{kExitIncomplete};  // finished, but some trials failed
   });
 }
 

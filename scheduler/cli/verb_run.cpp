@@ -212,7 +212,7 @@ void setup_run(CLI::App& app) {
       run_impact(*opt);
     } catch (const InterruptedExit& e) {
       std::fprintf(stderr, "interrupted: %s (no partial files left)\n", e.what());
-      std::exit(kExitInterrupted);
+      throw ExitWith{kExitInterrupted};
     }
   });
 }

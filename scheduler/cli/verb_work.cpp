@@ -88,7 +88,7 @@ int supervise(const WorkOptions& o, int threads) {
       for (auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
       argv.push_back(nullptr);
       execv(exe.c_str(), argv.data());
-      _exit(127);
+      _exit(kExitExecFailed);
     }
     kids.push_back(pid);
   }
@@ -115,7 +115,7 @@ int supervise(const WorkOptions& o, int threads) {
         if (k != done) continue;
         k = -1;
         --alive;
-        const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        const int code = WIFEXITED(status) ? WEXITSTATUS(status) : kExitSignalBase + WTERMSIG(status);
         if (code == kExitInterrupted) interrupted = true;
         else if (code != kExitOk && code != kExitIncomplete) {
           ++failures;
@@ -201,12 +201,9 @@ void setup_work(CLI::App& app) {
   sub->add_flag("--quiet", opt->quiet, "no per-job log lines");
   sub->callback([opt]() {
     const int code = run_work(*opt);
-    // main() maps exceptions to 0/1/2/3 only: the worker's own codes (4, 130) leave from here,
-    // after every database handle has been closed by run_work's scopes.
-    if (code != kExitOk) {
-      std::fflush(nullptr);
-      _exit(code);  // no exit handlers: see main.cpp (HDF5 clean-up after a failed job)
-    }
+    // The worker's own codes (4, 130) after every database handle was closed by run_work's
+    // scopes; no exit handlers (main.cpp: HDF5's clean-up after a failed job).
+    if (code != kExitOk) throw ExitWith{code, true};
   });
 }
 

@@ -268,7 +268,6 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   td.release_speed_m_s = dr.release_speed_m_s;
   td.projectile_diameter_m = p.projectile.diameter_m;
   td.projectile_mass_kg = p.projectile.mass_kg;
-  td.fill_height_m = bed.surface_height_m;
   td.grain_diameter_m = p.bed.grains.diameter_m;
   td.stopped = dr.stopped;
   td.scenario_json = s.dump();

@@ -39,24 +39,31 @@ std::string problems_message(const std::string& source, const std::vector<SpecPr
   return m;
 }
 
+/// A sweep spec's: "FILE: invalid sweep spec (N problems); nothing was written", one line each.
+std::string sweep_problems_message(const std::string& file, const std::vector<SpecProblem>& problems) {
+  std::string m = fmt::format("{}: invalid sweep spec ({} problem{}); nothing was written", file, problems.size(),
+                              problems.size() == 1 ? "" : "s");
+  for (const auto& p : problems)
+    m += fmt::format("\n  {}: found {}, expected {}", p.pointer.empty() ? "/" : p.pointer, p.found, p.expected);
+  return m;
+}
+
 }  // namespace
 
 SpecError::SpecError(std::string source, std::string pointer, std::string found, std::string expected)
     : SpecError(std::move(source), std::vector<SpecProblem>{{std::move(pointer), std::move(found), std::move(expected)}}) {}
 
 SpecError::SpecError(std::string source, std::vector<SpecProblem> problems)
-    : ConfigError(problems_message(source, problems)), source_(std::move(source)), problems_(std::move(problems)) {
-  if (problems_.empty()) throw std::logic_error("SpecError without a problem");
+    // Braces: the message is made before the arguments are moved (left to right).
+    : SpecError{Message{problems_message(source, problems)}, std::move(source), std::move(problems)} {}
+
+SpecError SpecError::sweep_spec(std::string file, std::vector<SpecProblem> problems) {
+  return {Message{sweep_problems_message(file, problems)}, std::move(file), std::move(problems)};
 }
 
-std::string pointer_token(const std::string& key) {
-  std::string out;
-  for (char c : key) {
-    if (c == '~') out += "~0";
-    else if (c == '/') out += "~1";
-    else out += c;
-  }
-  return out;
+SpecError::SpecError(Message message, std::string source, std::vector<SpecProblem> problems)
+    : ConfigError(std::move(message.text)), source_(std::move(source)), problems_(std::move(problems)) {
+  if (problems_.empty()) throw std::logic_error("SpecError without a problem");
 }
 
 SchemaValidator::SchemaValidator(json schema) : schema_(std::move(schema)) {}
@@ -152,7 +159,7 @@ void SchemaValidator::check(json& node, const json& schema_in, const std::string
         if (props.contains(it.key())) continue;
         std::string known;
         for (auto p = props.begin(); p != props.end(); ++p) known += (known.empty() ? "" : ", ") + p.key();
-        problems.push_back({ptr + "/" + pointer_token(it.key()), shown(it.value()) + " (unknown field)",
+        problems.push_back({pointer_child(ptr, it.key()), shown(it.value()) + " (unknown field)",
                             fmt::format("one of the fields {}", known)});
       }
     }
@@ -160,10 +167,10 @@ void SchemaValidator::check(json& node, const json& schema_in, const std::string
       for (const auto& r : s["required"]) {
         const std::string key = r.get<std::string>();
         if (!node.contains(key))
-          problems.push_back({ptr + "/" + pointer_token(key), "nothing (missing)", "a value: the field is required"});
+          problems.push_back({pointer_child(ptr, key), "nothing (missing)", "a value: the field is required"});
       }
     for (auto p = props.begin(); p != props.end(); ++p) {
-      const std::string child_ptr = ptr + "/" + pointer_token(p.key());
+      const std::string child_ptr = pointer_child(ptr, p.key());
       if (node.contains(p.key())) {
         check(node[p.key()], p.value(), child_ptr, problems);
       } else {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "engine/core/error.h"
+#include "scheduler/pipeline/json_pointer.h"  // pointer_token
 
 namespace gravsweep::pipeline {
 
@@ -21,12 +22,19 @@ struct SpecProblem {
   std::string expected;  ///< what was expected
 };
 
-/// Spec fields are invalid: every problem found, in order. Derives from ConfigError, so the CLI
-/// exits with code 2. pointer()/found()/expected() are those of the first problem.
+/// Spec fields are invalid: every problem found, in order, in a scenario spec (this validator,
+/// scenario_spec.h) or a sweep spec (scheduler/sweep/spec.h): the one error type of both. Derives
+/// from ConfigError, so the CLI exits with code 2. pointer()/found()/expected() are those of the
+/// first problem.
 class SpecError : public ConfigError {
  public:
+  /// A scenario's problems: "SOURCE: POINTER = FOUND is invalid: expected X" (several: counted,
+  /// then one a line).
   SpecError(std::string source, std::string pointer, std::string found, std::string expected);
   SpecError(std::string source, std::vector<SpecProblem> problems);  ///< at least one problem
+  /// A sweep spec's problems: "FILE: invalid sweep spec (N problems); nothing was written", then
+  /// "  POINTER: found F, expected E" for each (at least one problem).
+  [[nodiscard]] static SpecError sweep_spec(std::string file, std::vector<SpecProblem> problems);
   [[nodiscard]] const std::string& source() const { return source_; }
   [[nodiscard]] const std::vector<SpecProblem>& problems() const { return problems_; }
   [[nodiscard]] const std::string& pointer() const { return problems_.front().pointer; }
@@ -34,12 +42,13 @@ class SpecError : public ConfigError {
   [[nodiscard]] const std::string& expected() const { return problems_.front().expected; }
 
  private:
+  struct Message {
+    std::string text;
+  };
+  SpecError(Message message, std::string source, std::vector<SpecProblem> problems);
   std::string source_;
   std::vector<SpecProblem> problems_;
 };
-
-/// JSON pointer escaping of one reference token (RFC 6901: ~ -> ~0, / -> ~1).
-std::string pointer_token(const std::string& key);
 
 class SchemaValidator {
  public:

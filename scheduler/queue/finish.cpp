@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 
+#include "scheduler/queue/exit_codes.h"
 #include "scheduler/queue/queue_internal.h"
 #include "scheduler/sweep/canonical.h"
 
@@ -16,6 +17,21 @@ using db::Statement;
 using db::Transaction;
 using nlohmann::json;
 namespace fs = std::filesystem;
+
+namespace {
+
+/// Closes the attempt row of an attempt that did not complete: its outcome ('failed', 'dead',
+/// 'released'), end time, runtime, exit code and error.
+void end_attempt(Database& db, const Claim& c, const std::string& outcome, double now, int exit_code,
+                 const std::string& error) {
+  Statement st(db,
+               "UPDATE attempts SET outcome=?1, ended_at=?2, runtime_s=?2-started_at, exit_code=?3, error=?4 "
+               "WHERE attempt_id=?5");
+  st.bind(1, outcome).bind(2, now).bind(3, exit_code).bind(4, error).bind(5, c.attempt_row);
+  st.run();
+}
+
+}  // namespace
 
 bool complete(Database& db, const Claim& c, const Completion& done) {
   const double now = clock_s(db);
@@ -71,13 +87,7 @@ std::string fail(Database& db, const Claim& c, const std::string& error, int exi
     state = st.get_text(0);
     st.run();
   }
-  {
-    Statement st(db,
-                 "UPDATE attempts SET outcome=?1, ended_at=?2, runtime_s=?2-started_at, exit_code=?3, error=?4 "
-                 "WHERE attempt_id=?5");
-    st.bind(1, state).bind(2, now).bind(3, exit_code).bind(4, error).bind(5, c.attempt_row);
-    st.run();
-  }
+  end_attempt(db, c, state, now, exit_code, error);
   if (state == "dead") detail::cascade_dead(db, c.job_id, now);
   tx.commit();
   return state;
@@ -95,12 +105,7 @@ bool bed_mismatch(Database& db, const Claim& c, const std::string& reason) {
     st.run();
     if (db.changes() != 1) return false;
   }
-  {
-    Statement st(db, "UPDATE attempts SET outcome='failed', ended_at=?1, runtime_s=?1-started_at, exit_code=1, "
-                     "error=?2 WHERE attempt_id=?3");
-    st.bind(1, now).bind(2, reason).bind(3, c.attempt_row);
-    st.run();
-  }
+  end_attempt(db, c, "failed", now, kExitFailure, reason);
   {  // the bed is rebuilt once, by whichever drop noticed first
     Statement st(db,
                  "UPDATE jobs SET state='queued', output_path=NULL, output_sha256=NULL, output_bytes=NULL, "
@@ -120,7 +125,6 @@ bool bed_mismatch(Database& db, const Claim& c, const std::string& reason) {
   return true;
 }
 
-
 bool release(Database& db, const Claim& c, const std::string& why) {
   const double now = clock_s(db);
   Transaction tx(db);
@@ -132,11 +136,7 @@ bool release(Database& db, const Claim& c, const std::string& why) {
     st.run();
     if (db.changes() != 1) return false;
   }
-  Statement st(db,
-               "UPDATE attempts SET outcome='released', ended_at=?1, runtime_s=?1-started_at, exit_code=130, "
-               "error=?2 WHERE attempt_id=?3");
-  st.bind(1, now).bind(2, why).bind(3, c.attempt_row);
-  st.run();
+  end_attempt(db, c, "released", now, kExitInterrupted, why);
   tx.commit();
   return true;
 }

@@ -2,28 +2,18 @@
 
 #include <fmt/format.h>
 
-#if __has_include("scheduler/pipeline/impact_job.h")
 #include "scheduler/pipeline/bed_cache.h"
 #include "scheduler/pipeline/impact_job.h"
-#define GRAVSWEEP_HAVE_PIPELINE 1
-#else
-#define GRAVSWEEP_HAVE_PIPELINE 0
-#endif
 
 namespace gravsweep::queue {
 
-bool impact_available() { return GRAVSWEEP_HAVE_PIPELINE != 0; }
+bool impact_available() { return true; }
 
 sweep::BedKeyFn impact_bed_key() {
-#if GRAVSWEEP_HAVE_PIPELINE
   return [](const nlohmann::json& scenario) { return pipeline::bed_key(scenario); };
-#else
-  return {};
-#endif
 }
 
 void add_impact_runners(RunnerTable& table) {
-#if GRAVSWEEP_HAVE_PIPELINE
   table[JobKind::bed] = [](const RunContext& ctx) {
     RunOutput out;
     if (!ctx.bed_cache.empty()) {
@@ -56,9 +46,6 @@ void add_impact_runners(RunnerTable& table) {
     out.metrics = r.metrics;
     return out;
   };
-#else
-  (void)table;
-#endif
 }
 
 RunnerTable all_runners() {

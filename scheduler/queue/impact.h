@@ -1,17 +1,18 @@
-// The impact job kinds ("bed" and "drop") on top of scheduler/pipeline/impact_job.h, when that
-// pipeline is part of the build; otherwise available() is false and submit refuses impact sweeps.
+// The impact job kinds ("bed" and "drop") on top of scheduler/pipeline/impact_job.h. The pipeline
+// is part of every build (scheduler/CMakeLists.txt compiles pipeline/*.cpp into the library).
 #pragma once
 #include "scheduler/queue/worker.h"
 #include "scheduler/sweep/spec.h"
 
 namespace gravsweep::queue {
 
+/// Whether this build runs impact jobs: always true (the pipeline is always built).
 bool impact_available();
-/// Drops with equal keys share a bed (pipeline::bed_key); empty function when unavailable.
+/// Drops with equal keys share a bed (pipeline::bed_key).
 sweep::BedKeyFn impact_bed_key();
-/// Adds the "bed" and "drop" runners (no-op when unavailable).
+/// Adds the "bed" and "drop" runners.
 void add_impact_runners(RunnerTable& table);
-/// Every runner this build has: noop, and bed/drop when available.
+/// Every runner: noop, bed and drop.
 RunnerTable all_runners();
 
 }  // namespace gravsweep::queue

@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "scheduler/queue/exit_codes.h"
+
 namespace gravsweep::queue {
 
 std::string self_exe() {
@@ -36,7 +38,7 @@ pid_t spawn_process(const std::string& program, const std::vector<std::string>& 
       }
     }
     execv(program.c_str(), argv.data());
-    _exit(127);
+    _exit(kExitExecFailed);
   }
   return pid;
 }
@@ -47,7 +49,7 @@ int wait_process(pid_t pid) {
     if (errno != EINTR) return -1;
   }
   if (WIFEXITED(status)) return WEXITSTATUS(status);
-  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
+  if (WIFSIGNALED(status)) return kExitSignalBase + WTERMSIG(status);
   return -1;
 }
 

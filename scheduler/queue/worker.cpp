@@ -17,6 +17,7 @@
 
 #include "engine/core/error.h"
 #include "scheduler/queue/campaign.h"
+#include "scheduler/queue/exit_codes.h"
 #include "scheduler/sweep/canonical.h"
 
 namespace gravsweep::queue {
@@ -217,7 +218,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     };
     RunOutput out;
     std::string error;
-    int exit_code = 0;
+    int exit_code = kExitOk;
     bool permanent = false;
     const auto t0 = std::chrono::steady_clock::now();
     if (o.verbose)
@@ -259,15 +260,15 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
       out = runner->second(ctx);
     } catch (const ConfigError& e) {
       error = e.what();
-      exit_code = 2;
+      exit_code = kExitUsage;
       permanent = true;
     } catch (const NumericalFailure& e) {
       error = fmt::format("numerical failure at step {}, particle {}: {}", e.step(), e.particle(), e.what());
-      exit_code = 3;
+      exit_code = kExitNumerical;
       permanent = true;
     } catch (const std::exception& e) {
       error = e.what();
-      exit_code = 1;
+      exit_code = kExitFailure;
     }
     stop_beat();
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -287,7 +288,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     }
     if (error.empty() && !fs::exists(tmp)) {
       error = fmt::format("job {} finished but wrote no output at '{}'", c->job_id, tmp.string());
-      exit_code = 1;
+      exit_code = kExitFailure;
     }
     if (!error.empty()) {
       remove_tmp_of(paths.tmp(), prefix);

@@ -8,6 +8,8 @@
 #include <cstdlib>
 #include <fstream>
 
+#include "scheduler/pipeline/json_pointer.h"
+
 namespace gravsweep::sweep {
 
 namespace {
@@ -46,16 +48,6 @@ void write_double(std::string& out, double v, const std::string& where) {
   out += fmt::format("{}", v);  // shortest round-trip representation
 }
 
-std::string esc(const std::string& key) {  // JSON pointer token escaping (RFC 6901)
-  std::string r;
-  for (char c : key) {
-    if (c == '~') r += "~0";
-    else if (c == '/') r += "~1";
-    else r.push_back(c);
-  }
-  return r;
-}
-
 void write(std::string& out, const nlohmann::json& j, const std::string& where) {
   using T = nlohmann::json::value_t;
   switch (j.type()) {
@@ -82,7 +74,7 @@ void write(std::string& out, const nlohmann::json& j, const std::string& where) 
         first = false;
         write_string(out, it.key());
         out.push_back(':');
-        write(out, it.value(), where + "/" + esc(it.key()));
+        write(out, it.value(), pipeline::pointer_child(where, it.key()));
       }
       out.push_back('}');
       break;
@@ -108,7 +100,8 @@ nlohmann::json normalise(const nlohmann::json& j, const std::string& where) {
     }
     case T::object: {
       nlohmann::json out = nlohmann::json::object();
-      for (auto it = j.begin(); it != j.end(); ++it) out[it.key()] = normalise(it.value(), where + "/" + esc(it.key()));
+      for (auto it = j.begin(); it != j.end(); ++it)
+        out[it.key()] = normalise(it.value(), pipeline::pointer_child(where, it.key()));
       return out;
     }
     default: return j;

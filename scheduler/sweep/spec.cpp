@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "scheduler/pipeline/json_pointer.h"
 #include "scheduler/pipeline/json_schema.h"
 #include "scheduler/sweep/canonical.h"
 
@@ -40,15 +41,7 @@ std::string show(const json& v) {
   return s + " (" + type_name(v) + ")";
 }
 
-std::string join(const std::string& ptr, const std::string& token) {
-  std::string t;
-  for (char c : token) {
-    if (c == '~') t += "~0";
-    else if (c == '/') t += "~1";
-    else t.push_back(c);
-  }
-  return ptr + "/" + t;
-}
+std::string join(const std::string& ptr, const std::string& token) { return pipeline::pointer_child(ptr, token); }
 std::string join(const std::string& ptr, std::size_t i) { return ptr + "/" + std::to_string(i); }
 
 bool is_int(const json& v) {
@@ -289,17 +282,6 @@ std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json
 
 }  // namespace
 
-SpecError::SpecError(std::string file, std::vector<SpecProblem> problems)
-    : std::runtime_error([&] {
-        std::string msg = fmt::format("{}: invalid sweep spec ({} problem{}); nothing was written", file,
-                                      problems.size(), problems.size() == 1 ? "" : "s");
-        for (const auto& p : problems)
-          msg += fmt::format("\n  {}: found {}, expected {}", p.pointer.empty() ? "/" : p.pointer, p.found, p.expected);
-        return msg;
-      }()),
-      file_(std::move(file)),
-      problems_(std::move(problems)) {}
-
 std::size_t SweepSpec::points() const {
   std::size_t n = 1;
   for (const auto& g : groups) n *= g.size();
@@ -338,7 +320,7 @@ SweepSpec parse_spec(const json& doc, const std::string& file, const std::filesy
   SweepSpec spec;
   if (!doc.is_object()) {
     ck.add("", &doc, "an object {sweep, base, axes, ...}");
-    throw SpecError(file, ck.problems);
+    throw SpecError::sweep_spec(file, ck.problems);
   }
   ck.known_keys(doc, "", {"$schema", "sweep", "description", "job", "base", "axes", "repeats", "max_attempts",
                           "priority"});
@@ -458,9 +440,10 @@ SweepSpec parse_spec(const json& doc, const std::string& file, const std::filesy
     if (auto axis = parse_axis(doc["repeats"], "/repeats", base, ck, true))
       add_group(AxisGroup{{std::move(*axis)}}, "/repeats");
   }
-  if (!ck.problems.empty()) throw SpecError(file, ck.problems);
+  if (!ck.problems.empty()) throw SpecError::sweep_spec(file, ck.problems);
   if (spec.points() > 5'000'000)
-    throw SpecError(file, {{"/axes", fmt::format("{} points", spec.points()), "at most 5000000 points per sweep"}});
+    throw SpecError::sweep_spec(file,
+                                {{"/axes", fmt::format("{} points", spec.points()), "at most 5000000 points per sweep"}});
   spec.source = doc;
   spec.source["base"] = spec.base;
   spec.file = file;
@@ -470,10 +453,10 @@ SweepSpec parse_spec(const json& doc, const std::string& file, const std::filesy
 SweepSpec load_spec(const std::filesystem::path& path) {
   std::string why;
   const auto text = read_text_file(path, why);
-  if (!text) throw SpecError(path.string(), {{"", why, "a JSON sweep spec file"}});
+  if (!text) throw SpecError::sweep_spec(path.string(), {{"", why, "a JSON sweep spec file"}});
   json doc;
   if (const auto err = parse_json_text(*text, doc))
-    throw SpecError(path.string(), {{"", fmt::format("{} at {}", err->what, err->where()), "valid JSON"}});
+    throw SpecError::sweep_spec(path.string(), {{"", fmt::format("{} at {}", err->what, err->where()), "valid JSON"}});
   return parse_spec(doc, path.string(), path.parent_path());
 }
 
@@ -499,7 +482,7 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
     } catch (const pipeline::SpecError& e) {
       for (const auto& p : e.problems())
         if (!swept(p.pointer)) problems.push_back({"/base" + p.pointer, p.found, p.expected});
-      if (!problems.empty()) throw SpecError(spec.file.empty() ? spec.name : spec.file, problems);
+      if (!problems.empty()) throw SpecError::sweep_spec(spec.file.empty() ? spec.name : spec.file, problems);
     } catch (const std::exception&) {
       // Not checkable alone (e.g. a field every axis sets): the points report it.
     }
@@ -589,7 +572,7 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
   }
   for (std::size_t i = 0; i < problems.size(); ++i)
     if (repeats[i] > 0) problems[i].found += fmt::format(" (and {} more point{} with this problem)", repeats[i], repeats[i] == 1 ? "" : "s");
-  if (!problems.empty()) throw SpecError(spec.file.empty() ? spec.name : spec.file, problems);
+  if (!problems.empty()) throw SpecError::sweep_spec(spec.file.empty() ? spec.name : spec.file, problems);
   for (auto& b : beds) {  // drop the parameters that vary within the bed
     json kept = json::object();
     for (auto it = b.params.begin(); it != b.params.end(); ++it)

@@ -3,8 +3,9 @@
 // offsets). expand() turns a spec into content-addressed jobs: one `drop` job per point and one
 // `bed` job per distinct bed key, which the drops that share the bed depend on.
 //
-// Validation never stops at the first problem: SpecError lists every problem with the file, the
-// JSON pointer, the value found and what was expected.
+// Validation never stops at the first problem: SpecError (pipeline::SpecError, made by
+// SpecError::sweep_spec) lists every problem with the file, the JSON pointer, the value found and
+// what was expected.
 #pragma once
 #include <nlohmann/json.hpp>
 
@@ -22,16 +23,9 @@ namespace gravsweep::sweep {
 /// One problem: JSON pointer into the spec ("" = the document), the value found, what was expected.
 using SpecProblem = pipeline::SpecProblem;
 
-class SpecError : public std::runtime_error {
- public:
-  SpecError(std::string file, std::vector<SpecProblem> problems);
-  [[nodiscard]] const std::vector<SpecProblem>& problems() const { return problems_; }
-  [[nodiscard]] const std::string& file() const { return file_; }
-
- private:
-  std::string file_;
-  std::vector<SpecProblem> problems_;
-};
+/// The one spec error (pipeline/json_schema.h), thrown here as SpecError::sweep_spec(file, problems):
+/// a ConfigError whose message lists every problem.
+using SpecError = pipeline::SpecError;
 
 /// One swept scenario field.
 struct Axis {

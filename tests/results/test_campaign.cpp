@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "results/measurements/campaign.h"
 #include "results/model/model.h"
@@ -29,6 +30,13 @@ SynthOptions small() {
 std::string read_all(const std::filesystem::path& p) {
   std::ifstream in(p);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// `text` as one RFC 4180 field: in double quotes, each quote doubled.
+std::string csv_quoted(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
 }
 
 }  // namespace
@@ -155,4 +163,45 @@ TEST(Campaign, ReadBackFromSqliteFitsExactlyAsFromTheFolder) {
   const auto spec = parse_model("base+depth_friction");
   const auto a = fit_model(spec, c), b = fit_model(spec, back);
   for (Eigen::Index j = 0; j < a.coef.size(); ++j) EXPECT_NEAR(b.coef(j), a.coef(j), 1e-9 * std::abs(a.coef(j)));
+}
+
+TEST(Campaign, AttributeCellWithQuotesBackslashesAndLineBreaksIsStoredAsValidJson) {
+  TempDir d;
+  const auto dir = d.path / "c";
+  write_synthetic_campaign(dir.string(), parse_model("base"), small());
+  // One more trials.csv column, kept as an attribute: a quote (as `"5"" bead"`), backslashes and
+  // a line break inside a quoted field.
+  const std::string cell = "5\" bead, C:\\lab\\\"wet\" run\nsecond line";
+  std::istringstream in(read_all(dir / "trials.csv"));
+  std::string csv, line;
+  for (bool header = true; std::getline(in, line); header = false) {
+    csv += line;
+    csv += header ? std::string(",operator_note") : ',' + csv_quoted(cell);
+    csv += '\n';
+  }
+  std::ofstream(dir / "trials.csv") << csv;
+  const Campaign c = load_campaign(dir.string());
+  ASSERT_TRUE(c.issues.empty()) << c.issues.front().to_string();
+  ASSERT_EQ(c.trials.size(), 8u);
+  EXPECT_EQ(c.trials.front().info.attributes.at("operator_note"), cell);
+  const std::string dbfile = (d.path / "lab.db").string();
+  {
+    db::Database db(dbfile);
+    ASSERT_EQ(store_campaign(db, c), 8);
+  }
+  db::Database db(dbfile);
+  db::Statement q(db, "SELECT trial_id, attributes_json FROM trials ORDER BY trial_id");
+  int rows = 0;
+  while (q.step()) {
+    ++rows;
+    const std::string text = q.get_text(1);
+    const auto j = nlohmann::json::parse(text, nullptr, false);
+    ASSERT_TRUE(j.is_object()) << q.get_text(0) << ": attributes_json is not a JSON object: " << text;
+    ASSERT_TRUE(j.contains("operator_note")) << text;
+    EXPECT_EQ(j.at("operator_note").get<std::string>(), cell) << text;
+  }
+  EXPECT_EQ(rows, 8);
+  const Campaign back = load_campaign_any(dbfile);
+  ASSERT_EQ(back.trials.size(), 8u);
+  EXPECT_EQ(back.trials.front().info.attributes.at("operator_note"), cell);
 }

@@ -75,7 +75,6 @@ void write_dem_trace(const fs::path& p, const Poncelet& k, double fs_hz, const s
   d.release_speed_m_s = k.v0 - k.g * t_contact;
   d.projectile_diameter_m = 0.1;
   d.projectile_mass_kg = k.m;
-  d.fill_height_m = 0.1;
   d.grain_diameter_m = 0.01;
   d.stopped = true;
   d.scenario_json = scenario_json;
@@ -328,4 +327,18 @@ TEST(FromRuns, FindsCampaignTracesAndKeepsThemInsideTheNewCampaignFolder) {
   const Campaign c = load_campaign(out);
   ASSERT_EQ(c.trials.size(), 2u) << issues_of(c);
   EXPECT_EQ(c.trials[0].info.source, TraceSource::dem);
+}
+
+TEST(OneEntry, ADemTrialsFillHeightIsTheTracesMeasuredSurfaceHeight) {
+  TempDir d;
+  const Poncelet k;
+  const fs::path p = d.path / "a/trace.h5";
+  write_dem_trace(p, k, 10000, R"({"output": {"filter_cutoff_hz": 500}})");
+  TraceData td = read_trace(p);
+  td.surface_height_m = 0.0937;  // settled below a nominal fill of 0.1 m
+  write_trace(p, td);
+  EXPECT_DOUBLE_EQ(read_trace(p).surface_height_m, 0.0937);
+  const MeasuredTrial t = read_dem_trial({"a", "job1", p});
+  EXPECT_DOUBLE_EQ(t.info.fill_height_m, 0.0937);
+  EXPECT_DOUBLE_EQ(metric_options(t.info).fill_height_m.value_or(0), 0.0937);  // the rebound's floor
 }

@@ -3,6 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "scheduler/pipeline/json_pointer.h"
 #include "scheduler/sweep/canonical.h"
 
 using gravsweep::sweep::canonical_json;
@@ -55,5 +56,28 @@ TEST(Canonical, RejectsNonFinite) {
     FAIL() << "NaN accepted";
   } catch (const gravsweep::sweep::CanonicalError& e) {
     EXPECT_NE(std::string(e.what()).find("/a/b"), std::string::npos) << e.what();
+  }
+}
+
+TEST(JsonPointer, TokensAreEscapedAsRfc6901Says) {
+  using gravsweep::pipeline::pointer_child;
+  using gravsweep::pipeline::pointer_token;
+  EXPECT_EQ(pointer_token("gravity_m_s2"), "gravity_m_s2");
+  EXPECT_EQ(pointer_token("a/b~c"), "a~1b~0c");
+  EXPECT_EQ(pointer_token("~1"), "~01");  // '~' first, so "~1" is not read back as '/'
+  EXPECT_EQ(pointer_child("", "x/y"), "/x~1y");
+  EXPECT_EQ(pointer_child("/base", "m~s"), "/base/m~0s");
+  // The pointer a message names is the one nlohmann reads back to the same member.
+  const json j = {{"a/b", {{"c~d", 1}}}};
+  EXPECT_EQ(j.at(json::json_pointer(pointer_child(pointer_child("", "a/b"), "c~d"))), 1);
+}
+
+TEST(Canonical, RejectsNonFiniteNamingAnEscapedPointer) {
+  json j = {{"a/b", {{"c~d", std::nan("")}}}};
+  try {
+    canonical_json(j);
+    FAIL() << "NaN accepted";
+  } catch (const gravsweep::sweep::CanonicalError& e) {
+    EXPECT_NE(std::string(e.what()).find("/a~1b/c~0d"), std::string::npos) << e.what();
   }
 }

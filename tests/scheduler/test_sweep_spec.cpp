@@ -166,3 +166,29 @@ TEST(SweepSpec, BaseFromFileRelativeToSpec) {
   EXPECT_EQ(spec.groups[0].axes[0].name, "nested_k");
   EXPECT_EQ(spec.points(), 2u);
 }
+
+TEST(SweepSpec, ErrorIsTheOneSpecErrorAConfigErrorWithTheSweepMessage) {
+  // One SpecError for scenario and sweep specs (pipeline/json_schema.h); a sweep spec's message
+  // stays as it was: the file, the count, then one line per problem.
+  const json doc = {{"sweep", "s"},
+                    {"base", kBase},
+                    {"axes", {{{"pointer", "/g"}, {"values", {1.62, 9.81}}}}},
+                    {"colour/x", 1},
+                    {"max_attempts", 0}};
+  try {
+    parse(doc);
+    FAIL() << "an unknown key and max_attempts 0 accepted";
+  } catch (const gravsweep::ConfigError& e) {
+    const auto* se = dynamic_cast<const gravsweep::pipeline::SpecError*>(&e);
+    ASSERT_NE(se, nullptr) << "not a SpecError: " << e.what();
+    EXPECT_EQ(se->source(), "spec.json");
+    ASSERT_EQ(se->problems().size(), 2u) << e.what();
+    const std::string first = "\n  /colour~1x: found unknown key \"colour/x\", expected one of: ";
+    EXPECT_EQ(std::string(e.what()).rfind("spec.json: invalid sweep spec (2 problems); nothing was written" + first, 0),
+              0u)
+        << e.what();
+    EXPECT_EQ(se->pointer(), "/colour~1x");
+    EXPECT_NE(std::string(e.what()).find("\n  /max_attempts: found 0 (integer), expected "), std::string::npos)
+        << e.what();
+  }
+}
