@@ -187,6 +187,31 @@ TEST(Reproduction, FillHeightTrendsAsStated) {
   for (double z : plateau) EXPECT_NEAR(z, mean, 0.05 * mean);
 }
 
+// Fig. 6 (part 4, REPRODUCTION.md): at 1 m/s and 1 g with mu_t = 0, zstop falls as mu_r grows to
+// ~0.13 and is nearly flat from 0.13 to 0.25 (the paper: "flat"); inside the paper's axes, 2.5-5 cm.
+// Ours: 4.80, 3.99, 3.61, 3.43, 3.24, 3.19 cm at mu_r 0, 0.05, 0.09, 0.13, 0.2, 0.25 (one bed each).
+TEST(Reproduction, RollingFrictionDepthFallsThenFlattensAsFig6) {
+  const auto rows = csv_rows("results_part4_rolling_friction.csv");
+  ASSERT_EQ(rows.size(), 6u);
+  std::map<double, double> zstop_by_mur;
+  for (const auto& r : rows) {
+    EXPECT_NEAR(std::stod(r.at("vc_m_s")), 1.02, 0.03) << "the paper's Fig. 6 speed";
+    zstop_by_mur[std::stod(r.at("mu_rolling"))] = std::stod(r.at("zstop_m"));
+  }
+  ASSERT_EQ(zstop_by_mur.size(), 6u);
+  double previous = 1.0;
+  for (const auto& [mur, z] : zstop_by_mur) {
+    EXPECT_LT(z, previous) << "mu_r " << mur << ": deeper than at the smaller mu_r";
+    EXPECT_GT(z, 0.025) << mur;
+    EXPECT_LT(z, 0.05) << mur;
+    previous = z;
+  }
+  const double z0 = zstop_by_mur.at(0.0), z13 = zstop_by_mur.at(0.13), z25 = zstop_by_mur.at(0.25);
+  EXPECT_LT(z13, 0.8 * z0) << "falls by more than 20 % from mu_r 0 to 0.13";
+  EXPECT_GT(z25, 0.9 * z13) << "then within 10 % from 0.13 to 0.25";
+  EXPECT_LT((z13 - z25) / 0.12, 0.25 * (z0 - z13) / 0.13) << "the slope after 0.13 a quarter of that before";
+}
+
 // dt check (REPRODUCTION.md): at 1 us zstop is 1.3-1.8 % shallower than part 1's 5 us drops.
 TEST(Reproduction, DtCheckMovesZstopByLessThanTwoPercent) {
   const auto fine = csv_rows("results_part1_dt_check.csv");
