@@ -72,7 +72,7 @@ std::string render_status(const queue::Status& s, const std::string& db, double 
     out += "\nruntimes by kind:\n" + queue::render_table(k);
   }
   if (all.waiting + all.queued + all.failed + all.running > 0) {
-    out += s.eta_s >= 0 ? fmt::format("\nETA {} with {} active worker(s) (median runtime of finished jobs of each kind)\n",
+    out += s.eta_s >= 0 ? fmt::format("\nETA {} with {} active worker(s) (median runtime of finished jobs of each sweep and kind)\n",
                                       format_duration(s.eta_s), std::max<std::int64_t>(1, s.active_workers))
                         : "\nETA unknown: no job of some remaining kind has finished yet\n";
   }
@@ -161,7 +161,8 @@ void setup_status(CLI::App& app) {
       "status",
       "Show a campaign: job counts per state for each sweep and kind, running jobs with their\n"
       "progress and lease, stale leases (workers that stopped heartbeating), median runtimes and an\n"
-      "ETA (remaining jobs x median runtime of finished jobs of the same kind / active workers).\n"
+      "ETA (remaining jobs x median runtime of finished jobs of the same sweep and kind, or of the\n"
+      "kind where that sweep has none yet / active workers).\n"
       "Counts come from indexed queries: fast on 100,000 jobs.\n\n"
       "Examples:\n"
       "  gravsweep status --db campaign.db\n"

@@ -17,7 +17,7 @@ Status status(Database& db, std::size_t max_running) {
   const double now = clock_s(db);
   // A read transaction gives one consistent snapshot (WAL: does not block writers).
   Transaction tx(db, Transaction::Mode::deferred);
-  std::map<std::string, std::int64_t> remaining;  // per kind, each job once
+  std::map<std::pair<std::string, std::string>, std::int64_t> remaining;  // per (sweep, kind), each job once
   {
     // Jobs counted under the sweep that created them (covering index jobs_sweep_state), plus the
     // few memberships of jobs shared with another sweep.
@@ -48,7 +48,7 @@ Status status(Database& db, std::size_t max_running) {
           case JobState::dead: c.dead += n; break;
         }
         const bool left = state == JobState::waiting || state == JobState::queued || state == JobState::failed;
-        if (q == &own && left) remaining[key.second] += n;
+        if (q == &own && left) remaining[key] += n;
       }
     }
     std::sort(order.begin(), order.end());
@@ -69,17 +69,17 @@ Status status(Database& db, std::size_t max_running) {
     }
   }
   {
-    // Remaining work per kind, and the median runtime of that kind's finished attempts.
+    // Remaining work per kind (the table), and the ETA from the median runtime of finished
+    // attempts of the same sweep and kind: one sweep's 1 g drops say little about another's
+    // low-gravity ones. A sweep with none finished yet of that kind takes the kind's median.
     std::map<std::string, KindRuntime> kinds;
-    for (const auto& [kind, n] : remaining) {
-      kinds[kind].kind = kind;
-      kinds[kind].remaining = n;
+    for (const auto& [key, n] : remaining) {
+      kinds[key.second].kind = key.second;
+      kinds[key.second].remaining += n;
     }
     for (const auto& r : s.running) kinds[r.kind].kind = r.kind;
     Statement cnt(db, "SELECT count(*) FROM attempts WHERE kind=? AND outcome='done'");
     Statement med(db, "SELECT runtime_s FROM attempts WHERE kind=? AND outcome='done' ORDER BY runtime_s LIMIT 1 OFFSET ?");
-    double total = 0;
-    bool known = true;
     for (auto& [name, k] : kinds) {
       cnt.reset();
       cnt.bind(1, name);
@@ -89,16 +89,46 @@ Status status(Database& db, std::size_t max_running) {
         med.reset();
         med.bind(1, name).bind(2, k.finished / 2);
         if (med.step()) k.median_s = med.get_double(0);
-        total += static_cast<double>(k.remaining) * k.median_s;
-      } else if (k.remaining > 0) {
-        known = false;
       }
       s.runtimes.push_back(k);
     }
+    Statement cnt_sk(db,
+                     "SELECT count(*) FROM attempts a JOIN jobs j ON j.job_id=a.job_id WHERE j.sweep_id=? AND "
+                     "a.kind=? AND a.outcome='done'");
+    Statement med_sk(db,
+                     "SELECT a.runtime_s FROM attempts a JOIN jobs j ON j.job_id=a.job_id WHERE j.sweep_id=? AND "
+                     "a.kind=? AND a.outcome='done' ORDER BY a.runtime_s LIMIT 1 OFFSET ?");
+    // The median runtime for a job of this sweep and kind; false when nothing of the kind finished.
+    auto median_for = [&](const std::string& sweep, const std::string& kind, double& out) {
+      cnt_sk.reset();
+      cnt_sk.bind(1, sweep).bind(2, kind);
+      cnt_sk.step();
+      if (const std::int64_t n = cnt_sk.get_int(0); n > 0) {
+        med_sk.reset();
+        med_sk.bind(1, sweep).bind(2, kind).bind(3, n / 2);
+        if (med_sk.step()) {
+          out = med_sk.get_double(0);
+          return true;
+        }
+      }
+      const auto& k = kinds[kind];
+      out = k.median_s;
+      return k.finished > 0;
+    };
+    double total = 0;
+    bool known = true;
+    for (const auto& [key, n] : remaining) {
+      double m = 0;
+      if (n > 0 && median_for(key.first, key.second, m)) total += static_cast<double>(n) * m;
+      else if (n > 0) known = false;
+    }
+    Statement sweep_of(db, "SELECT sweep_id FROM jobs WHERE job_id=?");
     for (const auto& r : s.running) {
       if (r.stale) continue;
-      const auto& k = kinds[r.kind];
-      if (k.finished > 0) total += std::max(0.0, k.median_s * (1 - r.progress));
+      sweep_of.reset();
+      sweep_of.bind(1, r.job_id);
+      double m = 0;
+      if (sweep_of.step() && median_for(sweep_of.get_text(0), r.kind, m)) total += std::max(0.0, m * (1 - r.progress));
       else known = false;
     }
     if (known) s.eta_s = total / static_cast<double>(std::max<std::int64_t>(1, s.active_workers));
