@@ -161,8 +161,9 @@ void setup_status(CLI::App& app) {
       "status",
       "Show a campaign: job counts per state for each sweep and kind, running jobs with their\n"
       "progress and lease, stale leases (workers that stopped heartbeating), median runtimes and an\n"
-      "ETA (remaining jobs x median runtime of finished jobs of the same sweep and kind, or of the\n"
-      "kind where that sweep has none yet / active workers).\n"
+      "ETA (remaining jobs x median runtime of finished jobs of the same sweep and kind; where that\n"
+      "sweep has none yet, what its running jobs project from their progress, else the kind's\n"
+      "median / active workers).\n"
       "Counts come from indexed queries: fast on 100,000 jobs.\n\n"
       "Examples:\n"
       "  gravsweep status --db campaign.db\n"

@@ -98,7 +98,28 @@ Status status(Database& db, std::size_t max_running) {
     Statement med_sk(db,
                      "SELECT a.runtime_s FROM attempts a JOIN jobs j ON j.job_id=a.job_id WHERE j.sweep_id=? AND "
                      "a.kind=? AND a.outcome='done' ORDER BY a.runtime_s LIMIT 1 OFFSET ?");
-    // The median runtime for a job of this sweep and kind; false when nothing of the kind finished.
+    // The sweep of each running job, and for a sweep with nothing of a kind finished yet, the
+    // runtime its running jobs of that kind project (elapsed / progress, once past 5 %).
+    std::map<std::string, std::string> sweep_of_running;
+    {
+      Statement sweep_of(db, "SELECT sweep_id FROM jobs WHERE job_id=?");
+      for (const auto& r : s.running) {
+        sweep_of.reset();
+        sweep_of.bind(1, r.job_id);
+        if (sweep_of.step()) sweep_of_running[r.job_id] = sweep_of.get_text(0);
+      }
+    }
+    auto projected = [&](const std::string& sweep, const std::string& kind, double& out) {
+      std::vector<double> p;
+      for (const auto& r : s.running)
+        if (!r.stale && r.kind == kind && sweep_of_running[r.job_id] == sweep && r.progress > 0.05 && r.started_at > 0)
+          p.push_back((now - r.started_at) / r.progress);
+      if (p.empty()) return false;
+      std::sort(p.begin(), p.end());
+      out = p[p.size() / 2];
+      return true;
+    };
+    // The median runtime for a job of this sweep and kind; false when nothing is known of the kind.
     auto median_for = [&](const std::string& sweep, const std::string& kind, double& out) {
       cnt_sk.reset();
       cnt_sk.bind(1, sweep).bind(2, kind);
@@ -111,6 +132,7 @@ Status status(Database& db, std::size_t max_running) {
           return true;
         }
       }
+      if (projected(sweep, kind, out)) return true;
       const auto& k = kinds[kind];
       out = k.median_s;
       return k.finished > 0;
@@ -122,13 +144,10 @@ Status status(Database& db, std::size_t max_running) {
       if (n > 0 && median_for(key.first, key.second, m)) total += static_cast<double>(n) * m;
       else if (n > 0) known = false;
     }
-    Statement sweep_of(db, "SELECT sweep_id FROM jobs WHERE job_id=?");
     for (const auto& r : s.running) {
       if (r.stale) continue;
-      sweep_of.reset();
-      sweep_of.bind(1, r.job_id);
       double m = 0;
-      if (sweep_of.step() && median_for(sweep_of.get_text(0), r.kind, m)) total += std::max(0.0, m * (1 - r.progress));
+      if (median_for(sweep_of_running[r.job_id], r.kind, m)) total += std::max(0.0, m * (1 - r.progress));
       else known = false;
     }
     if (known) s.eta_s = total / static_cast<double>(std::max<std::int64_t>(1, s.active_workers));

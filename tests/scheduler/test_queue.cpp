@@ -330,6 +330,22 @@ TEST_P(QueueTest, EtaTakesTheMedianOfTheSameSweepNotOfEveryJobOfTheKind) {
   }
 }
 
+TEST_P(QueueTest, EtaOfASweepWithNothingFinishedComesFromItsRunningJobsProgress) {
+  submit_spec(noop_spec("fast", {1}));
+  submit_spec(noop_spec("slow", {3, 4}));
+  auto f = claim(db, me, paths, 60);
+  ASSERT_TRUE(f);
+  ASSERT_TRUE(complete(db, *f, done_for(*f)));  // the kind's median: a fast job's
+  auto r = claim(db, me, paths, 60);
+  ASSERT_TRUE(r);
+  std::this_thread::sleep_for(std::chrono::milliseconds(400));
+  heartbeat(db, *r, 60, 0.5, "drop", "half way");
+  const auto s = status(db);
+  // Half way after ~0.4 s projects ~0.8 s a job: ~0.4 s left of it, ~0.8 s for the queued one.
+  EXPECT_GT(s.eta_s, 0.9);
+  EXPECT_LT(s.eta_s, 3.0);
+}
+
 TEST_P(QueueTest, StatusIsFastOnAHundredThousandJobs) {
   json doc = {{"sweep", "big"}, {"job", "noop"}, {"base", {{"i", 0}}},
               {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"range", {{"start", 0}, {"stop", 99999}, {"step", 1}}}}}}};
