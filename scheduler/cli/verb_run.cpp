@@ -16,6 +16,7 @@
 #include "scheduler/cli/verbs.h"
 #include "scheduler/pipeline/impact_job.h"
 #include "scheduler/pipeline/scenario_spec.h"
+#include "scheduler/pipeline/stop.h"
 
 namespace gravsweep::cli {
 
@@ -56,9 +57,6 @@ void draw_run_fig2(const std::filesystem::path& trace, const std::filesystem::pa
     fmt::print("no fig2.png: {}\n", e.what());
   }
 }
-
-std::atomic<bool> g_stop{false};
-extern "C" void on_signal(int) { g_stop.store(true); }
 
 /// Exit code 130 on SIGINT/SIGTERM, after the job stopped cleanly (no partial files).
 struct InterruptedExit : std::runtime_error {
@@ -106,17 +104,7 @@ void run_impact(const RunOptions& o) {
   std::filesystem::create_directories(out, ec);
   if (ec) throw std::runtime_error(fmt::format("{}: cannot create the output folder: {}", out.string(), ec.message()));
 
-  g_stop = false;
-  auto old_int = std::signal(SIGINT, on_signal);
-  auto old_term = std::signal(SIGTERM, on_signal);
-  struct Restore {
-    void (*i)(int);
-    void (*t)(int);
-    ~Restore() {
-      std::signal(SIGINT, i);
-      std::signal(SIGTERM, t);
-    }
-  } restore{old_int, old_term};
+  const pipeline::ScopedStopSignals stop_signals;  // SIGINT/SIGTERM end the job cleanly (exit 130)
 
   ProgressBar bar(!o.quiet);
   auto progress = [&](const std::string& phase, double f, const std::string& d) { bar.update(phase, f, d); };
@@ -125,7 +113,7 @@ void run_impact(const RunOptions& o) {
     nlohmann::json bed_report;
     if (o.bed.empty()) {
       bed_path = out / "bed.h5";
-      const auto b = pipeline::run_bed_job(scenario, bed_path, o.threads, progress, &g_stop);
+      const auto b = pipeline::run_bed_job(scenario, bed_path, o.threads, progress, &pipeline::stop_requested());
       bar.finish();
       pipeline::write_bed_checksum(bed_path);
       bed_report = b.report;
@@ -140,7 +128,7 @@ void run_impact(const RunOptions& o) {
       bed_path = o.bed;
       fmt::print("bed: reusing {}\n", bed_path.string());
     }
-    const auto d = pipeline::run_drop_job(scenario, bed_path, out / "trace.h5", o.threads, progress, &g_stop);
+    const auto d = pipeline::run_drop_job(scenario, bed_path, out / "trace.h5", o.threads, progress, &pipeline::stop_requested());
     bar.finish();
     nlohmann::json metrics = d.metrics;
     metrics["scenario"] = std::filesystem::absolute(o.scenario).string();

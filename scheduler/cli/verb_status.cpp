@@ -12,6 +12,7 @@
 #include "scheduler/cli/progress.h"
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
+#include "scheduler/pipeline/stop.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
 #include "scheduler/queue/table.h"
@@ -119,7 +120,7 @@ nlohmann::json status_json(const queue::Status& s) {
 
 void run_status(const StatusOptions& o) {
   db::Database db = queue::open_campaign(o.db, queue::OpenMode::read);
-  if (o.watch_s > 0) queue::install_stop_signals();
+  if (o.watch_s > 0) pipeline::install_stop_signals();
   do {
     const auto t0 = std::chrono::steady_clock::now();
     const auto s = queue::status(db, static_cast<std::size_t>(o.max_running));
@@ -148,9 +149,9 @@ void run_status(const StatusOptions& o) {
     std::fflush(stdout);
     if (o.watch_s <= 0) break;
     const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.watch_s);
-    while (!queue::stop_requested().load() && std::chrono::steady_clock::now() < until)
+    while (!pipeline::stop_requested().load() && std::chrono::steady_clock::now() < until)
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  } while (!queue::stop_requested().load());
+  } while (!pipeline::stop_requested().load());
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
+#include "scheduler/pipeline/stop.h"
 #include "scheduler/queue/impact.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
@@ -140,7 +141,7 @@ int run_work(const WorkOptions& o) {
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int threads = o.threads > 0 ? o.threads : std::max(1, cores / std::max(1, o.workers));
   if (o.workers > 1) return supervise(o, threads);
-  queue::install_stop_signals();
+  pipeline::install_stop_signals();
   queue::WorkerOptions w;
   w.db_path = o.db;
   w.files = o.files;

@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "engine/core/error.h"
+#include "scheduler/pipeline/stop.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/exit_codes.h"
 #include "scheduler/sweep/canonical.h"
@@ -27,8 +28,6 @@ using nlohmann::json;
 
 namespace {
 
-std::atomic<bool> g_stop{false};
-
 /// True when this worker was started by a `work --workers N` supervisor that is gone.
 bool supervisor_gone() {
   static const long supervisor = [] {
@@ -38,11 +37,9 @@ bool supervisor_gone() {
   return supervisor > 0 && static_cast<long>(getppid()) != supervisor;
 }
 
-extern "C" void on_stop_signal(int) { g_stop.store(true); }
-
 void sleep_interruptible(double seconds) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (!g_stop.load() && std::chrono::steady_clock::now() < end)
+  while (!pipeline::stop_requested().load() && std::chrono::steady_clock::now() < end)
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
 }
 
@@ -63,8 +60,8 @@ void heartbeat_loop(const WorkerOptions& o, const Claim& c, JobSignals& sig, dou
   auto next = std::chrono::steady_clock::now();  // first beat at once: the job has started
   std::unique_lock lock(sig.m);
   while (!sig.finished) {
-    if (supervisor_gone()) g_stop.store(true);
-    if (g_stop.load()) sig.stop.store(true);
+    if (supervisor_gone()) pipeline::stop_requested().store(true);
+    if (pipeline::stop_requested().load()) sig.stop.store(true);
     if (std::chrono::steady_clock::now() >= next) {
       const std::string phase = sig.phase, detail = sig.detail;
       const double f = sig.fraction;
@@ -97,17 +94,6 @@ void remove_tmp_of(const fs::path& tmp_dir, const std::string& prefix) {
 }
 
 }  // namespace
-
-std::atomic<bool>& stop_requested() { return g_stop; }
-
-void install_stop_signals() {
-  struct sigaction sa {};
-  sa.sa_handler = on_stop_signal;
-  sigemptyset(&sa.sa_mask);
-  sa.sa_flags = 0;
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-}
 
 void fsync_path(const fs::path& path) {
   const int fd = ::open(path.c_str(), O_RDONLY);
@@ -174,10 +160,10 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
   for (const char* d : kOutputFolders) fs::create_directories(paths.root / d, ec);
   std::unique_ptr<db::Database> beat_db;  // the heartbeat thread's own connection, kept across jobs
   long ran = 0;
-  while (!g_stop.load() && (o.max_jobs < 0 || ran < o.max_jobs)) {
+  while (!pipeline::stop_requested().load() && (o.max_jobs < 0 || ran < o.max_jobs)) {
     if (supervisor_gone()) {
       std::fprintf(stderr, "worker %d: its supervisor is gone; stopping\n", who.pid);
-      g_stop.store(true);
+      pipeline::stop_requested().store(true);
       break;
     }
     Reclaimed lost;
@@ -278,7 +264,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
       ++rep.fenced_out;
       continue;
     }
-    if (g_stop.load() && (!error.empty() || !fs::exists(tmp))) {
+    if (pipeline::stop_requested().load() && (!error.empty() || !fs::exists(tmp))) {
       remove_tmp_of(paths.tmp(), prefix);
       release(db, *c, "interrupted by SIGINT/SIGTERM; lease released");
       ++rep.released;
@@ -338,7 +324,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
                    c->job_id.c_str());
     }
   }
-  if (g_stop.load()) rep.interrupted = true;
+  if (pipeline::stop_requested().load()) rep.interrupted = true;
   return rep;
 }
 

@@ -64,9 +64,6 @@ struct WorkerReport {
   bool interrupted = false;
 };
 
-/// Set by SIGINT/SIGTERM once install_stop_signals() ran.
-std::atomic<bool>& stop_requested();
-void install_stop_signals();
 
 WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners);
 
