@@ -81,6 +81,38 @@ results::Table error_table(const std::vector<results::ComparedModel>& cm) {
   return t;
 }
 
+/// Issue 13: when a term is added every reported error should fall, or the report says why one
+/// does not. Compares the last model with `base` metric by metric (RMS in units, and relative).
+void explain_rises(const std::vector<results::ComparedModel>& cm) {
+  const results::ComparedModel* before = nullptr;
+  for (const auto& m : cm)
+    if (m.name == "base") before = &m;
+  if (!before || &cm.back() == before) return;
+  const auto &b = before->errors, &a = cm.back().errors;
+  struct Pair {
+    const char *metric, *unit;
+    double rms_b, rms_a, rel_b, rel_a;
+  };
+  for (const Pair& p : {Pair{"zstop", "mm", b.zstop_rms_mm, a.zstop_rms_mm, b.zstop_rel_pct, a.zstop_rel_pct},
+                        Pair{"tstop", "ms", b.tstop_rms_ms, a.tstop_rms_ms, b.tstop_rel_pct, a.tstop_rel_pct},
+                        Pair{"apeak", "m_s2", b.apeak_rms_m_s2, a.apeak_rms_m_s2, b.apeak_rel_pct, a.apeak_rel_pct}}) {
+    const bool rms_up = p.rms_a > p.rms_b, rel_up = p.rel_a > p.rel_b;
+    if (rms_up && !rel_up)
+      fmt::print("note: {0}_rms_{1} rises {2:.3g} -> {3:.3g} while {0}_rel_pct falls {4:.3g} -> {5:.3g}: the RMS in "
+                 "{1} is set by the trials with the largest {0} (the fastest, at the highest gravity), the relative "
+                 "error weighs every trial alike; see `model residuals` for the trials\n",
+                 p.metric, p.unit, p.rms_b, p.rms_a, p.rel_b, p.rel_a);
+    else if (rel_up && !rms_up)
+      fmt::print("note: {0}_rel_pct rises {2:.3g} -> {3:.3g} while {0}_rms_{1} falls: the relative error is set by "
+                 "the trials with the smallest {0} (slow or low-gravity ones); see `model residuals`\n",
+                 p.metric, p.unit, p.rel_b, p.rel_a);
+    else if (rms_up && rel_up)
+      fmt::print("note: both {0} errors rise with {1}: it fits the trace better but predicts {0} worse held out; "
+                 "see `model residuals` for where\n",
+                 p.metric, cm.back().name);
+  }
+}
+
 void print_axes(const std::vector<results::AxisResidual>& axes, const std::string& format) {
   results::Table t({"axis", "eta2", "split_half_r", "trials_slope_up", "trials_slope_down", "sign_test_p", "mean_residual_over_g_by_bin"});
   for (const auto& a : axes) {
@@ -196,6 +228,7 @@ void setup_model(CLI::App& app) {
     const auto cm = results::compare_models(c, {base, spec}, of->folds);
     if (of->format == "table") fmt::print("\nHeld-out errors ({}-fold grouped CV, whole trials held out), before and after:\n", of->folds);
     error_table(cm).print(of->format);
+    if (of->format == "table") explain_rises(cm);
     if (!of->plot.empty()) {
       namespace fs = std::filesystem;
       const fs::path png = fs::absolute(of->plot);

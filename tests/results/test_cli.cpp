@@ -66,6 +66,18 @@ TEST(Cli, ModelFitPrintsBeforeAndAfterAsCsvAndJson) {
   EXPECT_GT(j[0]["f0_N"].get<double>(), 0);
 }
 
+// Issue 13 item 2: where an error does not fall when the term is added, the report says why. On the
+// dev campaign the apeak RMS (m/s2) rises a little while the relative apeak error halves.
+TEST(Cli, ModelFitSaysWhyAnErrorDoesNotFall) {
+  GRAVSWEEP_REQUIRE_DEV_CAMPAIGN();
+  const auto r = run("model fit '" + gravsweep::testing::dev_campaign() + "' --model base+depth_friction --no-plot");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("note: apeak_rms_m_s2 rises"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("while apeak_rel_pct falls"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("note: zstop"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("note: tstop"), std::string::npos) << r.out;
+}
+
 TEST(Cli, BadModelNameIsAUsageError) {
   GRAVSWEEP_REQUIRE_DEV_CAMPAIGN();
   const auto r = run("model fit '" + gravsweep::testing::dev_campaign() + "' --model base+warp --no-plot", true);
