@@ -69,8 +69,6 @@ void run_submit(const SubmitOptions& o) {
   for (const auto& path : o.specs) {
     try {
       Planned p{sweep::load_spec(path), {}};
-      if (p.spec.job_kind == "impact" && !queue::impact_available())
-        throw UsageError(fmt::format("{}: /job: found \"impact\", expected \"noop\" (this build has no impact pipeline)", path));
       p.jobs = sweep::expand(p.spec, queue::impact_bed_key());
       if (const std::size_t n = keep_matching(path, p.jobs, o.where))
         fmt::print("sweep {}: --where leaves out {} of {} points\n", p.spec.name, n, p.spec.points());

@@ -7,8 +7,6 @@
 
 namespace gravsweep::queue {
 
-bool impact_available() { return true; }
-
 sweep::BedKeyFn impact_bed_key() {
   return [](const nlohmann::json& scenario) { return pipeline::bed_key(scenario); };
 }

@@ -6,8 +6,6 @@
 
 namespace gravsweep::queue {
 
-/// Whether this build runs impact jobs: always true (the pipeline is always built).
-bool impact_available();
 /// Drops with equal keys share a bed (pipeline::bed_key).
 sweep::BedKeyFn impact_bed_key();
 /// Adds the "bed" and "drop" runners.

@@ -78,7 +78,6 @@ fs::path copy_bed(const fs::path& dir, bool with_checksum) {
 }  // namespace
 
 TEST(BedInput, RunWritesTheBedsChecksumBesideIt) {
-  if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
   const auto& p = prepared();
   std::ifstream f(p.bed.string() + ".sha256");
   std::string hex, name;
@@ -88,7 +87,6 @@ TEST(BedInput, RunWritesTheBedsChecksumBesideIt) {
 }
 
 TEST(BedInput, RunBedRefusesEveryFlippedBitOfTheParticleDataAndTakesTheIntactBed) {
-  if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
   const auto& p = prepared();
   const std::vector<char> bytes = read_bytes(p.bed);
   const std::size_t n = results::read_bed(p.bed).size();
@@ -137,7 +135,6 @@ TEST(BedInput, RunBedRefusesEveryFlippedBitOfTheParticleDataAndTakesTheIntactBed
 }
 
 TEST(BedInput, ABedWithoutAChecksumFileIsUsedWithAWarning) {
-  if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
   const auto& p = prepared();
   const fs::path old = copy_bed(p.dir.path / "old", false);
   const auto r = run_cli({"run", "tiny.json", "--out", "out_old", "--bed", old.string(), "--quiet"}, p.dir.path);
@@ -148,7 +145,6 @@ TEST(BedInput, ABedWithoutAChecksumFileIsUsedWithAWarning) {
 }
 
 TEST(BedInput, ACorruptBedFileExitsTwoNamingItInRunAndBench) {
-  if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
   const auto& p = prepared();
   const std::vector<char> bytes = read_bytes(p.bed);
   struct Corrupt {

@@ -142,7 +142,6 @@ TEST(CliQueue, SigtermEndsTheJobAndReleasesItsLease) {
 }
 
 TEST(CliQueue, ImpactSweepSharesBedsAndExtendsIdempotently) {
-  if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
   TempDir d;
   const std::string example = std::string(GRAVSWEEP_SOURCE_DIR) + "/examples/sweep_tiny.json";
   auto r = run_cli({"submit", example, "--db", "c.db"}, d.path);
@@ -173,7 +172,6 @@ TEST(CliQueue, ImpactSweepSharesBedsAndExtendsIdempotently) {
 }
 
 TEST(CliQueue, SubmitWhereTakesPartOfASweepWithOnlyTheBedsItNeeds) {
-  if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
   TempDir d;
   const std::string example = std::string(GRAVSWEEP_SOURCE_DIR) + "/examples/sweep_tiny.json";
   // The second repeat at 1 g only: 3 speeds, on the one 1 g bed.

@@ -206,7 +206,6 @@ void crash_campaign(Store store_kind, const json& doc, std::int64_t total, std::
 struct CrashCampaign : ::testing::TestWithParam<Store> {};
 
 TEST_P(CrashCampaign, SigkilledWorkersAndSupervisorsLoseNothingAndDuplicateNothing) {
-  if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
   json doc = {{"sweep", "crash"},
               {"max_attempts", 6},
               {"base", json::parse(tiny_base())},

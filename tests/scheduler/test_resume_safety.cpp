@@ -238,7 +238,6 @@ TEST(ResumeSafety, VersionOneCampaignIsMigratedAndItsRenamedCopyKeepsItsFiles) {
 }
 
 TEST(BedChecksum, AFlippedBitInAFinishedBedFailsTheDropAndRebuildsTheBed) {
-  if (!queue::impact_available()) GTEST_SKIP() << "this build has no impact pipeline";
   TempDir d;
   json doc = {{"sweep", "flip"},
               {"base", json::parse(tiny_base())},
