@@ -138,7 +138,8 @@ void run_status(const StatusOptions& o) {
       std::string versions;
       while (other.step()) {
         n_other += other.get_int(1);
-        versions += (versions.empty() ? "" : ",") + other.get_text(0);
+        if (!versions.empty()) versions += ',';
+        versions += other.get_text(0);  // (not "a" + b: GCC 12 warns -Wrestrict on it)
       }
       if (n_other > 0)
         fmt::print("{} result(s) were computed by another code version ({}); this is {}\n", n_other, versions,
