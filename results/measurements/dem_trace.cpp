@@ -11,7 +11,7 @@
 #include "results/io/hdf5.h"
 #include "results/io/trace_file.h"
 #include "results/measurements/campaign.h"
-#include "results/measurements/csv.h"
+#include "results/report/table.h"
 
 namespace gravsweep::results {
 
@@ -117,9 +117,9 @@ int write_campaign_from_runs(const std::vector<std::string>& roots, const std::s
   if (trials.empty()) return 0;
   const fs::path out(out_dir);
   fs::create_directories(out / "traces");
-  std::string csv;
-  for (const auto& f : trial_fields()) csv += std::string(csv.empty() ? "" : ",") + f.key;
-  csv += "\n";
+  std::vector<std::string> keys;
+  for (const auto& f : trial_fields()) keys.emplace_back(f.key);
+  Table table(keys);
   for (auto& [src, t] : trials) {
     // The trace goes inside the campaign folder (trials.csv paths never lead outside it).
     const std::string rel = "traces/" + t.info.trial_id + ".h5";
@@ -128,16 +128,14 @@ int write_campaign_from_runs(const std::vector<std::string>& roots, const std::s
     fs::create_hard_link(src, out / rel, ec);
     if (ec) fs::copy_file(src, out / rel, fs::copy_options::overwrite_existing);
     t.info.trace_file = rel;
-    std::string row;
-    for (const auto& f : trial_fields()) {
-      row += (row.empty() ? "" : ",") + csv_field(f.number ? fmt::format("{}", t.info.*f.number) : t.info.*f.text);
-    }
-    csv += row + "\n";
+    std::vector<std::string> row;
+    for (const auto& f : trial_fields()) row.push_back(f.number ? fmt::format("{}", t.info.*f.number) : t.info.*f.text);
+    table.add(std::move(row));
   }
   const fs::path tmp = out / "trials.csv.tmp";
   {
     std::ofstream f(tmp, std::ios::binary);
-    if (!(f << csv)) throw std::runtime_error(fmt::format("{}: cannot write trials.csv", out_dir));
+    if (!(f << table.csv())) throw std::runtime_error(fmt::format("{}: cannot write trials.csv", out_dir));
   }
   fs::rename(tmp, out / "trials.csv");
   return static_cast<int>(trials.size());

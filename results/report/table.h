@@ -1,17 +1,14 @@
-// A small table for CLI output: aligned text, CSV or JSON (`--format table|csv|json`).
+// The one table writer of every verb and of the report: aligned text, CSV (RFC 4180) and JSON
+// (`--format table|csv|json`), plus the HTML <table> of the report page. It lives in results/ so
+// that results/ (the report) and scheduler/ (every CLI verb) can both use it.
 #pragma once
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <cmath>
-#include <cstdlib>
-#include <cstdio>
+#include <cstddef>
 #include <nlohmann/json.hpp>
-#include <stdexcept>
 #include <string>
 #include <vector>
-
-#include "results/measurements/csv.h"
 
 namespace gravsweep::results {
 
@@ -22,89 +19,61 @@ inline std::string html_escape(const std::string& x) {
   return o;
 }
 
+/// The formats a table is written in, as `--format` takes them (scheduler/cli/format_option.h).
+inline const std::vector<std::string>& table_formats() {
+  static const std::vector<std::string> formats{"table", "csv", "json"};
+  return formats;
+}
+
+/// The look of the aligned text. A column of numbers (`nan` included) is right-aligned, any other
+/// left-aligned; empty and `-` cells stand for missing values and leave the choice to the others
+/// (a column of them alone is left-aligned). Trailing spaces are trimmed.
+struct TextStyle {
+  bool rule = false;         ///< a line of dashes under the header
+  bool label_column = true;  ///< the first column (a row label) left-aligned whatever it holds
+};
+/// The look of the queue verbs (status, results, pile): a rule under the header, every column
+/// aligned by what it holds. The default TextStyle is the look of the model verbs and the report.
+inline constexpr TextStyle kRuledText{true, false};
+
 class Table {
  public:
-  explicit Table(std::vector<std::string> columns) : cols_(std::move(columns)) {}
-  void add(std::vector<std::string> row) {
-    row.resize(cols_.size());
-    rows_.push_back(std::move(row));
-  }
-  [[nodiscard]] std::string render(const std::string& format) const {
-    std::string out;
-    if (format == "csv") {  // RFC 4180: a field with a comma, a quote or a line break is quoted
-      for (std::size_t j = 0; j < cols_.size(); ++j) out += (j ? "," : "") + csv_field(cols_[j]);
-      out += "\n";
-      for (const auto& r : rows_) {
-        for (std::size_t j = 0; j < r.size(); ++j) out += (j ? "," : "") + csv_field(r[j]);
-        out += "\n";
-      }
-    } else if (format == "json") {
-      nlohmann::json a = nlohmann::json::array();
-      for (const auto& r : rows_) {
-        nlohmann::json o;
-        for (std::size_t j = 0; j < r.size(); ++j) {
-          double d;
-          char* end = nullptr;
-          d = std::strtod(r[j].c_str(), &end);
-          if (!r[j].empty() && end && *end == '\0' && std::isfinite(d)) o[cols_[j]] = d;
-          else o[cols_[j]] = r[j];
-        }
-        a.push_back(o);
-      }
-      out = a.dump(2) + "\n";
-    } else if (format == "table") {
-      std::vector<std::size_t> w(cols_.size());
-      for (std::size_t j = 0; j < cols_.size(); ++j) w[j] = cols_[j].size();
-      for (const auto& r : rows_)
-        for (std::size_t j = 0; j < r.size(); ++j) w[j] = std::max(w[j], r[j].size());
-      // Numbers right-aligned, text left-aligned (a column is numeric when all its cells are).
-      std::vector<bool> numeric(cols_.size(), true);
-      for (const auto& r : rows_)
-        for (std::size_t j = 0; j < r.size(); ++j) {
-          char* end = nullptr;
-          std::strtod(r[j].c_str(), &end);
-          if (!(r[j].empty() || r[j] == "nan" || r[j] == "-" || (end && *end == '\0'))) numeric[j] = false;
-        }
-      numeric[0] = false;
-      auto line = [&](const std::vector<std::string>& r) {
-        std::string l;
-        for (std::size_t j = 0; j < r.size(); ++j)
-          l += (j ? "  " : "") + (numeric[j] ? fmt::format("{:>{}}", r[j], w[j]) : fmt::format("{:<{}}", r[j], w[j]));
-        while (!l.empty() && l.back() == ' ') l.pop_back();
-        out += l + "\n";
-      };
-      line(cols_);
-      for (const auto& r : rows_) line(r);
-    } else {
-      throw std::invalid_argument(fmt::format("--format '{}': expected table, csv or json", format));
-    }
-    return out;
-  }
+  explicit Table(std::vector<std::string> columns, TextStyle style = {});
+
+  /// A row of text cells (missing ones empty). JSON writes a cell that reads as a finite number
+  /// as a number, any other as a string.
+  void add(std::vector<std::string> row);
+  /// A row of typed values (null, numbers, strings, objects). JSON writes them as they are; text
+  /// and CSV write null as an empty cell, a number in its shortest exact form, a string as it is.
+  void add_values(std::vector<nlohmann::json> row);
+
+  [[nodiscard]] std::size_t size() const { return rows_.size(); }
+  [[nodiscard]] const std::vector<std::string>& columns() const { return cols_; }
+
+  /// `table`, `csv` or `json`; throws std::invalid_argument on anything else (the verbs refuse an
+  /// unknown --format while parsing, with exit code 2).
+  [[nodiscard]] std::string render(const std::string& format) const;
+  [[nodiscard]] std::string text() const;
+  /// RFC 4180: CRLF after every record (the header first), a field with a comma, a double quote
+  /// or a line break in double quotes with its quotes doubled.
+  [[nodiscard]] std::string csv() const;
+  /// An array with one object per row, keyed by column.
+  [[nodiscard]] std::string json() const;
   /// An HTML <table> (cells escaped; numeric cells right-aligned by the page's style).
-  [[nodiscard]] std::string render_html() const {
-    const auto& esc = html_escape;
-    std::string out = "<table>\n<tr>";
-    for (const auto& c : cols_) out += "<th>" + esc(c) + "</th>";
-    out += "</tr>\n";
-    for (const auto& r : rows_) {
-      out += "<tr>";
-      for (const auto& c : r) {
-        char* end = nullptr;
-        std::strtod(c.c_str(), &end);
-        const bool number = !c.empty() && end && *end == '\0';
-        out += (number ? "<td class=\"n\">" : "<td>") + esc(c) + "</td>";
-      }
-      out += "</tr>\n";
-    }
-    return out + "</table>\n";
-  }
-  void print(const std::string& format) const { std::fputs(render(format).c_str(), stdout); }
+  [[nodiscard]] std::string render_html() const;
+  void print(const std::string& format) const;
 
  private:
+  struct Row {
+    std::vector<std::string> text;      ///< what text, CSV and HTML write
+    std::vector<nlohmann::json> value;  ///< empty for a row of text cells
+  };
   std::vector<std::string> cols_;
-  std::vector<std::vector<std::string>> rows_;
+  TextStyle style_;
+  std::vector<Row> rows_;
 };
 
+/// A number for a table cell: `prec` significant digits, `nan` when not finite.
 inline std::string num(double x, int prec = 4) {
   if (!std::isfinite(x)) return "nan";
   return fmt::format("{:.{}g}", x, prec);

@@ -20,13 +20,13 @@
 #include "results/measurements/campaign.h"
 #include "results/measurements/trial.h"
 #include "results/processing/resample.h"
+#include "results/report/table.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/filter.h"
 #include "scheduler/queue/queue.h"
-#include "scheduler/queue/table.h"
 
 namespace gravsweep::cli {
 
@@ -144,9 +144,7 @@ void run_export(const ExportOptions& o) {
   const fs::path out(o.out);
   fs::create_directories(out / "traces");
   fs::create_directories(out / "scenarios");
-  queue::TextTable trials, results_csv;
-  trials.header = trials_header();
-  results_csv.header = t.columns;
+  results::Table trials(trials_header()), results_csv(t.columns);
   for (const auto& r : t.rows) {
     if (!r[c_kind].is_string() || r[c_kind].get<std::string>() != "drop" || !r[c_trace].is_string()) continue;
     const std::string job = r[c_job].get<std::string>();
@@ -155,19 +153,19 @@ void run_export(const ExportOptions& o) {
     const auto bed = bed_of(db, paths, td, r[c_bed].is_string() ? r[c_bed].get<std::string>() : std::string());
     const double rate = write_trace_csv(out / "traces" / (job + ".csv"), td, o.rate_hz);
     write_text_file(out / "scenarios" / (job + ".json"), json::parse(td.scenario_json).dump(2) + "\n");
-    trials.rows.push_back(trial_row(job, r[c_sweep].get<std::string>(), trace_path, td, bed, rate));
+    trials.add(trial_row(job, r[c_sweep].get<std::string>(), trace_path, td, bed, rate));
     std::vector<std::string> cells;
     for (const auto& v : r) cells.push_back(v.is_null() ? "" : v.is_string() ? v.get<std::string>() : v.dump());
-    results_csv.rows.push_back(std::move(cells));
+    results_csv.add(std::move(cells));
   }
   // CSV files are written last, each under a temporary name: an interrupted export leaves no
   // trials.csv that points at missing traces.
   for (const auto& [name, table] : {std::pair{"results.csv", &results_csv}, std::pair{"trials.csv", &trials}}) {
-    write_text_file(out / (std::string(name) + ".tmp"), queue::render_csv(*table));
+    write_text_file(out / (std::string(name) + ".tmp"), table->csv());
     fs::rename(out / (std::string(name) + ".tmp"), out / name);
   }
-  fmt::print("{} drops exported to {} (trials.csv, traces/ at {} Hz, scenarios/, results.csv)\n",
-             trials.rows.size(), out.string(), o.rate_hz);
+  fmt::print("{} drops exported to {} (trials.csv, traces/ at {} Hz, scenarios/, results.csv)\n", trials.size(),
+             out.string(), o.rate_hz);
 }
 
 }  // namespace

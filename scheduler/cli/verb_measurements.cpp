@@ -13,6 +13,7 @@
 #include "results/report/table.h"
 #include "scheduler/cli/campaign_input.h"
 #include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/format_option.h"
 #include "scheduler/cli/verbs.h"
 #include "db/database.h"
 
@@ -60,7 +61,7 @@ void setup_measurements(CLI::App& app) {
   imp->add_flag("--keep-going", o->keep_going, "store the good trials even when some are bad input (exit code 4)");
   imp->add_option("--db", o->db, "SQLite file to store into (created if missing)")->capture_default_str();
   imp->add_option("--cutoff", o->cutoff_hz, "low-pass cut-off, Hz")->capture_default_str();
-  imp->add_option("--format", o->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
+  add_format_option(imp, o->format);
   auto runs = std::make_shared<std::vector<std::string>>();
   auto runs_out = std::make_shared<std::string>();
   auto* fr = sub->add_subcommand(

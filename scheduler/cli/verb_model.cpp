@@ -18,6 +18,7 @@
 #include "results/report/table.h"
 #include "scheduler/cli/campaign_input.h"
 #include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/format_option.h"
 #include "scheduler/cli/verbs.h"
 
 namespace gravsweep::cli {
@@ -164,7 +165,7 @@ void setup_model(CLI::App& app) {
 
   auto* terms = sub->add_subcommand("terms", "List the registered model terms.\n\nExample:\n  gravsweep model terms");
   auto tf = std::make_shared<std::string>("table");
-  terms->add_option("--format", *tf, "table, csv or json")->capture_default_str();
+  add_format_option(terms, *tf);
   terms->callback([tf]() {
     results::Table t({"term", "parameters", "default_sharing", "meaning", "references"});
     for (const auto& r : results::term_registry()) {
@@ -184,7 +185,7 @@ void setup_model(CLI::App& app) {
       "  gravsweep model table3 campaign.db --where 'impact_speed_m_s>=0.5'");
   t3->add_option("dir", o3->dir, kDirHelp)->required();
   t3->add_option("--where", o3->where, kWhereHelp);
-  t3->add_option("--format", o3->format, "table, csv or json")->capture_default_str();
+  add_format_option(t3, o3->format);
   t3->callback([o3]() {
     const auto c = load(o3->dir, o3->where);
     results::Table t({"gravity_m_s2", "trials", "f0_N", "f0_se_N", "inv_d1_1_m", "inv_d1_se_1_m", "vt_m_s",
@@ -216,7 +217,7 @@ void setup_model(CLI::App& app) {
   fit->add_option("--plot", of->plot, "write the error-falling figure (PNG) here")->capture_default_str();
   auto no_plot = std::make_shared<bool>(false);
   fit->add_flag("--no-plot", *no_plot, "do not write the figure");
-  fit->add_option("--format", of->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
+  add_format_option(fit, of->format);
   fit->callback([of, no_plot]() {
     if (*no_plot) of->plot.clear();
     const auto c = load(of->dir, of->where);
@@ -263,7 +264,7 @@ void setup_model(CLI::App& app) {
   res->add_option("dir", ores->dir, kDirHelp)->required();
   res->add_option("--where", ores->where, kWhereHelp);
   res->add_option("--model", ores->model, "model: 'base' or a JSON spec file")->capture_default_str();
-  res->add_option("--format", ores->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
+  add_format_option(res, ores->format);
   res->callback([ores]() {
     const auto c = load(ores->dir, ores->where);
     const auto fm = results::fit_model(spec_of(ores->model), c);
@@ -303,7 +304,7 @@ void setup_model(CLI::App& app) {
   det->add_option("--seeds", od->seeds, "campaigns per hidden term")->capture_default_str();
   det->add_option("--null-seeds", od->null_seeds, "campaigns with nothing hidden")->capture_default_str();
   det->add_option("--terms", od->terms, "hidden terms to test")->delimiter(',')->capture_default_str();
-  det->add_option("--format", od->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
+  add_format_option(det, od->format);
   det->callback([od]() {
     namespace fs = std::filesystem;
     const fs::path root = fs::temp_directory_path() / fmt::format("gravsweep-detect-{}", ::getpid());
@@ -371,7 +372,7 @@ void setup_model(CLI::App& app) {
   rank->add_option("--folds", orank->folds, "cross-validation folds")->check(CLI::Range(2, 100))->capture_default_str();
   rank->add_option("--alpha", orank->alpha, "family-wise significance level")->capture_default_str();
   rank->add_option("--min-improvement", orank->min_improvement, "minimum mean relative improvement")->capture_default_str();
-  rank->add_option("--format", orank->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
+  add_format_option(rank, orank->format);
   rank->callback([orank]() {
     const auto c = load(orank->dir, orank->where);
     const auto base = spec_of(orank->baseline);

@@ -10,8 +10,9 @@
 #include "engine/scenario/paper_params.h"
 #include "engine/scenario/pile.h"
 #include "scheduler/cli/progress.h"
+#include "results/report/table.h"
+#include "scheduler/cli/format_option.h"
 #include "scheduler/cli/verbs.h"
-#include "scheduler/queue/table.h"
 
 namespace gravsweep::cli {
 
@@ -31,9 +32,9 @@ struct PileOptions {
 
 void run_pile(const PileOptions& o) {
   ProgressBar bar(!o.quiet);
-  queue::TextTable t;
-  t.header = {"mu_rolling", "mu_static", "repose_angle_deg", "apex_height_m", "grains_on_base", "flank_bins",
-              "rms_speed_m_s", "simulated_time_s", "wall_time_s"};
+  results::Table t({"mu_rolling", "mu_static", "repose_angle_deg", "apex_height_m", "grains_on_base", "flank_bins",
+                    "rms_speed_m_s", "simulated_time_s", "wall_time_s"},
+                   results::kRuledText);
   for (double mu_r : o.mu_rolling) {
     SystemConfig cfg = chrono_table1_config(mu_r);
     cfg.materials[kGrainMaterial].mu_static = o.mu_static;
@@ -50,12 +51,12 @@ void run_pile(const PileOptions& o) {
     });
     bar.finish();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    t.rows.push_back({fmt::format("{:g}", mu_r), fmt::format("{:g}", o.mu_static), fmt::format("{:.1f}", r.angle_deg),
-                      fmt::format("{:.4f}", r.apex_height_m), std::to_string(r.grains_on_base),
-                      std::to_string(r.flank_bins), fmt::format("{:.1e}", r.rms_speed_m_s),
-                      fmt::format("{:.2f}", r.simulated_time_s), fmt::format("{:.1f}", wall)});
+    t.add({fmt::format("{:g}", mu_r), fmt::format("{:g}", o.mu_static), fmt::format("{:.1f}", r.angle_deg),
+           fmt::format("{:.4f}", r.apex_height_m), std::to_string(r.grains_on_base), std::to_string(r.flank_bins),
+           fmt::format("{:.1e}", r.rms_speed_m_s), fmt::format("{:.2f}", r.simulated_time_s),
+           fmt::format("{:.1f}", wall)});
   }
-  fmt::print("{}", o.format == "csv" ? queue::render_csv(t) : queue::render_table(t));
+  t.print(o.format);
 }
 
 }  // namespace
@@ -80,7 +81,7 @@ void setup_pile(CLI::App& app) {
   sub->add_option("--dt", opt->dt_s, "time step, s (checked against the law's stability bound)")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--threads", opt->threads, "OpenMP threads")->check(CLI::Range(1, 1024))->capture_default_str();
   sub->add_option("--seed", opt->seed, "random seed of the base and the pour")->capture_default_str();
-  sub->add_option("--format", opt->format, "table or csv")->check(CLI::IsMember({"table", "csv"}))->capture_default_str();
+  add_format_option(sub, opt->format);
   sub->add_flag("--quiet", opt->quiet, "no progress bar");
   sub->callback([opt]() { run_pile(*opt); });
 }

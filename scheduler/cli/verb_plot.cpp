@@ -15,13 +15,13 @@
 
 #include "results/report/figures.h"
 #include "results/report/report.h"
+#include "results/report/table.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/filter.h"
 #include "scheduler/queue/queue.h"
-#include "scheduler/queue/table.h"
 
 namespace gravsweep::cli {
 
@@ -36,9 +36,10 @@ struct PlotResultsOptions {
   std::vector<std::string> where;
 };
 
-std::string csv_cell(const nlohmann::json& v) {
+/// A value of the results table as the plotting script reads it (null: empty).
+std::string xy_cell(const nlohmann::json& v) {
   if (v.is_null()) return "";
-  if (v.is_string()) return queue::csv_escape(v.get<std::string>());
+  if (v.is_string()) return v.get<std::string>();
   return v.dump();
 }
 
@@ -62,10 +63,10 @@ void run_plot_results(const PlotResultsOptions& o) {
                                  o.where.empty() && o.sweep.empty() ? "" : " (after --where/--sweep)"));
   results::ScratchDir tmp("plot");
   {
-    std::ofstream f(tmp.path / "xy.csv");
-    f << "x,y,group\n";
-    for (const auto& r : t.rows)
-      f << csv_cell(r[0]) << ',' << csv_cell(r[1]) << ',' << (o.group.empty() ? "" : csv_cell(r[2])) << '\n';
+    results::Table xy({"x", "y", "group"});
+    for (const auto& r : t.rows) xy.add({xy_cell(r[0]), xy_cell(r[1]), o.group.empty() ? "" : xy_cell(r[2])});
+    std::ofstream f(tmp.path / "xy.csv", std::ios::binary);
+    f << xy.csv();
   }
   const fs::path out = fs::absolute(o.out);
   fs::create_directories(out.parent_path());

@@ -12,11 +12,12 @@
 #include "results/measurements/trial.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/campaign_options.h"
+#include "results/report/table.h"
+#include "scheduler/cli/format_option.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/filter.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
-#include "scheduler/queue/table.h"
 
 namespace gravsweep::cli {
 
@@ -89,6 +90,58 @@ std::vector<std::string> metric_columns(db::Database& db) {
   return m;
 }
 
+/// Mean and sample standard deviation (NaN when undefined).
+std::pair<double, double> mean_and_std(const std::vector<double>& v) {
+  double mean = 0, ss = 0;
+  for (double x : v) mean += x;
+  mean = v.empty() ? NAN : mean / static_cast<double>(v.size());
+  for (double x : v) ss += (x - mean) * (x - mean);
+  const double sd = v.size() > 1 ? std::sqrt(ss / static_cast<double>(v.size() - 1)) : NAN;
+  return {mean, sd};
+}
+
+/// The groups as JSON (per metric an object of mean, std and count) or as one flat row each.
+std::string render_groups(const ResultsOptions& o, const std::vector<Group>& groups,
+                          const std::vector<std::string>& metrics) {
+  const std::size_t nk = o.group_by.size();
+  const auto finite = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+  if (o.format == "json") {
+    std::vector<std::string> cols = o.group_by;
+    cols.insert(cols.end(), {"rows", "metrics"});
+    results::Table jt(cols);
+    for (const auto& g : groups) {
+      nlohmann::json ms = nlohmann::json::object();
+      for (std::size_t m = 0; m < metrics.size(); ++m) {
+        const auto [mean, sd] = mean_and_std(g.values[m]);
+        ms[metrics[m]] = {{"mean", finite(mean)}, {"std", finite(sd)}, {"count", g.values[m].size()}};
+      }
+      std::vector<nlohmann::json> row(g.key.begin(), g.key.end());
+      row.insert(row.end(), {nlohmann::json(g.rows), std::move(ms)});
+      jt.add_values(std::move(row));
+    }
+    return jt.json();
+  }
+  std::vector<std::string> header = o.group_by;
+  header.emplace_back("rows");
+  for (const auto& m : metrics)
+    for (const char* s : {"_mean", "_std", "_count"}) header.push_back(m + s);
+  results::Table tt(header, results::kRuledText);
+  const bool table = o.format == "table";
+  for (const auto& g : groups) {
+    std::vector<std::string> cells;
+    for (std::size_t k = 0; k < nk; ++k) cells.push_back(cell(g.key[k], table, o.group_by[k], o.full));
+    cells.push_back(std::to_string(g.rows));
+    for (std::size_t m = 0; m < metrics.size(); ++m) {
+      const auto [mean, sd] = mean_and_std(g.values[m]);
+      cells.push_back(std::isfinite(mean) ? cell(mean, table, "", o.full) : (table ? "-" : ""));
+      cells.push_back(std::isfinite(sd) ? cell(sd, table, "", o.full) : (table ? "-" : ""));
+      cells.push_back(std::to_string(g.values[m].size()));
+    }
+    tt.add(std::move(cells));
+  }
+  return table ? tt.text() + fmt::format("({} group{})\n", groups.size(), groups.size() == 1 ? "" : "s") : tt.csv();
+}
+
 std::string group_text(const ResultsOptions& o, db::Database& db, std::size_t& n_groups) {
   std::vector<std::string> metrics = o.columns;
   if (metrics.empty()) {
@@ -134,52 +187,8 @@ std::string group_text(const ResultsOptions& o, db::Database& db, std::size_t& n
     }
     return false;
   });
-  auto stats = [](const std::vector<double>& v) {
-    double mean = 0, ss = 0;
-    for (double x : v) mean += x;
-    mean = v.empty() ? NAN : mean / static_cast<double>(v.size());
-    for (double x : v) ss += (x - mean) * (x - mean);
-    const double sd = v.size() > 1 ? std::sqrt(ss / static_cast<double>(v.size() - 1)) : NAN;
-    return std::pair<double, double>{mean, sd};
-  };
   n_groups = groups.size();
-  if (o.format == "json") {
-    nlohmann::json arr = nlohmann::json::array();
-    for (const auto& g : groups) {
-      nlohmann::json obj = nlohmann::json::object(), ms = nlohmann::json::object();
-      for (std::size_t k = 0; k < nk; ++k) obj[o.group_by[k]] = g.key[k];
-      obj["rows"] = g.rows;
-      for (std::size_t m = 0; m < metrics.size(); ++m) {
-        const auto [mean, sd] = stats(g.values[m]);
-        ms[metrics[m]] = {{"mean", std::isfinite(mean) ? nlohmann::json(mean) : nlohmann::json(nullptr)},
-                          {"std", std::isfinite(sd) ? nlohmann::json(sd) : nlohmann::json(nullptr)},
-                          {"count", g.values[m].size()}};
-      }
-      obj["metrics"] = std::move(ms);
-      arr.push_back(std::move(obj));
-    }
-    return arr.dump(2) + "\n";
-  }
-  queue::TextTable tt;
-  tt.header = o.group_by;
-  tt.header.emplace_back("rows");
-  for (const auto& m : metrics)
-    for (const char* s : {"_mean", "_std", "_count"}) tt.header.push_back(m + s);
-  const bool table = o.format == "table";
-  for (const auto& g : groups) {
-    std::vector<std::string> cells;
-    for (std::size_t k = 0; k < nk; ++k) cells.push_back(cell(g.key[k], table, o.group_by[k], o.full));
-    cells.push_back(std::to_string(g.rows));
-    for (std::size_t m = 0; m < metrics.size(); ++m) {
-      const auto [mean, sd] = stats(g.values[m]);
-      cells.push_back(std::isfinite(mean) ? cell(mean, table, "", o.full) : (table ? "-" : ""));
-      cells.push_back(std::isfinite(sd) ? cell(sd, table, "", o.full) : (table ? "-" : ""));
-      cells.push_back(std::to_string(g.values[m].size()));
-    }
-    tt.rows.push_back(std::move(cells));
-  }
-  return table ? queue::render_table(tt) + fmt::format("({} group{})\n", groups.size(), groups.size() == 1 ? "" : "s")
-               : queue::render_csv(tt);
+  return render_groups(o, groups, metrics);
 }
 
 void run_results(const ResultsOptions& o) {
@@ -201,25 +210,19 @@ void run_results(const ResultsOptions& o) {
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  std::string text;
-  if (o.format == "json") {
-    nlohmann::json arr = nlohmann::json::array();
-    for (const auto& r : t.rows) {
-      nlohmann::json obj = nlohmann::json::object();
-      for (std::size_t c = 0; c < t.columns.size(); ++c) obj[t.columns[c]] = r[c];
-      arr.push_back(std::move(obj));
+  results::Table tt(t.columns, results::kRuledText);
+  for (const auto& r : t.rows) {
+    if (o.format != "table") {  // CSV and JSON: the values as stored (null: an empty CSV cell)
+      tt.add_values(r);
+      continue;
     }
-    text = arr.dump(2) + "\n";
-  } else {
-    queue::TextTable tt;
-    tt.header = t.columns;
-    for (const auto& r : t.rows) {
-      std::vector<std::string> cells;
-      for (std::size_t c = 0; c < r.size(); ++c) cells.push_back(cell(r[c], o.format == "table", t.columns[c], o.full));
-      tt.rows.push_back(std::move(cells));
-    }
-    text = o.format == "csv" ? queue::render_csv(tt)
-                             : queue::render_table(tt) + fmt::format("({} row{})\n", t.rows.size(), t.rows.size() == 1 ? "" : "s");
+    std::vector<std::string> cells;
+    for (std::size_t c = 0; c < r.size(); ++c) cells.push_back(cell(r[c], true, t.columns[c], o.full));
+    tt.add(std::move(cells));
+  }
+  std::string text = tt.render(o.format);
+  if (o.format == "table") {
+    text += fmt::format("({} row{})\n", t.rows.size(), t.rows.size() == 1 ? "" : "s");
     if (summary) {
       const std::size_t more = queue::result_columns(db).size() - t.columns.size();
       text += fmt::format("({} more columns: --all, --columns a,b,... or --format csv)\n", more);
@@ -258,7 +261,7 @@ void setup_results(CLI::App& app) {
   sub->add_option("--group-by", opt->group_by, "group by these columns, comma separated: mean, std, count per metric")
       ->delimiter(',');
   sub->add_option("--limit", opt->limit, "at most this many rows");
-  sub->add_option("--format", opt->format, "table, csv or json")->check(CLI::IsMember({"table", "csv", "json"}))->capture_default_str();
+  add_format_option(sub, opt->format);
   sub->add_option("--out", opt->out, "write to this file (temporary name, then renamed) instead of stdout");
   sub->add_flag("--full", opt->full, "table: do not shorten checksums");
   sub->add_flag("--all", opt->all, "table: every column, not only the parameters and the paper's metrics");

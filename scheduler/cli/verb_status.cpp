@@ -11,11 +11,12 @@
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/progress.h"
 #include "scheduler/cli/campaign_options.h"
+#include "results/report/table.h"
+#include "scheduler/cli/format_option.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/pipeline/stop.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
-#include "scheduler/queue/table.h"
 #include "scheduler/queue/worker.h"
 
 namespace gravsweep::cli {
@@ -33,44 +34,41 @@ std::string render_status(const queue::Status& s, const std::string& db, double 
   std::string out;
   std::int64_t total = 0;
   queue::StateCounts all;
-  queue::TextTable t;
-  t.header = {"sweep", "kind", "waiting", "queued", "running", "failed", "done", "dead", "total"};
+  results::Table t({"sweep", "kind", "waiting", "queued", "running", "failed", "done", "dead", "total"},
+                   results::kRuledText);
   for (const auto& c : s.per_sweep) {
-    t.rows.push_back({c.sweep, c.kind, std::to_string(c.waiting), std::to_string(c.queued), std::to_string(c.running),
-                      std::to_string(c.failed), std::to_string(c.done), std::to_string(c.dead),
-                      std::to_string(c.total())});
+    t.add({c.sweep, c.kind, std::to_string(c.waiting), std::to_string(c.queued), std::to_string(c.running),
+           std::to_string(c.failed), std::to_string(c.done), std::to_string(c.dead), std::to_string(c.total())});
     total += c.total();
     all.waiting += c.waiting, all.queued += c.queued, all.running += c.running, all.failed += c.failed;
     all.done += c.done, all.dead += c.dead;
   }
   out += fmt::format("campaign {}: {} job memberships; {} done, {} dead, {} running, {} to run\n\n", db, total,
                      all.done, all.dead, all.running, all.waiting + all.queued + all.failed);
-  out += queue::render_table(t);
+  out += t.text();
   const double now = queue::now_s();
   if (!s.running.empty()) {
-    queue::TextTable r;
-    r.header = {"job_id", "kind", "attempt", "worker", "phase", "progress_pct", "elapsed_s", "heartbeat_age_s",
-                "lease_left_s", "detail"};
+    results::Table r({"job_id", "kind", "attempt", "worker", "phase", "progress_pct", "elapsed_s", "heartbeat_age_s",
+                      "lease_left_s", "detail"},
+                     results::kRuledText);
     for (const auto& j : s.running)
-      r.rows.push_back({j.job_id, j.kind, std::to_string(j.attempt), j.owner, j.phase,
-                        fmt::format("{:.1f}", 100 * j.progress), fmt::format("{:.1f}", now - j.started_at),
-                        fmt::format("{:.1f}", now - j.heartbeat_at),
-                        j.stale ? "STALE" : fmt::format("{:.1f}", j.lease_expires - now), j.detail});
+      r.add({j.job_id, j.kind, std::to_string(j.attempt), j.owner, j.phase, fmt::format("{:.1f}", 100 * j.progress),
+             fmt::format("{:.1f}", now - j.started_at), fmt::format("{:.1f}", now - j.heartbeat_at),
+             j.stale ? "STALE" : fmt::format("{:.1f}", j.lease_expires - now), j.detail});
     out += fmt::format("\nrunning jobs ({} active, {} stale lease{}):\n", s.active_workers, s.stale_leases,
                        s.stale_leases == 1 ? "" : "s");
-    out += queue::render_table(r);
+    out += r.text();
   }
   if (s.stale_leases > 0)
     out += fmt::format("\n{} stale lease(s): their workers stopped heartbeating; the next claim or `gravsweep resume` "
                        "requeues them.\n",
                        s.stale_leases);
   if (!s.runtimes.empty()) {
-    queue::TextTable k;
-    k.header = {"kind", "finished", "median_runtime_s", "remaining"};
+    results::Table k({"kind", "finished", "median_runtime_s", "remaining"}, results::kRuledText);
     for (const auto& r : s.runtimes)
-      k.rows.push_back({r.kind, std::to_string(r.finished), r.finished ? fmt::format("{:.2f}", r.median_s) : "-",
-                        std::to_string(r.remaining)});
-    out += "\nruntimes by kind:\n" + queue::render_table(k);
+      k.add({r.kind, std::to_string(r.finished), r.finished ? fmt::format("{:.2f}", r.median_s) : "-",
+             std::to_string(r.remaining)});
+    out += "\nruntimes by kind:\n" + k.text();
   }
   if (all.waiting + all.queued + all.failed + all.running > 0) {
     out += s.eta_s >= 0 ? fmt::format("\nETA {} with {} active worker(s) (median runtime of finished jobs of each sweep and kind)\n",
@@ -140,7 +138,8 @@ void run_status(const StatusOptions& o) {
       std::string versions;
       while (other.step()) {
         n_other += other.get_int(1);
-        versions += (versions.empty() ? "" : ",") + other.get_text(0);
+        if (!versions.empty()) versions += ',';
+        versions += other.get_text(0);  // (not "a" + b: GCC 12 warns -Wrestrict on it)
       }
       if (n_other > 0)
         fmt::print("{} result(s) were computed by another code version ({}); this is {}\n", n_other, versions,
@@ -171,7 +170,7 @@ void setup_status(CLI::App& app) {
       "  gravsweep status --db campaign.db --watch 2        # refresh every 2 s\n"
       "  gravsweep status --db campaign.db --format json");
   add_campaign_options(sub, opt->db, nullptr);
-  sub->add_option("--format", opt->format, "table or json")->check(CLI::IsMember({"table", "json"}))->capture_default_str();
+  add_format_option(sub, opt->format, {"table", "json"});  // several tables: no one CSV
   sub->add_option("--max-running", opt->max_running, "running jobs listed at most")->capture_default_str();
   sub->add_option("--watch", opt->watch_s, "refresh every this many seconds (0: once)")->capture_default_str();
   sub->callback([opt]() { run_status(*opt); });

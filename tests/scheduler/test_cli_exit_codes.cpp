@@ -133,3 +133,18 @@ TEST(ExitCodes, WorkWithADeadJobExits4FromOneWorkerAndFromTheSupervisor) {
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='dead'"), 2);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE exit_code=" + std::to_string(cli::kExitFailure)), 2);
 }
+
+// Every verb takes --format the same way (scheduler/cli/format_option.h): an unknown format is a
+// usage error (exit 2) with the same message, here from `results` (the former queue table writer)
+// and `model terms` (the former results::Table), before anything is read.
+TEST(ExitCodes, UnknownFormatIsRefusedWithExit2AndOneMessageByEveryVerb) {
+  TempDir d;
+  const auto results = run_cli({"results", "--db", "absent.db", "--format", "xml"}, d.path);
+  const auto terms = run_cli({"model", "terms", "--format", "xml"}, d.path);
+  EXPECT_EQ(results.code, cli::kExitUsage) << results.err;
+  EXPECT_EQ(terms.code, cli::kExitUsage) << terms.err;
+  EXPECT_NE(results.err.find("--format: xml not in {table,csv,json}"), std::string::npos) << results.err;
+  EXPECT_EQ(results.err, terms.err);
+  EXPECT_TRUE(results.out.empty()) << results.out;
+  EXPECT_FALSE(fs::exists(d.path / "absent.db"));
+}
