@@ -175,12 +175,6 @@ std::string strongest_axis(const std::vector<AxisResidual>& axes) {
                      best->axis, best->eta2, best->split_half_r);
 }
 
-bool has_term(const ModelSpec& s, const std::string& name) {
-  for (const auto& t : s.terms)
-    if (t.term->name == name) return true;
-  return false;
-}
-
 /// Each candidate added to `current` on its own, ranked by held-out improvement over `current`
 /// (grouped CV, whole trials out; a one-sided signed-rank test over trials, Bonferroni over the
 /// candidates at level alpha, and at least min_improvement mean relative gain). Named and
@@ -285,7 +279,7 @@ Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds, doub
   for (int round = 0; round < max_rounds; ++round) {
     std::vector<ModelTerm> named;
     for (const auto& term : term_registry())
-      if (!has_term(current, term.name)) named.push_back({&term, term.per_gravity, 1.0});
+      if (!current.has(term.name)) named.push_back({&term, term.per_gravity, 1.0});
     const auto cands = rank_candidates(current, c, named, folds, alpha, min_improvement);
     d.rounds.push_back(cands);
     if (cands.empty() || !cands.front().significant) break;
@@ -314,17 +308,15 @@ Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds, doub
       // does not explain the structure: it is named as tried, not as found.
       d.generated_worsens_metrics = d.errors_with_generated.zstop_rel_pct > d.errors_without_generated.zstop_rel_pct ||
                                     d.errors_with_generated.tstop_rel_pct > d.errors_without_generated.tstop_rel_pct;
-    }
-    if (g.test.significant && !d.generated_worsens_metrics) {
-      ModelSpec with = current;
-      with.terms.push_back(g.chosen);
-      d.generated = g.chosen.term->name;
-      d.generated_equivalent = g.equivalent;
-      d.generated_model = with.name();
-      d.structure_left_after_generated = structured(residual_axes(fit_model(with, c), c), where_generated);
-      if (!d.structure_left) {
-        d.structure_left = true;
-        where_named = strongest_axis(d.residual_after);
+      if (!d.generated_worsens_metrics) {
+        d.generated = g.chosen.term->name;
+        d.generated_equivalent = g.equivalent;
+        d.generated_model = with.name();
+        d.structure_left_after_generated = structured(residual_axes(fit_model(with, c), c), where_generated);
+        if (!d.structure_left) {
+          d.structure_left = true;
+          where_named = strongest_axis(d.residual_after);
+        }
       }
     }
   }

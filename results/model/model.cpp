@@ -31,6 +31,10 @@ std::string ModelSpec::name() const {
   return s;
 }
 
+bool ModelSpec::has(const std::string& term_name) const {
+  return std::any_of(terms.begin(), terms.end(), [&](const ModelTerm& t) { return t.term->name == term_name; });
+}
+
 ModelSpec parse_model(const std::string& text) {
   ModelSpec spec;
   if (std::filesystem::exists(text) && std::filesystem::is_regular_file(text)) {

@@ -21,6 +21,7 @@ struct ModelTerm {
 struct ModelSpec {
   std::vector<ModelTerm> terms;
   [[nodiscard]] std::string name() const;  ///< "base+depth_friction"
+  [[nodiscard]] bool has(const std::string& term_name) const;  ///< a term of that name is in the spec
 };
 
 /// Parses "base+depth_friction" (":shared" or ":per_gravity" after a name sets the sharing,

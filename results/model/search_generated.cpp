@@ -39,22 +39,26 @@ struct Screened {
   std::vector<double> mse;  ///< per-trial in-sample trace MSE with the form
 };
 
-/// Every form of the family added (per gravity level) to `current` and fitted to the selected
-/// trials, best (largest in-sample mean relative gain) first.
-std::vector<Screened> screen(const ModelSpec& current, const Campaign& c, const std::vector<bool>& mask) {
-  const auto before = trial_mses(fit_model(current, c, mask), c, mask);
-  std::vector<Screened> out;
+/// `current` fitted to the selected trials, and every form of the family added to it (per gravity
+/// level) and fitted to the same trials, best (largest in-sample mean relative gain) first.
+struct Screening {
+  FittedModel current;
+  std::vector<double> current_mse;  ///< per-trial in-sample trace MSE of `current`
+  std::vector<Screened> ranked;
+};
+Screening screen(const ModelSpec& current, const Campaign& c, const std::vector<bool>& mask) {
+  Screening out{fit_model(current, c, mask), {}, {}};
+  out.current_mse = trial_mses(out.current, c, mask);
   for (const auto& name : generated_family()) {
-    bool present = false;
-    for (const auto& t : current.terms) present = present || t.term->name == name;
-    if (present) continue;
+    if (current.has(name)) continue;
     ModelSpec s = current;
     const TermInfo* t = generated_term(name);
     s.terms.push_back({t, true, 1.0});
     auto mse = trial_mses(fit_model(s, c, mask), c, mask);
-    out.push_back({t, mean_relative_gain(before, mse), std::move(mse)});
+    out.ranked.push_back({t, mean_relative_gain(out.current_mse, mse), std::move(mse)});
   }
-  std::stable_sort(out.begin(), out.end(), [](const Screened& a, const Screened& b) { return a.gain > b.gain; });
+  std::stable_sort(out.ranked.begin(), out.ranked.end(),
+                   [](const Screened& a, const Screened& b) { return a.gain > b.gain; });
   return out;
 }
 
@@ -82,12 +86,13 @@ GeneratedSearch search_generated(const ModelSpec& current, const Campaign& c, in
   GeneratedSearch g;
   const std::size_t n = c.trials.size();
   const std::vector<bool> all(n, true);
-  const auto ranked = screen(current, c, all);
+  const Screening on_all = screen(current, c, all);
+  const auto& ranked = on_all.ranked;
   if (ranked.empty()) return g;
-  g.equivalent = equivalent_forms(ranked, trial_mses(fit_model(current, c, all), c, all));
+  g.equivalent = equivalent_forms(ranked, on_all.current_mse);
   // The form, on all trials; shared by the gravity levels when that is as good held out.
   ModelTerm chosen{ranked.front().term, true, 1.0};
-  if (fit_model(current, c).gravity_levels.size() > 1) {
+  if (on_all.current.gravity_levels.size() > 1) {
     ModelSpec per = current, shared = current;
     per.terms.push_back(chosen);
     shared.terms.push_back({chosen.term, false, 1.0});
@@ -112,12 +117,12 @@ GeneratedSearch search_generated(const ModelSpec& current, const Campaign& c, in
       any = any || fold[i] == k;
     }
     if (!any) continue;
-    const auto best = screen(current, c, train);
+    const Screening on_train = screen(current, c, train);
     ModelSpec with = current;
-    with.terms.push_back({best.front().term, chosen.per_gravity, 1.0});
-    const FittedModel m0 = fit_model(current, c, train), m1 = fit_model(with, c, train);
+    with.terms.push_back({on_train.ranked.front().term, chosen.per_gravity, 1.0});
+    const FittedModel m1 = fit_model(with, c, train);
     for (std::size_t i = 0; i < n; ++i)
-      if (!train[i]) mse0[i] = trial_trace_mse(m0, c.trials[i]), mse1[i] = trial_trace_mse(m1, c.trials[i]);
+      if (!train[i]) mse0[i] = trial_trace_mse(on_train.current, c.trials[i]), mse1[i] = trial_trace_mse(m1, c.trials[i]);
   }
   Candidate& cd = g.test;
   cd.term = chosen.term->name + (chosen.per_gravity ? "" : ":shared");

@@ -217,8 +217,9 @@ TEST_P(CrashCampaign, SigkilledWorkersAndSupervisorsLoseNothingAndDuplicateNothi
                  {"range", {{"start", 0.4}, {"stop", 1.0}, {"step", 0.1}}}}}},
               {"repeats", {{"name", "projectile_seed"}, {"pointer", "/projectile/seed"}, {"count", 2}, {"start", 1}}}};
   // 4 beds (gravity x bed seed) and 56 drops (7 speeds x 2 projectile seeds per bed).
-  crash_campaign(GetParam(), doc, 60, 56, {"gravity_m_s2", "bed_seed", "impact_speed_m_s", "projectile_seed", "bed_job_id"}, 4, 6,
-                 /*with_supervisor=*/true);
+  EXPECT_NO_FATAL_FAILURE(crash_campaign(GetParam(), doc, 60, 56,
+                                         {"gravity_m_s2", "bed_seed", "impact_speed_m_s", "projectile_seed", "bed_job_id"},
+                                         4, 6, /*with_supervisor=*/true));
 }
 
 TEST_P(CrashCampaign, NoopJobsSurviveSigkillToo) {
