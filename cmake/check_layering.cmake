@@ -1,11 +1,13 @@
 # The layering of gravsweep's libraries: a folder may include only the folders below it.
 #   engine/  -> (nothing of the project)      db/ -> (nothing of the project)
-#   results/ -> engine/, db/                  scheduler/ -> everything
+#   spec/    -> engine/core (ConfigError)     results/ -> engine/, db/, spec/
+#   scheduler/ -> everything
 # gravsweep_check_layering(<source dir>) stops with FATAL_ERROR naming each file and include
 # that points the wrong way. Run as a script (cmake -DROOT=<dir> -P check_layering.cmake) from CTest.
 function(gravsweep_check_layering root)
   set(problems "")
-  foreach(pair "engine:scheduler/|results/|db/" "db:scheduler/|results/|engine/" "results:scheduler/")
+  foreach(pair "engine:scheduler/|results/|db/|spec/" "db:scheduler/|results/|engine/|spec/"
+               "spec:scheduler/|results/|db/" "results:scheduler/")
     string(REPLACE ":" ";" parts "${pair}")
     list(GET parts 0 folder)
     list(GET parts 1 forbidden)
@@ -20,7 +22,7 @@ function(gravsweep_check_layering root)
     endforeach()
   endforeach()
   if(problems)
-    message(FATAL_ERROR "layering: includes against the dependency direction (scheduler -> results -> engine, db):${problems}")
+    message(FATAL_ERROR "layering: includes against the dependency direction (scheduler -> results -> spec -> engine; results -> db):${problems}")
   endif()
 endfunction()
 

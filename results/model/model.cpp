@@ -16,6 +16,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "spec/schemas.h"
+
 namespace gravsweep::results {
 
 // ---------------------------------------------------------------------------------------------
@@ -35,42 +37,47 @@ bool ModelSpec::has(const std::string& term_name) const {
   return std::any_of(terms.begin(), terms.end(), [&](const ModelTerm& t) { return t.term->name == term_name; });
 }
 
+namespace {
+
+/// The terms of a model file (schemas/model.schema.json, checked by spec/schemas.h; then each name
+/// looked up: a generated form's numbers must be in range). Throws spec::SpecError naming the file
+/// and the JSON pointer of every problem.
+std::vector<ModelTerm> model_file_terms(const std::string& file) {
+  std::ifstream in(file);
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const nlohmann::json::parse_error& e) {
+    throw spec::SpecError(file, "", "not valid JSON", e.what());
+  }
+  std::vector<spec::SpecProblem> problems;
+  spec::validator(spec::Schema::model).collect(j, problems);
+  if (!problems.empty()) throw spec::SpecError(file, std::move(problems));
+  std::vector<ModelTerm> terms;
+  for (std::size_t i = 0; i < j["terms"].size(); ++i) {
+    const auto& e = j["terms"][i];
+    const std::string name = e["name"].get<std::string>();
+    ModelTerm mt;
+    try {
+      mt.term = &find_term(name);
+    } catch (const std::invalid_argument& ex) {
+      problems.push_back({fmt::format("/terms/{}/name", i), spec::shown_value(e["name"]), ex.what()});
+      continue;
+    }
+    mt.per_gravity = e.contains("shared") ? !e["shared"].get<bool>() : mt.term->per_gravity;
+    mt.scale = e.value("scale", 1.0);
+    terms.push_back(mt);
+  }
+  if (!problems.empty()) throw spec::SpecError(file, std::move(problems));
+  return terms;
+}
+
+}  // namespace
+
 ModelSpec parse_model(const std::string& text) {
   ModelSpec spec;
   if (std::filesystem::exists(text) && std::filesystem::is_regular_file(text)) {
-    std::ifstream in(text);
-    nlohmann::json j;
-    try {
-      in >> j;
-    } catch (const std::exception& e) {
-      throw std::invalid_argument(fmt::format("{}: not valid JSON: {}", text, e.what()));
-    }
-    if (!j.is_object() || !j.contains("terms") || !j["terms"].is_array())
-      throw std::invalid_argument(fmt::format("{}: /terms: expected an array of terms", text));
-    for (std::size_t i = 0; i < j["terms"].size(); ++i) {
-      const auto& e = j["terms"][i];
-      const std::string ptr = fmt::format("/terms/{}", i);
-      if (!e.is_object() || !e.contains("name") || !e["name"].is_string())
-        throw std::invalid_argument(fmt::format("{}: {}/name: expected a term name (string)", text, ptr));
-      ModelTerm mt;
-      try {
-        mt.term = &find_term(e["name"].get<std::string>());
-      } catch (const std::invalid_argument& ex) {
-        throw std::invalid_argument(fmt::format("{}: {}/name: {}", text, ptr, ex.what()));
-      }
-      mt.per_gravity = mt.term->per_gravity;
-      if (e.contains("shared")) {
-        if (!e["shared"].is_boolean())
-          throw std::invalid_argument(fmt::format("{}: {}/shared: expected true or false", text, ptr));
-        mt.per_gravity = !e["shared"].get<bool>();
-      }
-      if (e.contains("scale")) {
-        if (!e["scale"].is_number())
-          throw std::invalid_argument(fmt::format("{}: {}/scale: expected a number", text, ptr));
-        mt.scale = e["scale"].get<double>();
-      }
-      spec.terms.push_back(mt);
-    }
+    spec.terms = model_file_terms(text);
   } else {
     std::stringstream ss(text);
     std::string item;

@@ -26,7 +26,9 @@ struct ModelSpec {
 
 /// Parses "base+depth_friction" (":shared" or ":per_gravity" after a name sets the sharing,
 /// "*2.5" a synth scale), or a JSON spec file ({"terms": [{"name": ..., "shared": bool,
-/// "scale": x}]}, schemas/model.schema.json). Errors name the JSON pointer.
+/// "scale": x}]}, schemas/model.schema.json). A file is checked against its schema (spec/schemas.h):
+/// spec::SpecError (a ConfigError) names the file and the JSON pointer of every problem; a bad name
+/// in the text form throws std::invalid_argument.
 ModelSpec parse_model(const std::string& text_or_path);
 
 /// A model with fitted coefficients for the gravity levels of a campaign.

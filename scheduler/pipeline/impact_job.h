@@ -12,7 +12,7 @@
 
 #include "engine/system/system.h"
 #include "results/io/bed_file.h"
-#include "scheduler/pipeline/json_schema.h"
+#include "spec/json_schema.h"
 
 namespace gravsweep::pipeline {
 

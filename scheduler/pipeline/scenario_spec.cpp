@@ -14,19 +14,13 @@
 #include "engine/contact/registry.h"
 #include "engine/integrate/integrators.h"
 #include "engine/scenario/paper_params.h"
+#include "spec/schemas.h"
 
 namespace gravsweep::pipeline {
 
 using nlohmann::json;
 
-extern const char* const kScenarioSchemaJson;  // generated from schemas/scenario.schema.json
-
 namespace {
-
-const SchemaValidator& validator() {
-  static const SchemaValidator v(json::parse(scenario_schema_text()));
-  return v;
-}
 
 std::string join(const std::vector<std::string>& v) {
   std::string s;
@@ -314,15 +308,10 @@ void check_output(Checks& ck) {
 
 }  // namespace
 
-const std::string& scenario_schema_text() {
-  static const std::string text(kScenarioSchemaJson);
-  return text;
-}
-
 json validate_scenario(const json& scenario, const std::string& source) {
   json s = scenario;
   std::vector<SpecProblem> problems;
-  validator().collect(s, problems);  // the schema: types, ranges, unknown and missing fields
+  spec::validator(spec::Schema::scenario).collect(s, problems);  // the schema: types, ranges, unknown and missing fields
   Checks ck(s, problems);            // then the rules across fields, on the sound fields
   check_names(ck);
   check_geometry(ck);

@@ -9,12 +9,12 @@
 #include "engine/scenario/impact.h"
 #include "engine/system/system.h"
 #include "results/processing/trace.h"
-#include "scheduler/pipeline/json_schema.h"
+#include "spec/json_schema.h"
 
 namespace gravsweep::pipeline {
 
-/// The text of schemas/scenario.schema.json as compiled into the binary.
-const std::string& scenario_schema_text();
+using spec::SpecError;
+using spec::SpecProblem;
 
 /// Validates a scenario against the schema and the cross-field rules (exactly one of
 /// impact_speed_m_s / drop_height_m, grains fit the container, the projectile and its offsets fit,

@@ -8,7 +8,7 @@
 #include <cstdlib>
 #include <fstream>
 
-#include "scheduler/pipeline/json_pointer.h"
+#include "spec/json_pointer.h"
 
 namespace gravsweep::sweep {
 
@@ -74,7 +74,7 @@ void write(std::string& out, const nlohmann::json& j, const std::string& where) 
         first = false;
         write_string(out, it.key());
         out.push_back(':');
-        write(out, it.value(), pipeline::pointer_child(where, it.key()));
+        write(out, it.value(), spec::pointer_child(where, it.key()));
       }
       out.push_back('}');
       break;
@@ -101,7 +101,7 @@ nlohmann::json normalise(const nlohmann::json& j, const std::string& where) {
     case T::object: {
       nlohmann::json out = nlohmann::json::object();
       for (auto it = j.begin(); it != j.end(); ++it)
-        out[it.key()] = normalise(it.value(), pipeline::pointer_child(where, it.key()));
+        out[it.key()] = normalise(it.value(), spec::pointer_child(where, it.key()));
       return out;
     }
     default: return j;

@@ -8,40 +8,29 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
-#include "scheduler/pipeline/json_pointer.h"
-#include "scheduler/pipeline/json_schema.h"
 #include "scheduler/sweep/canonical.h"
+#include "spec/json_pointer.h"
+#include "spec/schemas.h"
 
 namespace gravsweep::sweep {
 
 using nlohmann::json;
 
+// A sweep spec is checked in two passes, and every problem of both is reported at once:
+//  1. schemas/sweep.schema.json (spec/schemas.h): types, names, ranges, unknown and missing
+//     fields, exactly one of values/range/count, unique values;
+//  2. below, what a schema cannot say: the base scenario file, pointers present in the base, values
+//     of the base field's type, range and repeat expansion, zip lengths, a field swept twice, the
+//     no-op job's fields. An axis the schema already found bad is not checked again.
+
 namespace {
 
-std::string type_name(const json& v) {
-  switch (v.type()) {
-    case json::value_t::null: return "null";
-    case json::value_t::boolean: return "boolean";
-    case json::value_t::number_integer:
-    case json::value_t::number_unsigned: return "integer";
-    case json::value_t::number_float: return "number";
-    case json::value_t::string: return "string";
-    case json::value_t::array: return "array";
-    case json::value_t::object: return "object";
-    default: return "value";
-  }
-}
-
-std::string show(const json& v) {
-  std::string s = v.dump();
-  if (s.size() > 80) s = s.substr(0, 77) + "...";
-  return s + " (" + type_name(v) + ")";
-}
-
-std::string join(const std::string& ptr, const std::string& token) { return pipeline::pointer_child(ptr, token); }
+std::string show(const json& v) { return spec::shown_value(v); }
+std::string join(const std::string& ptr, const std::string& token) { return spec::pointer_child(ptr, token); }
 std::string join(const std::string& ptr, std::size_t i) { return ptr + "/" + std::to_string(i); }
 
 bool is_int(const json& v) {
@@ -53,25 +42,23 @@ bool is_int(const json& v) {
   return false;
 }
 
-/// Collects problems while walking the document.
+/// Collects the problems of the second pass.
 struct Checker {
   std::vector<SpecProblem> problems;
   void add(const std::string& ptr, const json* found, std::string expected) {
-    problems.push_back({ptr, found ? show(*found) : std::string("missing"), std::move(expected)});
+    problems.push_back({ptr, found ? show(*found) : std::string("nothing (missing)"), std::move(expected)});
   }
   void add_text(const std::string& ptr, std::string found, std::string expected) {
     problems.push_back({ptr, std::move(found), std::move(expected)});
   }
-  /// Unknown keys are errors (a typo in a key silently ignored is the worst outcome).
-  void known_keys(const json& obj, const std::string& ptr, const std::set<std::string>& keys) {
-    for (auto it = obj.begin(); it != obj.end(); ++it) {
-      if (keys.count(it.key())) continue;
-      std::string list;
-      for (const auto& k : keys) list += (list.empty() ? "" : ", ") + k;
-      add_text(join(ptr, it.key()), fmt::format("unknown key \"{}\"", it.key()), "one of: " + list);
-    }
-  }
 };
+
+/// True when a problem lies at `ptr` or below it.
+bool has_problem_under(const std::vector<SpecProblem>& problems, const std::string& ptr) {
+  return std::any_of(problems.begin(), problems.end(), [&](const SpecProblem& p) {
+    return p.pointer == ptr || p.pointer.rfind(ptr + "/", 0) == 0;
+  });
+}
 
 /// Problems of a no-op job's scenario: (pointer, found, expected). sleep_s and fail_attempts are
 /// what the no-op runner reads; anything else is carried along (an axis may sweep any field).
@@ -87,197 +74,210 @@ std::vector<SpecProblem> noop_problems(const json& s, const std::string& ptr) {
   return out;
 }
 
-std::string pointer_kind(const json& v) {
-  if (v.is_number()) return "number";
-  return type_name(v);
+std::string value_kind(const json& v) {
+  if (v.is_number()) return "number";  // numbers are numbers: 10 and 9.81 are both numbers
+  switch (v.type()) {
+    case json::value_t::null: return "null";
+    case json::value_t::boolean: return "boolean";
+    case json::value_t::string: return "string";
+    case json::value_t::array: return "array";
+    case json::value_t::object: return "object";
+    default: return "value";
+  }
 }
 
-/// Reads one axis (object with name?, pointer, values | range | count/start for repeats).
-std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json& base, Checker& ck,
-                               bool repeats) {
-  if (!a.is_object()) {
-    ck.add(ptr, &a, repeats ? "an object {pointer, count[, start]} or {pointer, values}"
-                            : "an object {name?, pointer, values | range} or {zip: [...]}");
+/// The field an axis sets, looked up in the base; nullptr (reported) when it is not there.
+const json* base_field(const json& a, const std::string& ptr, const json* base, Checker& ck) {
+  const std::string pointer = a["pointer"].get<std::string>();
+  try {
+    const json::json_pointer jp(pointer);
+    if (!base) return nullptr;  // the base could not be read (reported at /base)
+    if (base->contains(jp)) return &base->at(jp);
+    ck.add(join(ptr, "pointer"), &a["pointer"],
+           "a pointer to a field present in the base scenario (to sweep a default, write the field into the base)");
+  } catch (const json::exception&) {
+    ck.add(join(ptr, "pointer"), &a["pointer"], "a valid JSON pointer (RFC 6901)");
+  }
+  return nullptr;
+}
+
+/// The values of a range {start, stop, step | num}; nothing when it is refused (reported).
+std::optional<std::vector<json>> range_values(const json& r, const std::string& rp, bool integer_base, Checker& ck) {
+  std::vector<json> values;
+  const double start = r["start"].get<double>(), stop = r["stop"].get<double>();
+  if (r.contains("num")) {
+    const long num = r["num"].get<long>();
+    for (long i = 0; i < num; ++i)
+      values.emplace_back(num == 1 ? start
+                                   : round_decimal(start + (stop - start) * static_cast<double>(i) /
+                                                               static_cast<double>(num - 1)));
+    return values;
+  }
+  const double step = r["step"].get<double>();
+  if (stop < start) {
+    ck.add(join(rp, "stop"), &r["stop"], fmt::format("a number >= start ({})", start));
     return std::nullopt;
   }
-  ck.known_keys(a, ptr, repeats ? std::set<std::string>{"name", "pointer", "values", "count", "start", "step"}
-                                : std::set<std::string>{"name", "pointer", "values", "range", "description"});
+  // Inclusive of stop up to rounding: n = floor((stop - start) / step + 1e-9) + 1.
+  const double n = std::floor((stop - start) / step + 1e-9) + 1;
+  if (n > 1e6) {
+    ck.add(join(rp, "step"), &r["step"], "a step giving at most 1000000 values");
+    return std::nullopt;
+  }
+  const bool ints = is_int(r["start"]) && is_int(r["stop"]) && is_int(r["step"]) && integer_base;
+  for (long i = 0; i < static_cast<long>(n); ++i) {
+    const double v = round_decimal(start + static_cast<double>(i) * step);
+    values.push_back(ints ? json(static_cast<std::int64_t>(std::llround(v))) : json(v));
+  }
+  return values;
+}
+
+/// The values of repeats {count, start, step} (defaults inserted by the schema); an integer base
+/// value (a seed) needs integer start and step (reported there).
+std::optional<std::vector<json>> repeat_values(const json& a, const std::string& ptr, const json* base_value,
+                                               const std::string& pointer, Checker& ck) {
+  const json &start = a["start"], &step = a["step"];
+  if (base_value && base_value->is_number_integer()) {
+    bool ok = true;
+    for (const char* k : {"start", "step"})
+      if (!is_int(a[k])) {
+        ck.add(join(ptr, k), &a[k], fmt::format("an integer like the base value at {} ({})", pointer, base_value->dump()));
+        ok = false;
+      }
+    if (!ok) return std::nullopt;
+  }
+  std::vector<json> values;
+  const bool ints = is_int(start) && is_int(step);
+  for (long i = 0; i < a["count"].get<long>(); ++i) {
+    if (ints)
+      values.emplace_back(static_cast<std::int64_t>(std::llround(start.get<double>())) +
+                          i * static_cast<std::int64_t>(std::llround(step.get<double>())));
+    else
+      values.emplace_back(round_decimal(start.get<double>() + static_cast<double>(i) * step.get<double>()));
+  }
+  return values;
+}
+
+/// Reads one axis the schema found sound ({name?, pointer, values | range} or, for repeats,
+/// {name?, pointer, values | count/start/step}): the checks across fields.
+std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json* base, Checker& ck) {
   Axis axis;
-  bool ok = true;
-  const json* base_value = nullptr;
-  if (!a.contains("pointer")) {
-    ck.add(join(ptr, "pointer"), nullptr, "a JSON pointer string into the base scenario, e.g. \"/gravity_m_s2\"");
-    ok = false;
-  } else if (!a["pointer"].is_string() || a["pointer"].get<std::string>().empty() ||
-             a["pointer"].get<std::string>()[0] != '/') {
-    ck.add(join(ptr, "pointer"), &a["pointer"], "a JSON pointer string starting with '/', e.g. \"/gravity_m_s2\"");
-    ok = false;
-  } else {
-    axis.pointer = a["pointer"].get<std::string>();
-    try {
-      const json::json_pointer jp(axis.pointer);
-      if (!base.is_object()) {
-        // The base could not be read (its problem is reported at /base): nothing to look the pointer up in.
-      } else if (!base.contains(jp)) {
-        ck.add(join(ptr, "pointer"), &a["pointer"], "a pointer to a field present in the base scenario (to sweep a default, write the field into the base)");
-        ok = false;
-      } else {
-        base_value = &base.at(jp);
-      }
-    } catch (const json::exception&) {
-      ck.add(join(ptr, "pointer"), &a["pointer"], "a valid JSON pointer (RFC 6901)");
-      ok = false;
-    }
-  }
+  axis.pointer = a["pointer"].get<std::string>();
+  const json* base_value = base_field(a, ptr, base, ck);
+  bool ok = base == nullptr || base_value != nullptr;
   if (a.contains("name")) {
-    if (!a["name"].is_string() || !valid_column_name(a["name"].get<std::string>())) {
-      ck.add(join(ptr, "name"), &a["name"], "a column name [a-z_][a-z0-9_]* with units, e.g. \"gravity_m_s2\", not one of the fixed results columns (job_id, sweep, kind, attempt, ...)");
-      ok = false;
-    } else {
-      axis.name = a["name"].get<std::string>();
-    }
-  } else if (!axis.pointer.empty()) {
-    axis.name = column_from_pointer(axis.pointer);
-    if (!valid_column_name(axis.name)) {
+    axis.name = a["name"].get<std::string>();
+  } else {
+    // The column name derived from the pointer obeys the schema's rule for a written one.
+    json derived = column_from_pointer(axis.pointer);
+    std::vector<SpecProblem> bad;
+    spec::validator(spec::Schema::sweep).collect_definition(derived, "column", join(ptr, "pointer"), bad);
+    if (!bad.empty()) {
       ck.add(join(ptr, "pointer"), &a["pointer"],
-             "a pointer whose tokens make a column name, or an explicit \"name\" [a-z_][a-z0-9_]*");
+             fmt::format("a pointer whose tokens make a column name (\"{}\" is not one), or an explicit \"name\" "
+                         "[a-z_][a-z0-9_]*", derived.get<std::string>()));
       ok = false;
     }
+    axis.name = derived.get<std::string>();
   }
-
-  // Values.
-  const int sources = int(a.contains("values")) + int(a.contains("range")) + int(a.contains("count"));
-  if (sources != 1) {
-    ck.add_text(ptr, sources == 0 ? "none of values/range" + std::string(repeats ? "/count" : "")
-                                  : "more than one of values/range/count",
-                repeats ? "exactly one of \"values\" or \"count\"" : "exactly one of \"values\" or \"range\"");
-    return std::nullopt;
-  }
+  std::optional<std::vector<json>> values;
+  std::string values_ptr;
   if (a.contains("values")) {
-    const json& vs = a["values"];
-    if (!vs.is_array() || vs.empty()) {
-      ck.add(join(ptr, "values"), &vs, "a non-empty array of values");
-      return std::nullopt;
-    }
-    for (std::size_t i = 0; i < vs.size(); ++i) axis.values.push_back(vs[i]);
+    values = a["values"].get<std::vector<json>>();
+    values_ptr = join(ptr, "values");
   } else if (a.contains("range")) {
-    const json& r = a["range"];
-    const std::string rp = join(ptr, "range");
-    if (!r.is_object()) {
-      ck.add(rp, &r, "an object {start, stop, step} or {start, stop, num}");
-      return std::nullopt;
-    }
-    ck.known_keys(r, rp, {"start", "stop", "step", "num"});
-    bool rok = true;
-    for (const char* k : {"start", "stop"}) {
-      if (!r.contains(k) || !r[k].is_number()) {
-        ck.add(join(rp, k), r.contains(k) ? &r[k] : nullptr, "a number");
-        rok = false;
-      }
-    }
-    if (r.contains("step") == r.contains("num")) {
-      ck.add_text(rp, r.contains("step") ? "both step and num" : "neither step nor num",
-                  "exactly one of \"step\" (positive number) or \"num\" (integer >= 1)");
-      rok = false;
-    }
-    if (r.contains("step") && (!r["step"].is_number() || !(r["step"].get<double>() > 0))) {
-      ck.add(join(rp, "step"), &r["step"], "a positive number");
-      rok = false;
-    }
-    if (r.contains("num") && (!is_int(r["num"]) || r["num"].get<double>() < 1 || r["num"].get<double>() > 1e6)) {
-      ck.add(join(rp, "num"), &r["num"], "an integer between 1 and 1000000");
-      rok = false;
-    }
-    if (!rok) return std::nullopt;
-    const double start = r["start"].get<double>(), stop = r["stop"].get<double>();
-    const bool ints = is_int(r["start"]) && is_int(r["stop"]) && (!r.contains("step") || is_int(r["step"])) &&
-                      base_value && base_value->is_number_integer();
-    if (r.contains("step")) {
-      const double step = r["step"].get<double>();
-      if (stop < start) {
-        ck.add(join(rp, "stop"), &r["stop"], fmt::format("a number >= start ({})", start));
-        return std::nullopt;
-      }
-      // Inclusive of stop up to rounding: n = floor((stop - start) / step + 1e-9) + 1.
-      const double n = std::floor((stop - start) / step + 1e-9) + 1;
-      if (n > 1e6) {
-        ck.add(join(rp, "step"), &r["step"], "a step giving at most 1000000 values");
-        return std::nullopt;
-      }
-      for (long i = 0; i < static_cast<long>(n); ++i) {
-        const double v = round_decimal(start + static_cast<double>(i) * step);
-        axis.values.push_back(ints ? json(static_cast<std::int64_t>(std::llround(v))) : json(v));
-      }
-    } else {
-      const long num = static_cast<long>(r["num"].get<double>());
-      for (long i = 0; i < num; ++i) {
-        const double v = num == 1 ? start : round_decimal(start + (stop - start) * static_cast<double>(i) /
-                                                                      static_cast<double>(num - 1));
-        axis.values.push_back(json(v));
-      }
-    }
-  } else {  // repeats: count/start/step
-    const json& c = a["count"];
-    if (!is_int(c) || c.get<double>() < 1 || c.get<double>() > 1e6) {
-      ck.add(join(ptr, "count"), &c, "an integer between 1 and 1000000");
-      return std::nullopt;
-    }
-    json start = a.value("start", json(0)), step = a.value("step", json(1));
-    if (!start.is_number()) {
-      ck.add(join(ptr, "start"), &a["start"], "a number");
-      return std::nullopt;
-    }
-    if (!step.is_number()) {
-      ck.add(join(ptr, "step"), &a["step"], "a number");
-      return std::nullopt;
-    }
-    // Repeats number seeds: an integer base value needs integer start and step (reported there).
-    if (base_value && base_value->is_number_integer()) {
-      bool iok = true;
-      for (const char* k : {"start", "step"})
-        if (a.contains(k) && !is_int(a[k])) {
-          ck.add(join(ptr, k), &a[k], fmt::format("an integer like the base value at {} ({})", axis.pointer,
-                                                  base_value->dump()));
-          iok = false;
-        }
-      if (!iok) return std::nullopt;
-    }
-    const bool ints = is_int(start) && is_int(step);
-    for (long i = 0; i < static_cast<long>(c.get<double>()); ++i) {
-      if (ints)
-        axis.values.push_back(json(static_cast<std::int64_t>(std::llround(start.get<double>())) +
-                                   i * static_cast<std::int64_t>(std::llround(step.get<double>()))));
-      else
-        axis.values.push_back(json(round_decimal(start.get<double>() + static_cast<double>(i) * step.get<double>())));
-    }
+    values_ptr = join(ptr, "range");
+    values = range_values(a["range"], values_ptr, base_value && base_value->is_number_integer(), ck);
+  } else {
+    values_ptr = join(ptr, "count");
+    values = repeat_values(a, ptr, base_value, axis.pointer, ck);
   }
+  if (!values) return std::nullopt;
+  axis.values = std::move(*values);
+  if (!base_value) return ok ? std::optional<Axis>(std::move(axis)) : std::nullopt;
 
-  // Each value: a finite value of the base field's type; canonical form.
-  if (base_value) {
-    const std::string values_ptr = a.contains("values") ? join(ptr, "values") : a.contains("range") ? join(ptr, "range") : join(ptr, "count");
-    for (std::size_t i = 0; i < axis.values.size(); ++i) {
-      const json& v = axis.values[i];
-      const std::string vp = a.contains("values") ? join(values_ptr, i) : values_ptr;
-      if (!base_value->is_null() && pointer_kind(v) != pointer_kind(*base_value)) {
-        ck.add(vp, &v, fmt::format("a {} like the base value at {} ({})", pointer_kind(*base_value), axis.pointer,
-                                   base_value->dump()));
-        ok = false;
-      } else {  // numbers are numbers: 10 in the base and 9.81 on an axis are both numbers
-        axis.values[i] = canonicalize(v);
-      }
+  // Each value: a value of the base field's kind; canonical form; no two the same.
+  std::set<std::string> seen;
+  for (std::size_t i = 0; i < axis.values.size(); ++i) {
+    const json& v = axis.values[i];
+    const std::string vp = a.contains("values") ? join(values_ptr, i) : values_ptr;
+    if (!base_value->is_null() && value_kind(v) != value_kind(*base_value)) {
+      ck.add(vp, &v, fmt::format("a {} like the base value at {} ({})", value_kind(*base_value), axis.pointer,
+                                 base_value->dump()));
+      ok = false;
+      continue;
     }
-    // Duplicate values make duplicate jobs: refuse them.
-    std::set<std::string> seen;
-    for (std::size_t i = 0; i < axis.values.size() && ok; ++i) {
-      if (!seen.insert(canonical_json(axis.values[i])).second) {
-        ck.add(a.contains("values") ? join(values_ptr, i) : values_ptr, &axis.values[i],
-               "values that differ from each other (this one repeats an earlier value)");
-        ok = false;
-      }
+    axis.values[i] = canonicalize(v);
+    if (ok && !seen.insert(canonical_json(axis.values[i])).second) {
+      ck.add(vp, &axis.values[i], "values that differ from each other (this one repeats an earlier value)");
+      ok = false;
     }
   }
   if (!ok) return std::nullopt;
   return axis;
+}
+
+/// The base scenario: inline, or a file relative to the spec (read here). Nothing when it cannot be
+/// read (reported).
+std::optional<json> read_base(const json& doc, const std::filesystem::path& base_dir, Checker& ck) {
+  if (doc["base"].is_object()) return doc["base"];
+  const std::filesystem::path p = base_dir / doc["base"].get<std::string>();
+  std::string why;
+  const auto text = read_text_file(p, why);
+  json base;
+  if (!text) {
+    ck.add("/base", &doc["base"], fmt::format("a readable scenario file ('{}' is {})", p.string(), why));
+  } else if (const auto err = parse_json_text(*text, base)) {
+    ck.add("/base", &doc["base"], fmt::format("a JSON scenario file ('{}': {} at {})", p.string(), err->what, err->where()));
+  } else if (!base.is_object()) {
+    ck.add("/base", &doc["base"], fmt::format("a file holding a JSON object ('{}' holds {})", p.string(), value_kind(base)));
+  } else {
+    return base;
+  }
+  return std::nullopt;
+}
+
+/// The axes and repeats into groups: a zip of equal lengths is one group; no column name or field
+/// twice. Axes the schema found bad are skipped (already reported).
+void read_axes(const json& doc, const json* base, const std::vector<SpecProblem>& schema_problems, SweepSpec& spec,
+               Checker& ck) {
+  std::set<std::string> names, pointers;
+  auto add_group = [&](AxisGroup g, const std::string& ptr) {
+    for (const auto& a : g.axes) {
+      if (!names.insert(a.name).second)
+        ck.add_text(ptr, fmt::format("column name \"{}\" used twice", a.name), "distinct axis names");
+      if (!pointers.insert(a.pointer).second)
+        ck.add_text(ptr, fmt::format("pointer \"{}\" swept twice", a.pointer), "each field swept by one axis only");
+    }
+    spec.groups.push_back(std::move(g));
+  };
+  const json axes = doc.value("axes", json::array());
+  for (std::size_t i = 0; i < axes.size(); ++i) {
+    const std::string ap = join("/axes", i);
+    if (has_problem_under(schema_problems, ap)) continue;
+    if (!axes[i].contains("zip")) {
+      if (auto axis = parse_axis(axes[i], ap, base, ck)) add_group(AxisGroup{{std::move(*axis)}}, ap);
+      continue;
+    }
+    const json& z = axes[i]["zip"];
+    AxisGroup g;
+    bool ok = true;
+    for (std::size_t k = 0; k < z.size(); ++k) {
+      auto axis = parse_axis(z[k], join(join(ap, "zip"), k), base, ck);
+      if (!axis) {
+        ok = false;
+      } else if (!g.axes.empty() && axis->values.size() != g.axes.front().values.size()) {
+        ck.add_text(join(join(ap, "zip"), k), fmt::format("{} values", axis->values.size()),
+                    fmt::format("{} values, as many as {}/zip/0", g.axes.front().values.size(), ap));
+        ok = false;
+      } else {
+        g.axes.push_back(std::move(*axis));
+      }
+    }
+    if (ok) add_group(std::move(g), ap);
+  }
+  if (doc.contains("repeats") && !has_problem_under(schema_problems, "/repeats"))
+    if (auto axis = parse_axis(doc["repeats"], "/repeats", base, ck)) add_group(AxisGroup{{std::move(*axis)}}, "/repeats");
 }
 
 }  // namespace
@@ -302,149 +302,38 @@ std::string column_from_pointer(const std::string& pointer) {
   return out;
 }
 
-bool valid_column_name(const std::string& name) {
-  if (name.empty() || name.size() > 64) return false;
-  static const std::set<std::string> reserved = {"job_id",     "sweep",        "kind",        "bed_job_id",
-                                                 "attempt",    "trace_path",   "trace_sha256", "trace_bytes",
-                                                 "runtime_s",  "finished_at",  "code_version"};
-  if (reserved.count(name)) return false;
-  if (!(std::islower(static_cast<unsigned char>(name[0])) || name[0] == '_')) return false;
-  for (char c : name)
-    if (!(std::islower(static_cast<unsigned char>(c)) || std::isdigit(static_cast<unsigned char>(c)) || c == '_'))
-      return false;
-  return true;
-}
-
-SweepSpec parse_spec(const json& doc, const std::string& file, const std::filesystem::path& base_dir) {
-  Checker ck;
+SweepSpec parse_spec(const json& doc_in, const std::string& file, const std::filesystem::path& base_dir) {
+  json doc = doc_in;  // the schema inserts its defaults (job, max_attempts, priority, repeat start/step)
+  std::vector<SpecProblem> problems;
+  spec::validator(spec::Schema::sweep).collect(doc, problems);
+  if (!doc.is_object()) throw SpecError::sweep_spec(file, problems);
   SweepSpec spec;
-  if (!doc.is_object()) {
-    ck.add("", &doc, "an object {sweep, base, axes, ...}");
-    throw SpecError::sweep_spec(file, ck.problems);
-  }
-  ck.known_keys(doc, "", {"$schema", "sweep", "description", "job", "base", "axes", "repeats", "max_attempts",
-                          "priority"});
-  if (!doc.contains("sweep")) {
-    ck.add("/sweep", nullptr, "a sweep name string [A-Za-z0-9_.-]+");
-  } else if (!doc["sweep"].is_string() || doc["sweep"].get<std::string>().empty() ||
-             doc["sweep"].get<std::string>().find_first_not_of(
-                 "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") != std::string::npos) {
-    ck.add("/sweep", &doc["sweep"], "a sweep name string [A-Za-z0-9_.-]+");
-  } else {
-    spec.name = doc["sweep"].get<std::string>();
-  }
-  if (doc.contains("description") && !doc["description"].is_string())
-    ck.add("/description", &doc["description"], "a string");
-  if (doc.contains("job")) {
-    if (!doc["job"].is_string() || (doc["job"] != "impact" && doc["job"] != "noop"))
-      ck.add("/job", &doc["job"], "\"impact\" (bed + drop jobs, the default) or \"noop\" (scheduler benchmark)");
-    else
-      spec.job_kind = doc["job"].get<std::string>();
-  }
-  for (const char* k : {"max_attempts", "priority"}) {
-    if (!doc.contains(k)) continue;
-    const bool attempts = std::string(k) == "max_attempts";
-    if (!is_int(doc[k]) || (attempts && (doc[k].get<double>() < 1 || doc[k].get<double>() > 100)) ||
-        std::abs(doc[k].get<double>()) > 1e6)
-      ck.add(std::string("/") + k, &doc[k], attempts ? "an integer between 1 and 100" : "an integer");
-    else if (attempts)
-      spec.max_attempts = static_cast<int>(doc[k].get<double>());
-    else
-      spec.priority = static_cast<int>(doc[k].get<double>());
-  }
+  auto sound = [&](const char* ptr) { return doc.contains(ptr + 1) && !has_problem_under(problems, ptr); };
+  if (sound("/sweep")) spec.name = doc["sweep"].get<std::string>();
+  if (sound("/job")) spec.job_kind = doc["job"].get<std::string>();
+  if (sound("/max_attempts")) spec.max_attempts = doc["max_attempts"].get<int>();
+  if (sound("/priority")) spec.priority = doc["priority"].get<int>();
 
-  // Base scenario: inline object or a file name relative to the spec.
-  json base;
-  bool have_base = false;
-  if (!doc.contains("base")) {
-    ck.add("/base", nullptr, "the base scenario: an object, or a file name relative to the spec");
-  } else if (doc["base"].is_string()) {
-    const std::filesystem::path p = base_dir / doc["base"].get<std::string>();
-    std::string why;
-    const auto text = read_text_file(p, why);
-    if (!text) {
-      ck.add("/base", &doc["base"], fmt::format("a readable scenario file ('{}' is {})", p.string(), why));
-    } else if (const auto err = parse_json_text(*text, base)) {
-      ck.add("/base", &doc["base"], fmt::format("a JSON scenario file ('{}': {} at {})", p.string(), err->what, err->where()));
-    } else if (!base.is_object()) {
-      ck.add("/base", &doc["base"], fmt::format("a file holding a JSON object ('{}' holds {})", p.string(), type_name(base)));
-    } else {
-      have_base = true;
-    }
-  } else if (doc["base"].is_object()) {
-    base = doc["base"];
-    have_base = true;
-  } else {
-    ck.add("/base", &doc["base"], "an object (the base scenario) or a file name string");
-  }
-  if (have_base) {
+  Checker ck;
+  std::optional<json> base;
+  if (sound("/base")) base = read_base(doc, base_dir, ck);
+  if (base) {
     try {
-      spec.base = canonicalize(base);
+      spec.base = canonicalize(*base);
+      if (spec.job_kind == "noop")
+        for (auto& p : noop_problems(spec.base, "/base")) ck.problems.push_back(std::move(p));
     } catch (const CanonicalError& e) {
       ck.add_text("/base", e.what(), "finite numbers only");
+      base.reset();
     }
   }
-
-  if (have_base && spec.job_kind == "noop")
-    for (auto& p : noop_problems(spec.base, "/base")) ck.problems.push_back(std::move(p));
-
-  std::set<std::string> names, pointers;
-  auto add_group = [&](AxisGroup g, const std::string& ptr) {
-    for (const auto& a : g.axes) {
-      if (!names.insert(a.name).second)
-        ck.add_text(ptr, fmt::format("column name \"{}\" used twice", a.name), "distinct axis names");
-      if (!pointers.insert(a.pointer).second)
-        ck.add_text(ptr, fmt::format("pointer \"{}\" swept twice", a.pointer), "each field swept by one axis only");
-    }
-    spec.groups.push_back(std::move(g));
-  };
-  if (doc.contains("axes")) {
-    const json& axes = doc["axes"];
-    if (!axes.is_array()) {
-      ck.add("/axes", &axes, "an array of axes");
-    } else {
-      for (std::size_t i = 0; i < axes.size(); ++i) {
-        const std::string ap = join("/axes", i);
-        const json& a = axes[i];
-        if (a.is_object() && a.contains("zip")) {
-          ck.known_keys(a, ap, {"zip", "description"});
-          const json& z = a["zip"];
-          if (!z.is_array() || z.size() < 2) {
-            ck.add(join(ap, "zip"), &z, "an array of at least two axes that vary together");
-            continue;
-          }
-          AxisGroup g;
-          bool ok = true;
-          for (std::size_t k = 0; k < z.size(); ++k) {
-            auto axis = parse_axis(z[k], join(join(ap, "zip"), k), base, ck, false);
-            if (!axis) {
-              ok = false;
-              continue;
-            }
-            if (!g.axes.empty() && axis->values.size() != g.axes.front().values.size()) {
-              ck.add_text(join(join(ap, "zip"), k), fmt::format("{} values", axis->values.size()),
-                          fmt::format("{} values, as many as {}/zip/0", g.axes.front().values.size(), ap));
-              ok = false;
-              continue;
-            }
-            g.axes.push_back(std::move(*axis));
-          }
-          if (ok) add_group(std::move(g), ap);
-        } else if (auto axis = parse_axis(a, ap, base, ck, false)) {
-          add_group(AxisGroup{{std::move(*axis)}}, ap);
-        }
-      }
-    }
-  }
-  if (doc.contains("repeats")) {
-    if (auto axis = parse_axis(doc["repeats"], "/repeats", base, ck, true))
-      add_group(AxisGroup{{std::move(*axis)}}, "/repeats");
-  }
-  if (!ck.problems.empty()) throw SpecError::sweep_spec(file, ck.problems);
+  read_axes(doc, base ? &spec.base : nullptr, problems, spec, ck);
+  problems.insert(problems.end(), ck.problems.begin(), ck.problems.end());
+  if (!problems.empty()) throw SpecError::sweep_spec(file, problems);
   if (spec.points() > 5'000'000)
     throw SpecError::sweep_spec(file,
                                 {{"/axes", fmt::format("{} points", spec.points()), "at most 5000000 points per sweep"}});
-  spec.source = doc;
+  spec.source = doc_in;
   spec.source["base"] = spec.base;
   spec.file = file;
   return spec;
@@ -479,7 +368,7 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
   if (spec.job_kind != "noop" && bed_key) {
     try {
       (void)bed_key(spec.base);
-    } catch (const pipeline::SpecError& e) {
+    } catch (const SpecError& e) {
       for (const auto& p : e.problems())
         if (!swept(p.pointer)) problems.push_back({"/base" + p.pointer, p.found, p.expected});
       if (!problems.empty()) throw SpecError::sweep_spec(spec.file.empty() ? spec.name : spec.file, problems);
@@ -522,7 +411,7 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
     try {
       if (!bed_key) throw std::runtime_error("no bed key function (the impact pipeline is not built in)");
       key = bed_key(job.scenario);
-    } catch (const pipeline::SpecError& e) {
+    } catch (const SpecError& e) {
       // The base was sound, so these are problems of swept values: one per field and reason,
       // counting the other points that have it.
       for (const auto& sp : e.problems()) {

@@ -3,9 +3,10 @@
 // offsets). expand() turns a spec into content-addressed jobs: one `drop` job per point and one
 // `bed` job per distinct bed key, which the drops that share the bed depend on.
 //
-// Validation never stops at the first problem: SpecError (pipeline::SpecError, made by
-// SpecError::sweep_spec) lists every problem with the file, the JSON pointer, the value found and
-// what was expected.
+// Validation never stops at the first problem: the schema (spec/schemas.h) and then the checks
+// across fields (spec.cpp) each report every problem, and SpecError (spec::SpecError, made by
+// SpecError::sweep_spec) lists them all with the file, the JSON pointer, the value found and what
+// was expected.
 #pragma once
 #include <nlohmann/json.hpp>
 
@@ -15,17 +16,17 @@
 #include <string>
 #include <vector>
 
-#include "scheduler/pipeline/json_schema.h"
 #include "scheduler/queue/job_types.h"
+#include "spec/json_schema.h"
 
 namespace gravsweep::sweep {
 
 /// One problem: JSON pointer into the spec ("" = the document), the value found, what was expected.
-using SpecProblem = pipeline::SpecProblem;
+using SpecProblem = spec::SpecProblem;
 
-/// The one spec error (pipeline/json_schema.h), thrown here as SpecError::sweep_spec(file, problems):
+/// The one spec error (spec/json_schema.h), thrown here as SpecError::sweep_spec(file, problems):
 /// a ConfigError whose message lists every problem.
-using SpecError = pipeline::SpecError;
+using SpecError = spec::SpecError;
 
 /// One swept scenario field.
 struct Axis {
@@ -76,9 +77,8 @@ using BedKeyFn = std::function<nlohmann::json(const nlohmann::json& scenario)>;
 /// SpecError naming the point.
 std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key);
 
-/// A results column name is [a-z_][a-z0-9_]*; derives one from a pointer ("/drop/speed_m_s"
-/// -> "drop_speed_m_s").
+/// The column name an axis without "name" gets: its pointer's tokens, lower case, joined by '_'
+/// ("/drop/speed_m_s" -> "drop_speed_m_s"); checked by the schema's rule for column names.
 std::string column_from_pointer(const std::string& pointer);
-bool valid_column_name(const std::string& name);
 
 }  // namespace gravsweep::sweep

@@ -8,6 +8,7 @@
 #include "engine/scenario/paper_params.h"
 #include "scenario_helpers.h"
 #include "scheduler/pipeline/scenario_spec.h"
+#include "spec/schemas.h"
 
 namespace gravsweep {
 namespace {
@@ -187,7 +188,7 @@ TEST(ScenarioSpec, TheCompiledSchemaIsTheRepositorysSchema) {
   ASSERT_TRUE(in.good());
   std::stringstream ss;
   ss << in.rdbuf();
-  EXPECT_EQ(json::parse(ss.str()), json::parse(pipeline::scenario_schema_text()));
+  EXPECT_EQ(json::parse(ss.str()), json::parse(spec::schema_text(spec::Schema::scenario)));
 }
 
 TEST(ScenarioSpec, ExamplesAreValid) {

@@ -106,7 +106,7 @@ std::vector<Case> corpus() {
   c.push_back({"mass a string", with(im, "/base/projectile/mass_kg", "heavy"), "/base/projectile/mass_kg", "", true});
   // 2^64 is shown as the number it is (never wrapped to -9223372036854775808), with the bound in full.
   c.push_back({"seed 2^64", with(im, "/base/bed/seed", json::parse("18446744073709551616")), "/base/bed/seed",
-               "found 1.8446744073709552e+19, expected a number >= 0 and <= 9007199254740991", true});
+               "found 1.8446744073709552e+19 (number), expected an integer between 0 and 9007199254740991", true});
   c.push_back({"dt_s 5e-324", with(im, "/base/dt_s", 5e-324), "/base/dt_s", "at least 1e-09", true});
   json wide = im;
   wide["base"]["container"]["diameter_m"] = 20;

@@ -3,7 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "scheduler/pipeline/json_pointer.h"
+#include "spec/json_pointer.h"
 #include "scheduler/sweep/canonical.h"
 
 using gravsweep::sweep::canonical_json;
@@ -60,8 +60,8 @@ TEST(Canonical, RejectsNonFinite) {
 }
 
 TEST(JsonPointer, TokensAreEscapedAsRfc6901Says) {
-  using gravsweep::pipeline::pointer_child;
-  using gravsweep::pipeline::pointer_token;
+  using gravsweep::spec::pointer_child;
+  using gravsweep::spec::pointer_token;
   EXPECT_EQ(pointer_token("gravity_m_s2"), "gravity_m_s2");
   EXPECT_EQ(pointer_token("a/b~c"), "a~1b~0c");
   EXPECT_EQ(pointer_token("~1"), "~01");  // '~' first, so "~1" is not read back as '/'

@@ -168,7 +168,7 @@ TEST(SweepSpec, BaseFromFileRelativeToSpec) {
 }
 
 TEST(SweepSpec, ErrorIsTheOneSpecErrorAConfigErrorWithTheSweepMessage) {
-  // One SpecError for scenario and sweep specs (pipeline/json_schema.h); a sweep spec's message
+  // One SpecError for scenario and sweep specs (spec/json_schema.h); a sweep spec's message
   // stays as it was: the file, the count, then one line per problem.
   const json doc = {{"sweep", "s"},
                     {"base", kBase},
@@ -179,7 +179,7 @@ TEST(SweepSpec, ErrorIsTheOneSpecErrorAConfigErrorWithTheSweepMessage) {
     parse(doc);
     FAIL() << "an unknown key and max_attempts 0 accepted";
   } catch (const gravsweep::ConfigError& e) {
-    const auto* se = dynamic_cast<const gravsweep::pipeline::SpecError*>(&e);
+    const auto* se = dynamic_cast<const gravsweep::spec::SpecError*>(&e);
     ASSERT_NE(se, nullptr) << "not a SpecError: " << e.what();
     EXPECT_EQ(se->source(), "spec.json");
     ASSERT_EQ(se->problems().size(), 2u) << e.what();

@@ -1,11 +1,10 @@
-// JSON pointers (RFC 6901) as the spec validators and canonical_json() write them in messages.
-// The one place a reference token is escaped; no dependency on the rest of the scheduler, so
-// scheduler/pipeline and scheduler/sweep both include it.
+// JSON pointers (RFC 6901) as the spec validator (spec/json_schema.h), the sweep and model spec
+// checks and canonical_json() write them in messages: the one place a reference token is escaped.
 #pragma once
 #include <string>
 #include <string_view>
 
-namespace gravsweep::pipeline {
+namespace gravsweep::spec {
 
 /// One reference token escaped (RFC 6901 Sect. 3): '~' -> "~0", '/' -> "~1".
 inline std::string pointer_token(std::string_view key) {
@@ -24,4 +23,4 @@ inline std::string pointer_child(const std::string& parent, std::string_view key
   return parent + "/" + pointer_token(key);
 }
 
-}  // namespace gravsweep::pipeline
+}  // namespace gravsweep::spec
