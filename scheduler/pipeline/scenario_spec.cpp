@@ -16,6 +16,50 @@
 #include "engine/scenario/paper_params.h"
 #include "spec/schemas.h"
 
+// Typed JSON (nlohmann's from_json, found by argument-dependent lookup) for the engine's material
+// types, read from a scenario the schema has validated (schemas/scenario.schema.json: /materials,
+// /contact/pairs, /contact/composition). The engine stays free of JSON; these live beside the one
+// place that reads them.
+namespace gravsweep {
+
+void from_json(const nlohmann::json& j, Material& m) {
+  m.young_modulus_Pa = j.at("young_modulus_Pa");
+  m.poisson_ratio = j.at("poisson_ratio");
+  m.cor_normal = j.at("cor_normal");
+  m.cor_tangential = j.at("cor_tangential");
+  m.mu_static = j.at("mu_static");
+  m.mu_rolling = j.at("mu_rolling");
+  m.mu_twisting = j.at("mu_twisting");
+  m.kn_N_m = j.at("kn_N_m");
+  m.kt_N_m = j.at("kt_N_m");
+  m.shape_beta = j.at("shape_beta");
+}
+
+void from_json(const nlohmann::json& j, PairOverride& o) {
+  auto opt = [&](const char* k, std::optional<double>& f) {
+    if (j.contains(k)) f = j.at(k).get<double>();
+  };
+  opt("cor_normal", o.cor_normal);
+  opt("cor_tangential", o.cor_tangential);
+  opt("mu_static", o.mu_static);
+  opt("mu_rolling", o.mu_rolling);
+  opt("mu_twisting", o.mu_twisting);
+  opt("kn_N_m", o.kn_N_m);
+  opt("kt_N_m", o.kt_N_m);
+  opt("shape_beta", o.shape_beta);
+}
+
+/// An unknown name is an error, never a silent fallback to the first value (scenario_params may be
+/// handed a scenario the schema did not see).
+void from_json(const nlohmann::json& j, Composition& c) {
+  const std::string name = j.get<std::string>();
+  if (name == "explicit_pair") c = Composition::explicit_pair;
+  else if (name == "chrono_min") c = Composition::chrono_min;
+  else throw ConfigError(fmt::format("/contact/composition: found \"{}\", expected \"explicit_pair\" or \"chrono_min\"", name));
+}
+
+}  // namespace gravsweep
+
 namespace gravsweep::pipeline {
 
 using nlohmann::json;
@@ -28,45 +72,6 @@ std::string join(const std::vector<std::string>& v) {
   return s;
 }
 
-Material material_from(const json& j, const std::string& name) {
-  Material m{name};
-  m.young_modulus_Pa = j.at("young_modulus_Pa");
-  m.poisson_ratio = j.at("poisson_ratio");
-  m.cor_normal = j.at("cor_normal");
-  m.cor_tangential = j.at("cor_tangential");
-  m.mu_static = j.at("mu_static");
-  m.mu_rolling = j.at("mu_rolling");
-  m.mu_twisting = j.at("mu_twisting");
-  m.kn_N_m = j.at("kn_N_m");
-  m.kt_N_m = j.at("kt_N_m");
-  m.shape_beta = j.at("shape_beta");
-  return m;
-}
-
-PairOverride pair_from(const json& j) {
-  PairOverride o;
-  auto opt = [&](const char* k, std::optional<double>& f) {
-    if (j.contains(k)) f = j.at(k).get<double>();
-  };
-  opt("cor_normal", o.cor_normal);
-  opt("cor_tangential", o.cor_tangential);
-  opt("mu_static", o.mu_static);
-  opt("mu_rolling", o.mu_rolling);
-  opt("mu_twisting", o.mu_twisting);
-  opt("kn_N_m", o.kn_N_m);
-  opt("kt_N_m", o.kt_N_m);
-  opt("shape_beta", o.shape_beta);
-  return o;
-}
-
-/// /contact/composition by name (schemas/scenario.schema.json); an unknown name is an error, never
-/// a silent fallback (scenario_params may be handed a scenario the schema did not see).
-Composition composition_of(const std::string& name) {
-  if (name == "explicit_pair") return Composition::explicit_pair;
-  if (name == "chrono_min") return Composition::chrono_min;
-  throw ConfigError(fmt::format("/contact/composition: found \"{}\", expected \"explicit_pair\" or \"chrono_min\"", name));
-}
-
 /// The system configuration common to preparation and drop (dt and gravity set by the caller).
 SystemConfig base_config(const json& s) {
   SystemConfig c;
@@ -74,13 +79,15 @@ SystemConfig base_config(const json& s) {
   c.contact_law = ct.at("law");
   c.rolling_model = ct.at("rolling_model");
   c.integrator = s.at("integrator");
-  c.composition = composition_of(ct.at("composition").get<std::string>());
+  c.composition = ct.at("composition").get<Composition>();
   c.options.clamp_normal = ct.at("clamp_normal");
   const json& m = s.at("materials");
   c.materials.assign(3, Material{});
-  c.materials[kGrainMaterial] = material_from(m.at("grain"), "grain");
-  c.materials[kWallMaterial] = material_from(m.at("wall"), "wall");
-  c.materials[kProjectileMaterial] = material_from(m.at("projectile"), "projectile");
+  for (const auto& [index, name] : {std::pair{kGrainMaterial, "grain"}, std::pair{kWallMaterial, "wall"},
+                                    std::pair{kProjectileMaterial, "projectile"}}) {
+    c.materials[index] = m.at(name).get<Material>();
+    c.materials[index].name = name;
+  }
   const std::pair<const char*, std::pair<int, int>> pairs[] = {
       {"grain-grain", {kGrainMaterial, kGrainMaterial}},
       {"grain-wall", {kGrainMaterial, kWallMaterial}},
@@ -88,7 +95,7 @@ SystemConfig base_config(const json& s) {
       {"projectile-wall", {kWallMaterial, kProjectileMaterial}}};
   for (const auto& [name, key] : pairs)
     if (ct.at("pairs").contains(name) && !ct.at("pairs").at(name).empty())
-      c.pair_overrides[key] = pair_from(ct.at("pairs").at(name));
+      c.pair_overrides[key] = ct.at("pairs").at(name).get<PairOverride>();
   c.threads = s.at("threads");
   return c;
 }
