@@ -114,7 +114,9 @@ class Statement {
   Statement& bind(int idx, const std::string& v) { return bind(idx, std::string_view(v)); }
   Statement& bind_null(int idx);
   template <class T>
-  Statement& bind(const char* name, const T& v) { return bind(index_of(name), v); }
+  Statement& bind(const char* name, const T& v) {
+    return bind(index_of(name), v);
+  }
   [[nodiscard]] int index_of(const char* name) const;
 
   /// Advances to the next row; false when done. Throws DbError on failure.

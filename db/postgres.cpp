@@ -64,10 +64,20 @@ class PgCursor final : public detail::Cursor {
   [[nodiscard]] ColumnType column_type(int i) const override {
     if (PQgetisnull(result_.get(), row_, i)) return ColumnType::null;
     switch (PQftype(result_.get(), i)) {
-      case kBoolOid: case kInt8Oid: case kInt2Oid: case kInt4Oid: case kOidOid: return ColumnType::integer;
-      case kFloat4Oid: case kFloat8Oid: case kNumericOid: return ColumnType::real;
-      case kByteaOid: return ColumnType::blob;
-      default: return ColumnType::text;
+      case kBoolOid:
+      case kInt8Oid:
+      case kInt2Oid:
+      case kInt4Oid:
+      case kOidOid:
+        return ColumnType::integer;
+      case kFloat4Oid:
+      case kFloat8Oid:
+      case kNumericOid:
+        return ColumnType::real;
+      case kByteaOid:
+        return ColumnType::blob;
+      default:
+        return ColumnType::text;
     }
   }
   [[nodiscard]] std::int64_t get_int(int i) const override {
@@ -102,7 +112,8 @@ class PgCursor final : public detail::Cursor {
 
   void slot(int idx) {
     if (idx < 1 || idx > static_cast<int>(values_.size()))
-      throw DbError(fmt::format("SQL parameter {} out of range 1..{} in: {}", idx, values_.size(), sql_.substr(0, 200)));
+      throw DbError(
+          fmt::format("SQL parameter {} out of range 1..{} in: {}", idx, values_.size(), sql_.substr(0, 200)));
   }
   void set(int idx, std::string v, Oid type) {
     slot(idx);
@@ -146,8 +157,8 @@ class PgConnection final : public detail::Connection {
   }
 
   /// Runs one statement with its parameters; throws DbError naming the server's message.
-  Result run(const std::string& sql, const std::string& translated, const std::vector<std::optional<std::string>>& values,
-             const std::vector<Oid>& types) {
+  Result run(const std::string& sql, const std::string& translated,
+             const std::vector<std::optional<std::string>>& values, const std::vector<Oid>& types) {
     std::vector<const char*> ptrs(values.size());
     for (std::size_t i = 0; i < values.size(); ++i) ptrs[i] = values[i] ? values[i]->c_str() : nullptr;
     Result r(PQexecParams(conn_.get(), translated.c_str(), static_cast<int>(values.size()), types.data(), ptrs.data(),
@@ -174,9 +185,9 @@ class PgConnection final : public detail::Connection {
     if (st == PGRES_COMMAND_OK || st == PGRES_TUPLES_OK || st == PGRES_EMPTY_QUERY) return;
     const char* state = r ? PQresultErrorField(r, PG_DIAG_SQLSTATE) : nullptr;
     const std::string msg = trimmed(r ? PQresultErrorMessage(r) : PQerrorMessage(conn_.get()));
-    throw DbError(fmt::format("database '{}': {} [SQLSTATE {}] (in: {})", url_, msg, state ? state : "none",
-                              sql.substr(0, 200)),
-                  retryable(state) ? DbError::Kind::busy : DbError::Kind::other);
+    throw DbError(
+        fmt::format("database '{}': {} [SQLSTATE {}] (in: {})", url_, msg, state ? state : "none", sql.substr(0, 200)),
+        retryable(state) ? DbError::Kind::busy : DbError::Kind::other);
   }
 };
 
@@ -230,7 +241,8 @@ std::string translate_parameters(std::string_view sql, std::map<std::string, int
     } else if (c == ':' && i + 1 < sql.size() && sql[i + 1] == ':') {  // a cast
       out += "::";
       ++i;
-    } else if (c == ':' && i + 1 < sql.size() && (std::isalpha(static_cast<unsigned char>(sql[i + 1])) || sql[i + 1] == '_') &&
+    } else if (c == ':' && i + 1 < sql.size() &&
+               (std::isalpha(static_cast<unsigned char>(sql[i + 1])) || sql[i + 1] == '_') &&
                (i == 0 || !is_ident(sql[i - 1]))) {
       std::size_t j = i + 1;
       while (j < sql.size() && is_ident(sql[j])) ++j;

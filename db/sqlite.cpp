@@ -20,9 +20,9 @@ class SqliteCursor final : public detail::Cursor {
   SqliteCursor(sqlite3* db, const std::string& path, std::string_view sql) : db_(db), path_(path), sql_(sql) {
     const int rc = sqlite3_prepare_v2(db_, sql_.c_str(), static_cast<int>(sql_.size()), &stmt_, nullptr);
     if (rc != SQLITE_OK)
-      throw DbError(fmt::format("database '{}': cannot prepare: {} (in: {})", path_, sqlite3_errmsg(db_),
-                                sql_.substr(0, 200)),
-                    kind_of(rc));
+      throw DbError(
+          fmt::format("database '{}': cannot prepare: {} (in: {})", path_, sqlite3_errmsg(db_), sql_.substr(0, 200)),
+          kind_of(rc));
   }
   ~SqliteCursor() override { sqlite3_finalize(stmt_); }
   SqliteCursor(const SqliteCursor&) = delete;
@@ -55,11 +55,16 @@ class SqliteCursor final : public detail::Cursor {
   [[nodiscard]] std::string column_name(int i) const override { return sqlite3_column_name(stmt_, i); }
   [[nodiscard]] ColumnType column_type(int i) const override {
     switch (sqlite3_column_type(stmt_, i)) {
-      case SQLITE_INTEGER: return ColumnType::integer;
-      case SQLITE_FLOAT: return ColumnType::real;
-      case SQLITE_TEXT: return ColumnType::text;
-      case SQLITE_BLOB: return ColumnType::blob;
-      default: return ColumnType::null;
+      case SQLITE_INTEGER:
+        return ColumnType::integer;
+      case SQLITE_FLOAT:
+        return ColumnType::real;
+      case SQLITE_TEXT:
+        return ColumnType::text;
+      case SQLITE_BLOB:
+        return ColumnType::blob;
+      default:
+        return ColumnType::null;
     }
   }
   [[nodiscard]] std::int64_t get_int(int i) const override { return sqlite3_column_int64(stmt_, i); }
@@ -77,9 +82,9 @@ class SqliteCursor final : public detail::Cursor {
   std::string sql_;
   void check(int rc) const {
     if (rc != SQLITE_OK)
-      throw DbError(fmt::format("database '{}': bind failed: {} (in: {})", path_, sqlite3_errmsg(db_),
-                                sql_.substr(0, 200)),
-                    kind_of(rc));
+      throw DbError(
+          fmt::format("database '{}': bind failed: {} (in: {})", path_, sqlite3_errmsg(db_), sql_.substr(0, 200)),
+          kind_of(rc));
   }
 };
 

@@ -16,15 +16,23 @@ namespace {
 
 std::string type_name(const json& v) {
   switch (v.type()) {
-    case json::value_t::null: return "null";
-    case json::value_t::boolean: return "boolean";
+    case json::value_t::null:
+      return "null";
+    case json::value_t::boolean:
+      return "boolean";
     case json::value_t::number_integer:
-    case json::value_t::number_unsigned: return "integer";
-    case json::value_t::number_float: return "number";
-    case json::value_t::string: return "string";
-    case json::value_t::array: return "array";
-    case json::value_t::object: return "object";
-    default: return "value";
+    case json::value_t::number_unsigned:
+      return "integer";
+    case json::value_t::number_float:
+      return "number";
+    case json::value_t::string:
+      return "string";
+    case json::value_t::array:
+      return "array";
+    case json::value_t::object:
+      return "object";
+    default:
+      return "value";
   }
 }
 
@@ -36,11 +44,31 @@ std::string joined(const std::vector<std::string>& items, const char* separator 
 
 /// The keywords this validator implements (json_schema.h); anything else in a schema is refused.
 const std::set<std::string>& known_keywords() {
-  static const std::set<std::string> k = {
-      "$schema", "$id",     "$ref",     "$defs",     "title",       "description", "examples",
-      "default", "type",    "enum",     "not",       "oneOf",       "properties",  "additionalProperties",
-      "required", "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum", "minLength", "maxLength",
-      "pattern", "items",   "minItems", "uniqueItems"};
+  static const std::set<std::string> k = {"$schema",
+                                          "$id",
+                                          "$ref",
+                                          "$defs",
+                                          "title",
+                                          "description",
+                                          "examples",
+                                          "default",
+                                          "type",
+                                          "enum",
+                                          "not",
+                                          "oneOf",
+                                          "properties",
+                                          "additionalProperties",
+                                          "required",
+                                          "minimum",
+                                          "maximum",
+                                          "exclusiveMinimum",
+                                          "exclusiveMaximum",
+                                          "minLength",
+                                          "maxLength",
+                                          "pattern",
+                                          "items",
+                                          "minItems",
+                                          "uniqueItems"};
   return k;
 }
 
@@ -50,8 +78,8 @@ void check_keywords(const json& s, const std::string& where) {
   if (!s.is_object()) return;
   for (auto it = s.begin(); it != s.end(); ++it) {
     if (!known_keywords().count(it.key()))
-      throw std::logic_error(fmt::format("schema: keyword '{}' at '{}' is not supported by spec/json_schema.cpp",
-                                         it.key(), where));
+      throw std::logic_error(
+          fmt::format("schema: keyword '{}' at '{}' is not supported by spec/json_schema.cpp", it.key(), where));
     const std::string at = pointer_child(where, it.key());
     if (it.key() == "properties" || it.key() == "$defs") {
       for (auto p = it->begin(); p != it->end(); ++p) check_keywords(p.value(), pointer_child(at, p.key()));
@@ -109,7 +137,8 @@ std::string sweep_problems_message(const std::string& file, const std::vector<Sp
 }  // namespace
 
 SpecError::SpecError(std::string source, std::string pointer, std::string found, std::string expected)
-    : SpecError(std::move(source), std::vector<SpecProblem>{{std::move(pointer), std::move(found), std::move(expected)}}) {}
+    : SpecError(std::move(source),
+                std::vector<SpecProblem>{{std::move(pointer), std::move(found), std::move(expected)}}) {}
 
 SpecError::SpecError(std::string source, std::vector<SpecProblem> problems)
     // Braces: the message is made before the arguments are moved (left to right).
@@ -184,15 +213,19 @@ bool SchemaValidator::check_type(json& node, const json& s, const std::string& p
   if (s.contains("type")) {
     const std::string type = s["type"].get<std::string>();
     bool ok = false;
-    if (type == "object") ok = node.is_object();
-    else if (type == "number") ok = node.is_number();
+    if (type == "object")
+      ok = node.is_object();
+    else if (type == "number")
+      ok = node.is_number();
     else if (type == "integer")
-      ok = node.is_number_integer() ||
-           (node.is_number_float() && std::isfinite(node.get<double>()) &&
-            std::floor(node.get<double>()) == node.get<double>());
-    else if (type == "string") ok = node.is_string();
-    else if (type == "boolean") ok = node.is_boolean();
-    else if (type == "array") ok = node.is_array();
+      ok = node.is_number_integer() || (node.is_number_float() && std::isfinite(node.get<double>()) &&
+                                        std::floor(node.get<double>()) == node.get<double>());
+    else if (type == "string")
+      ok = node.is_string();
+    else if (type == "boolean")
+      ok = node.is_boolean();
+    else if (type == "array")
+      ok = node.is_array();
     if (!ok) {
       // (the document's own description is its schema's title text, too long for a message)
       problems.push_back({ptr, shown_value(node), ptr.empty() ? type_phrase(type) : described(s, type_phrase(type))});
@@ -254,11 +287,13 @@ void SchemaValidator::check_string(const json& node, const json& s, const std::s
                                    std::vector<SpecProblem>& problems) const {
   const auto& text = node.get_ref<const std::string&>();
   if (s.contains("minLength") && text.size() < s["minLength"].get<std::size_t>())
-    problems.push_back({ptr, shown_value(node), described(s, fmt::format("a string of at least {} characters",
-                                                                           s["minLength"].get<std::size_t>()))});
+    problems.push_back(
+        {ptr, shown_value(node),
+         described(s, fmt::format("a string of at least {} characters", s["minLength"].get<std::size_t>()))});
   if (s.contains("maxLength") && text.size() > s["maxLength"].get<std::size_t>())
-    problems.push_back({ptr, shown_value(node), described(s, fmt::format("a string of at most {} characters",
-                                                                           s["maxLength"].get<std::size_t>()))});
+    problems.push_back(
+        {ptr, shown_value(node),
+         described(s, fmt::format("a string of at most {} characters", s["maxLength"].get<std::size_t>()))});
   if (s.contains("pattern")) {
     const std::string pattern = s["pattern"].get<std::string>();
     constexpr std::size_t kShownPatternChars = 40;  // a longer pattern is left to the description
@@ -274,9 +309,9 @@ void SchemaValidator::check_array(json& node, const json& s, const std::string& 
                                   std::vector<SpecProblem>& problems) const {
   if (s.contains("minItems") && node.size() < s["minItems"].get<std::size_t>()) {
     const auto n = s["minItems"].get<std::size_t>();
-    problems.push_back({ptr, shown_value(node),
-                        described(s, n == 1 ? std::string("a non-empty array")
-                                            : fmt::format("an array of at least {} items", n))});
+    problems.push_back(
+        {ptr, shown_value(node),
+         described(s, n == 1 ? std::string("a non-empty array") : fmt::format("an array of at least {} items", n))});
   }
   if (s.contains("items"))
     for (std::size_t i = 0; i < node.size(); ++i) check(node[i], s["items"], ptr + "/" + std::to_string(i), problems);
@@ -297,15 +332,16 @@ void SchemaValidator::check_object(json& node, const json& s, const std::string&
     for (auto p = props.begin(); p != props.end(); ++p) known.push_back(p.key());
     for (auto it = node.begin(); it != node.end(); ++it)
       if (!props.contains(it.key()))
-        problems.push_back({pointer_child(ptr, it.key()), fmt::format("unknown key \"{}\"", it.key()),
-                            "one of: " + joined(known)});
+        problems.push_back(
+            {pointer_child(ptr, it.key()), fmt::format("unknown key \"{}\"", it.key()), "one of: " + joined(known)});
   }
   if (s.contains("required"))
     for (const auto& r : s["required"]) {
       const std::string key = r.get<std::string>();
       if (!node.contains(key)) {
         const json field = props.contains(key) ? resolve(props[key]) : json::object();
-        problems.push_back({pointer_child(ptr, key), "nothing (missing)", described(field, "a value: the field is required")});
+        problems.push_back(
+            {pointer_child(ptr, key), "nothing (missing)", described(field, "a value: the field is required")});
       }
     }
   for (auto p = props.begin(); p != props.end(); ++p) {
@@ -350,8 +386,8 @@ void SchemaValidator::check_one_of(json& node, const json& s, const std::string&
     if (node.is_object())
       for (const auto& f : field_names)
         if (node.contains(f.substr(1, f.size() - 2))) present.push_back(f);
-    const std::string what = present.empty() ? "none of " + joined(field_names, "/")
-                                             : "more than one of " + joined(present, "/");
+    const std::string what =
+        present.empty() ? "none of " + joined(field_names, "/") : "more than one of " + joined(present, "/");
     problems.push_back({ptr, what, described(s, "exactly one of " + joined(field_names, " or "))});
     return;
   }

@@ -11,24 +11,24 @@
 namespace gravsweep {
 
 struct ContactGeometry {
-  Vec3 n;                 ///< unit normal, body 1 -> body 2
-  double overlap_m;       ///< delta_n > 0 while touching
-  double distance_m;      ///< centre distance (wall: centre-to-surface distance)
-  double r1_m, r2_m;      ///< radii (r2 unused for walls)
-  double R_eff_m;         ///< effective radius R* (wall: R, or R Rc/(Rc-R) on a concave cylinder)
-  double m_eff_kg;        ///< effective mass m* (wall: the particle's mass, wall of infinite mass)
-  Vec3 v1, v2;            ///< centre velocities used for forces (wall: v2 = 0)
-  Vec3 w1, w2;            ///< angular velocities (wall: w2 = 0)
-  bool wall;              ///< body 2 is a fixed wall
+  Vec3 n;             ///< unit normal, body 1 -> body 2
+  double overlap_m;   ///< delta_n > 0 while touching
+  double distance_m;  ///< centre distance (wall: centre-to-surface distance)
+  double r1_m, r2_m;  ///< radii (r2 unused for walls)
+  double R_eff_m;     ///< effective radius R* (wall: R, or R Rc/(Rc-R) on a concave cylinder)
+  double m_eff_kg;    ///< effective mass m* (wall: the particle's mass, wall of infinite mass)
+  Vec3 v1, v2;        ///< centre velocities used for forces (wall: v2 = 0)
+  Vec3 w1, w2;        ///< angular velocities (wall: w2 = 0)
+  bool wall;          ///< body 2 is a fixed wall
 };
 
 /// Per-contact state that survives from step to step (and across neighbour-list rebuilds): the
 /// part every law and model uses, 48 bytes, stored for every listed pair.
 struct ContactHistory {
-  Vec3 shear_m = Vec3::Zero();     ///< tangential spring (Chrono delta_t / pkdgrav S)
-  double duration_s = 0;           ///< time since first touch (Chrono contact_duration)
-  double gate_s = 0;               ///< Chrono's rolling/spinning activation time t_collision
-  bool active = false;             ///< false: no history yet (new contact)
+  Vec3 shear_m = Vec3::Zero();  ///< tangential spring (Chrono delta_t / pkdgrav S)
+  double duration_s = 0;        ///< time since first touch (Chrono contact_duration)
+  double gate_s = 0;            ///< Chrono's rolling/spinning activation time t_collision
+  bool active = false;          ///< false: no history yet (new contact)
 };
 
 /// The history of the rotating contact frame (pkdgrav's n_old and Zhang's rolling and twisting
@@ -36,9 +36,9 @@ struct ContactHistory {
 /// `uses_frame_history` (hooke, zhang); the others get a scratch record that nothing reads.
 /// The force loop resets it together with a new contact's ContactHistory.
 struct FrameHistory {
-  Vec3 n_old = Vec3::Zero();       ///< normal of the previous step (pkdgrav frame rotation)
-  Vec3 roll_rad = Vec3::Zero();    ///< rolling spring angle phi_R (Zhang 2017)
-  double twist_rad = 0;            ///< twisting spring angle phi_Q (Zhang 2017)
+  Vec3 n_old = Vec3::Zero();     ///< normal of the previous step (pkdgrav frame rotation)
+  Vec3 roll_rad = Vec3::Zero();  ///< rolling spring angle phi_R (Zhang 2017)
+  double twist_rad = 0;          ///< twisting spring angle phi_Q (Zhang 2017)
 };
 
 /// Law-wide switches, shared by all pairs.
@@ -54,11 +54,11 @@ struct ContactForce {
   Vec3 force_on_2 = Vec3::Zero();  ///< body 1 receives the opposite
   Vec3 torque_1 = Vec3::Zero();
   Vec3 torque_2 = Vec3::Zero();
-  double normal_force_N = 0;       ///< signed damped normal force (> 0 repulsive)
-  double kn_N_m = 0, kt_N_m = 0;   ///< instantaneous stiffnesses
-  double cn_N_s_m = 0, ct_N_s_m = 0;  ///< instantaneous damping coefficients
-  Vec3 u_contact = Vec3::Zero();   ///< relative contact-point velocity (2 minus 1)
-  double lever1_m = 0, lever2_m = 0;  ///< distances from centres to the contact plane
+  double normal_force_N = 0;               ///< signed damped normal force (> 0 repulsive)
+  double kn_N_m = 0, kt_N_m = 0;           ///< instantaneous stiffnesses
+  double cn_N_s_m = 0, ct_N_s_m = 0;       ///< instantaneous damping coefficients
+  Vec3 u_contact = Vec3::Zero();           ///< relative contact-point velocity (2 minus 1)
+  double lever1_m = 0, lever2_m = 0;       ///< distances from centres to the contact plane
   Quat frame_rotation = Quat::Identity();  ///< rotation of the contact frame this step
 };
 

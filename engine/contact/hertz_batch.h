@@ -25,9 +25,8 @@ namespace gravsweep {
 
 /// True for the (law, rolling) pairs HertzBatch evaluates.
 template <class Law, class Rolling>
-inline constexpr bool kHasHertzBatch =
-    std::is_same_v<Law, HertzChrono> &&
-    (std::is_same_v<Rolling, RollingSunday> || std::is_same_v<Rolling, RollingNone>);
+inline constexpr bool kHasHertzBatch = std::is_same_v<Law, HertzChrono> &&
+                                       (std::is_same_v<Rolling, RollingSunday> || std::is_same_v<Rolling, RollingNone>);
 
 struct HertzBatch {
   static constexpr int kSize = 64;  ///< contacts per batch (about 30 KB: stays in L1)
@@ -60,10 +59,9 @@ struct HertzBatch {
   }
 
   /// Appends one touching pair; h is its history (a new contact when !h.active).
-  GRAVSWEEP_INLINE void add(std::uint32_t kk, std::uint32_t ii, std::uint32_t jj, const Vec3& d, double d2,
-                            double ri, double rj, double meff, const Vec3& vi, const Vec3& vj,
-                            const Vec3& wi, const Vec3& wj, const PairCoefficients& pc,
-                            const ContactHistory& h) {
+  GRAVSWEEP_INLINE void add(std::uint32_t kk, std::uint32_t ii, std::uint32_t jj, const Vec3& d, double d2, double ri,
+                            double rj, double meff, const Vec3& vi, const Vec3& vj, const Vec3& wi, const Vec3& wj,
+                            const PairCoefficients& pc, const ContactHistory& h) {
     const int b = count++;
     k[b] = kk;
     i[b] = ii;

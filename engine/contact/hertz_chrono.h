@@ -56,16 +56,15 @@ struct HertzChrono {
       const Material& mat = s.materials[m];
       const double limit = kMaxDtOverRayleigh * rayleigh_time_s(mat, s.min_radius_m[m]);
       if (s.dt_s > limit)
-        throw ConfigError(fmt::format(
-            "contact law 'hertz': dt = {:.3g} s exceeds the stability bound {:.3g} s "
-            "(0.3 x Rayleigh time of material '{}' at radius {:.3g} m)",
-            s.dt_s, limit, mat.name, s.min_radius_m[m]));
+        throw ConfigError(
+            fmt::format("contact law 'hertz': dt = {:.3g} s exceeds the stability bound {:.3g} s "
+                        "(0.3 x Rayleigh time of material '{}' at radius {:.3g} m)",
+                        s.dt_s, limit, mat.name, s.min_radius_m[m]));
     }
   }
 
-  GRAVSWEEP_INLINE static void evaluate(const ContactGeometry& g, const PairCoefficients& c,
-                       const ContactOptions& opt, ContactHistory& h, FrameHistory& /*fh*/, double dt_s,
-                       ContactForce& out) {
+  GRAVSWEEP_INLINE static void evaluate(const ContactGeometry& g, const PairCoefficients& c, const ContactOptions& opt,
+                                        ContactHistory& h, FrameHistory& /*fh*/, double dt_s, ContactForce& out) {
     const Vec3& n = g.n;
     const double delta = g.overlap_m;
     // Contact points on each surface with full-radius levers (ChNarrowphasePRIMS sphere_sphere).

@@ -56,23 +56,22 @@ struct HookePkdgrav {
         const PairCoefficients& c = s.pairs(a, b);
         const std::string label = s.materials[a].name + "-" + s.materials[b].name;
         if (!(c.kn_N_m > 0))
-          throw ConfigError(fmt::format(
-              "contact law 'hooke': kn_N_m = {} for pair {}; expected a spring constant > 0",
-              c.kn_N_m, label));
+          throw ConfigError(fmt::format("contact law 'hooke': kn_N_m = {} for pair {}; expected a spring constant > 0",
+                                        c.kn_N_m, label));
         if (!s.check_time_step) continue;
         const double m_eff = std::isinf(ma) ? mb : std::isinf(mb) ? ma : ma * mb / (ma + mb);
         const double limit = contact_time_s(c.kn_N_m, m_eff, c.cor_normal) / kMinStepsPerContact;
         if (s.dt_s > limit)
-          throw ConfigError(fmt::format(
-              "contact law 'hooke': dt = {:.3g} s exceeds the stability bound {:.3g} s "
-              "(contact time / {} for pair {})",
-              s.dt_s, limit, kMinStepsPerContact, label));
+          throw ConfigError(
+              fmt::format("contact law 'hooke': dt = {:.3g} s exceeds the stability bound {:.3g} s "
+                          "(contact time / {} for pair {})",
+                          s.dt_s, limit, kMinStepsPerContact, label));
       }
   }
 
   GRAVSWEEP_INLINE static void evaluate(const ContactGeometry& g, const PairCoefficients& c,
-                       const ContactOptions& /*opt*/, ContactHistory& h, FrameHistory& fh, double dt_s,
-                       ContactForce& out) {
+                                        const ContactOptions& /*opt*/, ContactHistory& h, FrameHistory& fh, double dt_s,
+                                        ContactForce& out) {
     const Vec3& n = g.n;
     // Lever arms to the contact plane (2.1); a wall is a sphere of infinite radius.
     double l1, l2;

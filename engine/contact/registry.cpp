@@ -31,8 +31,7 @@ std::vector<std::string> names_of() {
 template <class Tuple>
 std::string description_of(const std::string& name) {
   std::string d;
-  std::apply([&](auto... e) { ((name == decltype(e)::name ? (d = decltype(e)::description, 0) : 0), ...); },
-             Tuple{});
+  std::apply([&](auto... e) { ((name == decltype(e)::name ? (d = decltype(e)::description, 0) : 0), ...); }, Tuple{});
   return d;
 }
 
@@ -45,9 +44,8 @@ std::string join(const std::vector<std::string>& v) {
 template <class Law>
 ForceFunction with_rolling(std::string_view rolling) {
   ForceFunction f = nullptr;
-  std::apply([&](auto... r) {
-    ((rolling == decltype(r)::name ? (f = &force_loop<Law, decltype(r)>, 0) : 0), ...);
-  }, RollingModels{});
+  std::apply([&](auto... r) { ((rolling == decltype(r)::name ? (f = &force_loop<Law, decltype(r)>, 0) : 0), ...); },
+             RollingModels{});
   return f;
 }
 
@@ -61,15 +59,16 @@ std::string rolling_model_description(const std::string& n) { return description
 ForceFunction select_force_function(std::string_view law, std::string_view rolling) {
   ForceFunction f = nullptr;
   bool law_found = false;
-  std::apply([&](auto... l) {
-    ((law == decltype(l)::name ? (law_found = true, f = with_rolling<decltype(l)>(rolling), 0) : 0), ...);
-  }, ContactLaws{});
+  std::apply(
+      [&](auto... l) {
+        ((law == decltype(l)::name ? (law_found = true, f = with_rolling<decltype(l)>(rolling), 0) : 0), ...);
+      },
+      ContactLaws{});
   if (!law_found)
-    throw ConfigError(fmt::format("unknown contact law '{}'; valid contact laws: {}", law,
-                                  join(contact_law_names())));
+    throw ConfigError(fmt::format("unknown contact law '{}'; valid contact laws: {}", law, join(contact_law_names())));
   if (f == nullptr)
-    throw ConfigError(fmt::format("unknown rolling model '{}'; valid rolling models: {}", rolling,
-                                  join(rolling_model_names())));
+    throw ConfigError(
+        fmt::format("unknown rolling model '{}'; valid rolling models: {}", rolling, join(rolling_model_names())));
   return f;
 }
 
@@ -77,25 +76,27 @@ bool uses_frame_history(std::string_view law, std::string_view rolling) {
   bool uses = false;
   std::apply([&](auto... l) { ((law == decltype(l)::name ? (uses |= decltype(l)::uses_frame_history, 0) : 0), ...); },
              ContactLaws{});
-  std::apply([&](auto... r) { ((rolling == decltype(r)::name ? (uses |= decltype(r)::uses_frame_history, 0) : 0), ...); },
-             RollingModels{});
+  std::apply(
+      [&](auto... r) { ((rolling == decltype(r)::name ? (uses |= decltype(r)::uses_frame_history, 0) : 0), ...); },
+      RollingModels{});
   return uses;
 }
 
 void prepare_contact_law(std::string_view law, PairTable& pairs) {
-  std::apply([&](auto... l) {
-    ((law == decltype(l)::name ? (pairs.for_each([](PairCoefficients& c) { decltype(l)::prepare(c); }), 0) : 0), ...);
-  }, ContactLaws{});
+  std::apply(
+      [&](auto... l) {
+        ((law == decltype(l)::name ? (pairs.for_each([](PairCoefficients& c) { decltype(l)::prepare(c); }), 0) : 0),
+         ...);
+      },
+      ContactLaws{});
 }
 
 void check_contact_law(std::string_view law, const LawSetup& setup) {
   bool found = false;
-  std::apply([&](auto... l) {
-    ((law == decltype(l)::name ? (found = true, decltype(l)::check(setup), 0) : 0), ...);
-  }, ContactLaws{});
+  std::apply([&](auto... l) { ((law == decltype(l)::name ? (found = true, decltype(l)::check(setup), 0) : 0), ...); },
+             ContactLaws{});
   if (!found)
-    throw ConfigError(fmt::format("unknown contact law '{}'; valid contact laws: {}", law,
-                                  join(contact_law_names())));
+    throw ConfigError(fmt::format("unknown contact law '{}'; valid contact laws: {}", law, join(contact_law_names())));
 }
 
 }  // namespace gravsweep

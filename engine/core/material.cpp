@@ -9,8 +9,7 @@
 
 namespace gravsweep {
 
-PairCoefficients compose_pair(const Material& a, const Material& b,
-                              const PairOverride* ov) {
+PairCoefficients compose_pair(const Material& a, const Material& b, const PairOverride* ov) {
   PairCoefficients c;
   // Hertz composition of elastic moduli (Chrono ChContactMaterialCompositeSMC, dem-physics.md 1.2).
   const double inv_E = (1 - a.poisson_ratio * a.poisson_ratio) / a.young_modulus_Pa +
@@ -49,16 +48,13 @@ PairCoefficients compose_pair(const Material& a, const Material& b,
 
 void validate_material(const Material& m) {
   auto fail = [&](const char* field, double value, const char* expected) {
-    throw ConfigError(fmt::format("material '{}': {} = {} is invalid; expected {}", m.name, field,
-                                  value, expected));
+    throw ConfigError(fmt::format("material '{}': {} = {} is invalid; expected {}", m.name, field, value, expected));
   };
   if (!(m.young_modulus_Pa > 0)) fail("young_modulus_Pa", m.young_modulus_Pa, "E > 0");
-  if (!(m.poisson_ratio > 0 && m.poisson_ratio < 0.5))
-    fail("poisson_ratio", m.poisson_ratio, "nu in (0, 0.5)");
+  if (!(m.poisson_ratio > 0 && m.poisson_ratio < 0.5)) fail("poisson_ratio", m.poisson_ratio, "nu in (0, 0.5)");
   if (!(m.density_kg_m3 > 0)) fail("density_kg_m3", m.density_kg_m3, "> 0");
   if (!(m.cor_normal > 0 && m.cor_normal <= 1)) fail("cor_normal", m.cor_normal, "COR in (0, 1]");
-  if (!(m.cor_tangential > 0 && m.cor_tangential <= 1))
-    fail("cor_tangential", m.cor_tangential, "COR in (0, 1]");
+  if (!(m.cor_tangential > 0 && m.cor_tangential <= 1)) fail("cor_tangential", m.cor_tangential, "COR in (0, 1]");
   if (!(m.mu_static >= 0)) fail("mu_static", m.mu_static, ">= 0");
   if (!(m.mu_rolling >= 0)) fail("mu_rolling", m.mu_rolling, ">= 0");
   if (!(m.mu_twisting >= 0)) fail("mu_twisting", m.mu_twisting, ">= 0");

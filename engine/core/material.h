@@ -19,31 +19,30 @@ struct Material {
   double young_modulus_Pa = 7.0e8;  ///< E (Hertz law)
   double poisson_ratio = 0.24;      ///< nu in (0, 0.5)
   double density_kg_m3 = 2480.0;
-  double cor_normal = 0.9;          ///< normal coefficient of restitution, (0, 1]
-  double cor_tangential = 1.0;      ///< pkdgrav eps_t, (0, 1]
-  double mu_static = 0.16;          ///< sliding (Coulomb) friction
-  double mu_rolling = 0.0;          ///< rolling friction (Chrono: lever fraction; pkdgrav: mu_r)
-  double mu_twisting = 0.0;         ///< twisting / spinning friction
-  double kn_N_m = 0.0;              ///< pkdgrav normal spring constant (Hooke law)
-  double kt_N_m = 0.0;              ///< pkdgrav tangential spring; 0 means 2/7 kn (pkdgrav default)
-  double shape_beta = 0.05;         ///< pkdgrav/Zhang 2017 shape parameter beta
+  double cor_normal = 0.9;      ///< normal coefficient of restitution, (0, 1]
+  double cor_tangential = 1.0;  ///< pkdgrav eps_t, (0, 1]
+  double mu_static = 0.16;      ///< sliding (Coulomb) friction
+  double mu_rolling = 0.0;      ///< rolling friction (Chrono: lever fraction; pkdgrav: mu_r)
+  double mu_twisting = 0.0;     ///< twisting / spinning friction
+  double kn_N_m = 0.0;          ///< pkdgrav normal spring constant (Hooke law)
+  double kt_N_m = 0.0;          ///< pkdgrav tangential spring; 0 means 2/7 kn (pkdgrav default)
+  double shape_beta = 0.05;     ///< pkdgrav/Zhang 2017 shape parameter beta
 };
 
 /// Restitution and friction for one pair type, used by explicit_pair composition. Unset fields
 /// fall back to the chrono_min value.
 struct PairOverride {
-  std::optional<double> cor_normal, cor_tangential, mu_static, mu_rolling, mu_twisting, kn_N_m,
-      kt_N_m, shape_beta;
+  std::optional<double> cor_normal, cor_tangential, mu_static, mu_rolling, mu_twisting, kn_N_m, kt_N_m, shape_beta;
 };
 
 enum class Composition { explicit_pair, chrono_min };
 
 /// Coefficients of one contact between materials a and b; symmetric in (a, b).
 struct PairCoefficients {
-  double E_eff_Pa = 0;      ///< 1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2 (Chrono, dem-physics.md 1.2)
-  double G_eff_Pa = 0;      ///< 1/G* = 2(2-nu1)(1+nu1)/E1 + 2(2-nu2)(1+nu2)/E2
-  double kn_N_m = 0;        ///< Hooke normal stiffness
-  double kt_N_m = 0;        ///< Hooke tangential stiffness
+  double E_eff_Pa = 0;  ///< 1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2 (Chrono, dem-physics.md 1.2)
+  double G_eff_Pa = 0;  ///< 1/G* = 2(2-nu1)(1+nu1)/E1 + 2(2-nu2)(1+nu2)/E2
+  double kn_N_m = 0;    ///< Hooke normal stiffness
+  double kt_N_m = 0;    ///< Hooke tangential stiffness
   double cor_normal = 1;
   double cor_tangential = 1;
   double mu_static = 0;
@@ -65,9 +64,7 @@ class PairTable {
  public:
   PairTable() = default;
   explicit PairTable(std::size_t n_materials) : n_(n_materials), table_(n_materials * n_materials) {}
-  [[nodiscard]] const PairCoefficients& operator()(std::size_t a, std::size_t b) const {
-    return table_[a * n_ + b];
-  }
+  [[nodiscard]] const PairCoefficients& operator()(std::size_t a, std::size_t b) const { return table_[a * n_ + b]; }
   void set(std::size_t a, std::size_t b, const PairCoefficients& c) {
     table_[a * n_ + b] = c;
     table_[b * n_ + a] = c;
@@ -86,8 +83,7 @@ class PairTable {
 
 /// Builds the coefficients of a pair: moduli by the Hertz composition formulas, the rest by
 /// Chrono's min() strategy, then any explicit override applied on top.
-PairCoefficients compose_pair(const Material& a, const Material& b,
-                              const PairOverride* override_or_null);
+PairCoefficients compose_pair(const Material& a, const Material& b, const PairOverride* override_or_null);
 
 /// Range checks of a material; throws ConfigError naming the material and the parameter.
 void validate_material(const Material& m);

@@ -27,16 +27,16 @@ struct Particles {
   // Properties.
   std::vector<double> radius_m;
   std::vector<double> mass_kg;
-  std::vector<double> inv_mass_1_kg;         ///< 0 for a fixed particle
-  std::vector<double> inv_inertia_1_kg_m2;   ///< solid sphere I = 2/5 m r^2; 0 for fixed
-  std::vector<std::uint8_t> material;        ///< index into the material table
+  std::vector<double> inv_mass_1_kg;        ///< 0 for a fixed particle
+  std::vector<double> inv_inertia_1_kg_m2;  ///< solid sphere I = 2/5 m r^2; 0 for fixed
+  std::vector<std::uint8_t> material;       ///< index into the material table
   std::vector<SizeClass> size_class;
 
   [[nodiscard]] std::size_t size() const { return position_m.size(); }
 
   /// Appends a free (or fixed) solid sphere at rest and returns its index.
-  ParticleIndex add(const Vec3& pos, double radius, double mass, std::uint8_t material_id,
-                    SizeClass cls, bool fixed = false) {
+  ParticleIndex add(const Vec3& pos, double radius, double mass, std::uint8_t material_id, SizeClass cls,
+                    bool fixed = false) {
     position_m.push_back(pos);
     velocity_m_s.push_back(Vec3::Zero());
     omega_rad_s.push_back(Vec3::Zero());

@@ -14,16 +14,15 @@ Wall Wall::plane(std::string name, const Vec3& point, const Vec3& inward_normal,
   return w;
 }
 
-Wall Wall::disk(std::string name, const Vec3& centre, const Vec3& inward_normal, double radius_m,
-                std::uint8_t mat) {
+Wall Wall::disk(std::string name, const Vec3& centre, const Vec3& inward_normal, double radius_m, std::uint8_t mat) {
   Wall w = plane(std::move(name), centre, inward_normal, mat);
   w.kind = WallKind::disk;
   w.radius_m = radius_m;
   return w;
 }
 
-Wall Wall::cylinder(std::string name, const Vec3& base, const Vec3& axis, double radius_m,
-                    double height_m, std::uint8_t mat) {
+Wall Wall::cylinder(std::string name, const Vec3& base, const Vec3& axis, double radius_m, double height_m,
+                    std::uint8_t mat) {
   Wall w;
   w.kind = WallKind::cylinder;
   w.name = std::move(name);

@@ -14,19 +14,18 @@ struct Wall {
   WallKind kind = WallKind::plane;
   std::string name;
   std::uint8_t material = 0;
-  Vec3 point_m = Vec3::Zero();   ///< plane: a point on it; disk: its centre; cylinder: base of the axis
-  Vec3 normal = Vec3::UnitZ();   ///< plane/disk: unit normal pointing into the domain; cylinder: axis
-  double radius_m = kInf;        ///< disk radius or cylinder radius
-  double height_m = kInf;        ///< cylinder extent along its axis from point_m
+  Vec3 point_m = Vec3::Zero();  ///< plane: a point on it; disk: its centre; cylinder: base of the axis
+  Vec3 normal = Vec3::UnitZ();  ///< plane/disk: unit normal pointing into the domain; cylinder: axis
+  double radius_m = kInf;       ///< disk radius or cylinder radius
+  double height_m = kInf;       ///< cylinder extent along its axis from point_m
   /// Concave cylinder: R* = R Rc / (Rc - R) (true curvature). False: flat-face R* = R, as Chrono's
   /// container built from boxes (dem-physics.md 1.1).
   bool concave_curvature = true;
 
   static Wall plane(std::string name, const Vec3& point, const Vec3& inward_normal, std::uint8_t mat);
-  static Wall disk(std::string name, const Vec3& centre, const Vec3& inward_normal, double radius_m,
-                   std::uint8_t mat);
-  static Wall cylinder(std::string name, const Vec3& base, const Vec3& axis, double radius_m,
-                       double height_m, std::uint8_t mat);
+  static Wall disk(std::string name, const Vec3& centre, const Vec3& inward_normal, double radius_m, std::uint8_t mat);
+  static Wall cylinder(std::string name, const Vec3& base, const Vec3& axis, double radius_m, double height_m,
+                       std::uint8_t mat);
 };
 
 /// Contact of a sphere with a wall.

@@ -26,16 +26,17 @@ void VerletList::clear() {
 
 void VerletList::set_frame_history(bool keep) {
   keep_frame_ = keep;
-  if (keep) frame_history.resize(history.size());
-  else frame_history.clear();
+  if (keep)
+    frame_history.resize(history.size());
+  else
+    frame_history.clear();
 }
 
 std::size_t VerletList::bytes() const {
   return offset.capacity() * sizeof(std::uint32_t) + neighbor.capacity() * sizeof(std::uint32_t) +
-         history.capacity() * sizeof(ContactHistory) +
-         frame_history.capacity() * sizeof(FrameHistory) + position_at_build_.capacity() * sizeof(Vec3) +
-         (cell_start_.capacity() + cell_particles_.capacity() + particle_cell_.capacity() +
-          count_.capacity()) *
+         history.capacity() * sizeof(ContactHistory) + frame_history.capacity() * sizeof(FrameHistory) +
+         position_at_build_.capacity() * sizeof(Vec3) +
+         (cell_start_.capacity() + cell_particles_.capacity() + particle_cell_.capacity() + count_.capacity()) *
              sizeof(std::uint32_t);
 }
 
@@ -128,11 +129,10 @@ void VerletList::build(const Particles& p, double skin_m, int threads) {
       dims[a] = std::max<long>(1, static_cast<long>((hi[a] - lo[a]) / cell) + 1);
     }
     if (static_cast<double>(dims[0]) * dims[1] * dims[2] > static_cast<double>(kMaxCells))
-      throw NumericalFailure(
-          fmt::format("neighbour list: particles spread over {:.3g} x {:.3g} x {:.3g} m, too many "
-                      "cells; a grain has probably left the container",
-                      hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]),
-          -1, -1);
+      throw NumericalFailure(fmt::format("neighbour list: particles spread over {:.3g} x {:.3g} x {:.3g} m, too many "
+                                         "cells; a grain has probably left the container",
+                                         hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]),
+                             -1, -1);
   }
   const std::size_t n_cells = static_cast<std::size_t>(dims[0] * dims[1] * dims[2]);
   auto cell_coord = [&](const Vec3& x, int a) {
@@ -143,8 +143,7 @@ void VerletList::build(const Particles& p, double skin_m, int threads) {
   cell_start_.assign(n_cells + 1, 0);
   for (std::size_t i = 0; i < n; ++i) {
     if (p.radius_m[i] > large_threshold) continue;
-    const long c = (cell_coord(p.position_m[i], 2) * dims[1] + cell_coord(p.position_m[i], 1)) *
-                       dims[0] +
+    const long c = (cell_coord(p.position_m[i], 2) * dims[1] + cell_coord(p.position_m[i], 1)) * dims[0] +
                    cell_coord(p.position_m[i], 0);
     particle_cell_[i] = static_cast<std::uint32_t>(c);
     ++cell_start_[c + 1];

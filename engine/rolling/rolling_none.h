@@ -10,7 +10,7 @@ struct RollingNone {
   /// Needs FrameHistory stored per contact (contact.h).
   static constexpr bool uses_frame_history = false;
   GRAVSWEEP_INLINE static void apply(const ContactGeometry&, const PairCoefficients&, const ContactOptions&,
-                    ContactHistory&, FrameHistory&, double, ContactForce&) {}
+                                     ContactHistory&, FrameHistory&, double, ContactForce&) {}
 };
 
 }  // namespace gravsweep

@@ -18,7 +18,7 @@ struct RollingSunday {
   static constexpr bool uses_frame_history = false;
 
   GRAVSWEEP_INLINE static void apply(const ContactGeometry& g, const PairCoefficients& c, const ContactOptions& opt,
-                    ContactHistory& h, FrameHistory& /*fh*/, double /*dt_s*/, ContactForce& out) {
+                                     ContactHistory& h, FrameHistory& /*fh*/, double /*dt_s*/, ContactForce& out) {
     if (h.duration_s <= h.gate_s) return;  // activation gate: mu_r = mu_t = 0 early in a contact
     const Vec3& n = g.n;
     const double Fn = out.normal_force_N;  // signed damped normal force

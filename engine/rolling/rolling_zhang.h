@@ -17,7 +17,7 @@ struct RollingZhang {
   static constexpr bool uses_frame_history = true;
 
   GRAVSWEEP_INLINE static void apply(const ContactGeometry& g, const PairCoefficients& c, const ContactOptions&,
-                    ContactHistory& /*h*/, FrameHistory& fh, double dt_s, ContactForce& out) {
+                                     ContactHistory& /*h*/, FrameHistory& fh, double dt_s, ContactForce& out) {
     const Vec3& n = g.n;
     const double Rbar = g.wall ? g.r1_m : g.r1_m * g.r2_m / (g.r1_m + g.r2_m);
     const double bR2 = (c.shape_beta * Rbar) * (c.shape_beta * Rbar);

@@ -13,16 +13,19 @@ namespace gravsweep {
 
 const char* to_string(BedPhase p) {
   switch (p) {
-    case BedPhase::fill: return "fill";
-    case BedPhase::settle: return "settle";
-    case BedPhase::flatten: return "flatten";
-    case BedPhase::relax: return "relax";
+    case BedPhase::fill:
+      return "fill";
+    case BedPhase::settle:
+      return "settle";
+    case BedPhase::flatten:
+      return "flatten";
+    case BedPhase::relax:
+      return "relax";
   }
   return "?";
 }
 
-void add_container_walls(System& sys, const ContainerSpec& c, double height_m,
-                         std::uint8_t wall_material) {
+void add_container_walls(System& sys, const ContainerSpec& c, double height_m, std::uint8_t wall_material) {
   const double R = 0.5 * c.diameter_m;
   sys.walls.push_back(Wall::disk("bottom", Vec3::Zero(), Vec3::UnitZ(), R, wall_material));
   sys.walls.push_back(Wall::cylinder("side", Vec3::Zero(), Vec3::UnitZ(), R, height_m, wall_material));
@@ -37,8 +40,8 @@ std::size_t place_grains(System& sys, const BedSpec& spec) {
   const double d_max = g.diameter_m + 2 * g.diameter_spread_m;
   const double grain_volume = kPi / 6 * std::pow(g.diameter_m, 3);
   const double bed_volume = kPi * R_c * R_c * spec.fill_height_m;
-  const auto target = static_cast<std::size_t>(
-      std::ceil(spec.overfill_factor * spec.packing_fraction * bed_volume / grain_volume));
+  const auto target =
+      static_cast<std::size_t>(std::ceil(spec.overfill_factor * spec.packing_fraction * bed_volume / grain_volume));
   std::mt19937_64 rng(spec.seed);
   std::uniform_real_distribution<double> uni(-1.0, 1.0);
   const double spacing = 1.04 * d_max;
@@ -87,8 +90,8 @@ void grain_speeds(const System& sys, double& rms_m_s, double& max_m_s) {
   max_m_s = std::sqrt(mx2);
 }
 
-bool settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress,
-            BedPhase phase, double* rms_out, double* max_out) {
+bool settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress, BedPhase phase,
+            double* rms_out, double* max_out) {
   const double dt = sys.config().dt_s;
   // The settling threshold of rolling friction holds for this phase only (SettleCriteria).
   struct ThresholdScope {
@@ -150,7 +153,10 @@ double surface_height(const System& sys, double container_radius_m) {
   double d = 0;
   std::size_t n = 0;
   for (std::size_t i = 0; i < p.size(); ++i)
-    if (p.size_class[i] == SizeClass::grain) { d += 2 * p.radius_m[i]; ++n; }
+    if (p.size_class[i] == SizeClass::grain) {
+      d += 2 * p.radius_m[i];
+      ++n;
+    }
   if (n == 0) return 0;
   d /= static_cast<double>(n);
   const double reach = 0.6 * container_radius_m;
@@ -169,7 +175,10 @@ double surface_height(const System& sys, double container_radius_m) {
   double sum = 0;
   std::size_t cnt = 0;
   for (double t : top)
-    if (std::isfinite(t)) { sum += t; ++cnt; }
+    if (std::isfinite(t)) {
+      sum += t;
+      ++cnt;
+    }
   return cnt > 0 ? sum / static_cast<double>(cnt) : 0.0;
 }
 
@@ -186,8 +195,8 @@ BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progr
   double top = 0;
   for (std::size_t i = 0; i < sys.particles.size(); ++i)
     top = std::max(top, sys.particles.position_m[i].z() + sys.particles.radius_m[i]);
-  const double wall_h = spec.container.wall_height_m > 0 ? spec.container.wall_height_m
-                                                         : std::max(top, spec.fill_height_m) + 0.1;
+  const double wall_h =
+      spec.container.wall_height_m > 0 ? spec.container.wall_height_m : std::max(top, spec.fill_height_m) + 0.1;
   add_container_walls(sys, spec.container, wall_h, spec.wall_material);
   sys.invalidate();
   if (progress) progress(BedPhase::fill, 1.0, fmt::format("{} grains", rep.grains_placed));
@@ -198,8 +207,7 @@ BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progr
   // Flatten: delete grains whose centre lies above the fill height.
   std::vector<bool> remove(sys.particles.size(), false);
   for (std::size_t i = 0; i < sys.particles.size(); ++i)
-    remove[i] = sys.particles.size_class[i] == SizeClass::grain &&
-                sys.particles.position_m[i].z() > spec.fill_height_m;
+    remove[i] = sys.particles.size_class[i] == SizeClass::grain && sys.particles.position_m[i].z() > spec.fill_height_m;
   sys.remove_particles(remove);
   if (progress) progress(BedPhase::flatten, 1.0, fmt::format("{} grains kept", sys.particles.size()));
   // Relax the new surface (at the drop's gravity when the bed was settled at another, reached by a
@@ -207,8 +215,9 @@ BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progr
   if (spec.relax_gravity_m_s2)
     ramp_gravity(sys, *spec.relax_gravity_m_s2, spec.gravity_ramp_s, spec.settle.check_interval_s, progress);
   const double t1 = sys.time_s();
-  met = settle(sys, spec.settle, spec.relax_time_s, progress, BedPhase::relax, &rep.rms_speed_m_s,
-               &rep.max_speed_m_s) && met;
+  met =
+      settle(sys, spec.settle, spec.relax_time_s, progress, BedPhase::relax, &rep.rms_speed_m_s, &rep.max_speed_m_s) &&
+      met;
   rep.relax_time_s = sys.time_s() - t1;
   rep.settled = met;
   rep.grains_kept = sys.particles.size();

@@ -13,13 +13,13 @@
 namespace gravsweep {
 
 struct ContainerSpec {
-  double diameter_m = 0.315;       ///< inner diameter of the cylinder (paper: 31.5 cm)
-  double wall_height_m = 0.0;      ///< 0 = as tall as the initial grain column
+  double diameter_m = 0.315;   ///< inner diameter of the cylinder (paper: 31.5 cm)
+  double wall_height_m = 0.0;  ///< 0 = as tall as the initial grain column
 };
 
 struct GrainSpec {
-  double diameter_m = 0.01;        ///< mean grain diameter (paper: 1 cm)
-  double diameter_spread_m = 5e-4; ///< uniform spread +/- (paper, Chrono: 1 +/- 0.05 cm)
+  double diameter_m = 0.01;         ///< mean grain diameter (paper: 1 cm)
+  double diameter_spread_m = 5e-4;  ///< uniform spread +/- (paper, Chrono: 1 +/- 0.05 cm)
   double density_kg_m3 = 2480.0;
 };
 
@@ -43,7 +43,7 @@ struct BedSpec {
   double packing_fraction = 0.60;  ///< assumed random packing, for the grain count
   std::uint64_t seed = 1;
   SettleCriteria settle;
-  double relax_time_s = 0.05;      ///< minimum relaxation after flattening
+  double relax_time_s = 0.05;  ///< minimum relaxation after flattening
   std::uint8_t grain_material = 0;
   std::uint8_t wall_material = 1;
   /// When set, gravity switches to this value after flattening, before the relaxation (a bed poured
@@ -68,29 +68,27 @@ struct BedReport {
   std::size_t grains_kept = 0;
   double settle_time_s = 0;
   double relax_time_s = 0;
-  bool settled = false;            ///< criteria met (false: the time cap ended a phase)
+  bool settled = false;  ///< criteria met (false: the time cap ended a phase)
   double rms_speed_m_s = 0;
   double max_speed_m_s = 0;
-  double surface_height_m = 0;     ///< mean height of the top of the grains near the axis
+  double surface_height_m = 0;  ///< mean height of the top of the grains near the axis
   double bulk_density_kg_m3 = 0;
 };
 
 /// Adds the container walls (disk bottom at z = 0, cylinder side) to the system.
-void add_container_walls(System& sys, const ContainerSpec& c, double height_m,
-                         std::uint8_t wall_material);
+void add_container_walls(System& sys, const ContainerSpec& c, double height_m, std::uint8_t wall_material);
 
 /// Places grains without overlap on a jittered lattice filling the container up to the height
 /// needed for the grain count; returns the number placed.
 std::size_t place_grains(System& sys, const BedSpec& spec);
 
 /// Runs until the grains meet the criteria or the time cap; returns true if the criteria were met.
-bool settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress,
-            BedPhase phase, double* rms_out = nullptr, double* max_out = nullptr);
+bool settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress, BedPhase phase,
+            double* rms_out = nullptr, double* max_out = nullptr);
 
 /// Takes gravity from its present value to `to_m_s2` geometrically over ramp_s (same direction; in
 /// any other case, or with ramp_s = 0, at once), advancing the system meanwhile.
-void ramp_gravity(System& sys, const Vec3& to_m_s2, double ramp_s, double interval_s,
-                  const BedProgress& progress = {});
+void ramp_gravity(System& sys, const Vec3& to_m_s2, double ramp_s, double interval_s, const BedProgress& progress = {});
 
 /// The whole preparation: walls, placement, settling, flattening, relaxation.
 BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progress = {});

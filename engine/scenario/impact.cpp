@@ -36,13 +36,11 @@ std::optional<FirstTouch> first_touch_bottom(const System& sys, double x_m, doub
   return best;
 }
 
-DropResult drop_projectile(System& sys, double surface_height_m, const ProjectileSpec& ps,
-                           const DropStop& stop, double sample_rate_hz, const DropProgress& progress,
-                           const DropSnapshots& snapshots) {
+DropResult drop_projectile(System& sys, double surface_height_m, const ProjectileSpec& ps, const DropStop& stop,
+                           double sample_rate_hz, const DropProgress& progress, const DropSnapshots& snapshots) {
   if (ps.impact_speed_m_s.has_value() == ps.drop_height_m.has_value())
     throw ConfigError("projectile: give exactly one of impact_speed_m_s and drop_height_m");
-  if (!(ps.diameter_m > 0) || !(ps.mass_kg > 0))
-    throw ConfigError("projectile: diameter_m and mass_kg must be > 0");
+  if (!(ps.diameter_m > 0) || !(ps.mass_kg > 0)) throw ConfigError("projectile: diameter_m and mass_kg must be > 0");
   if (!(sample_rate_hz > 0)) throw ConfigError("drop: sample_rate_hz must be > 0");
   const double dt = sys.config().dt_s;
   const double g = -sys.config().gravity_m_s2.z();  // > 0: downward gravity
@@ -55,30 +53,29 @@ DropResult drop_projectile(System& sys, double surface_height_m, const Projectil
   // The grain the projectile meets first, falling straight down at its lateral offset: the start
   // gap is measured from there, not from the mean surface (a grain standing proud of the mean
   // surface would otherwise be inside the projectile at release).
-  const std::optional<FirstTouch> touch =
-      first_touch_bottom(sys, ps.lateral_offset_x_m, ps.lateral_offset_y_m, R);
+  const std::optional<FirstTouch> touch = first_touch_bottom(sys, ps.lateral_offset_x_m, ps.lateral_offset_y_m, R);
   const double touch_bottom = touch ? touch->bottom_height_m : surface_height_m;
   res.first_touch_height_m = touch_bottom;
   if (ps.impact_speed_m_s) {
     const double gap = ps.start_gap_m + ps.vertical_offset_m;
     const double v2 = (*ps.impact_speed_m_s) * (*ps.impact_speed_m_s) - 2 * g * gap;
     if (v2 < 0)
-      throw ConfigError(fmt::format(
-          "projectile: impact speed {} m/s cannot be reached from a start {} m above the surface "
-          "at g = {} m/s2 (free fall alone gives more); lower start_gap_m or the vertical offset",
-          *ps.impact_speed_m_s, gap, g));
+      throw ConfigError(
+          fmt::format("projectile: impact speed {} m/s cannot be reached from a start {} m above the surface "
+                      "at g = {} m/s2 (free fall alone gives more); lower start_gap_m or the vertical offset",
+                      *ps.impact_speed_m_s, gap, g));
     v0 = std::sqrt(v2);
     bottom = touch_bottom + gap;
   } else {
     bottom = surface_height_m + *ps.drop_height_m + ps.vertical_offset_m;
   }
   if (touch && bottom < touch_bottom)
-    throw ConfigError(fmt::format(
-        "projectile: at release (bottom at z = {:.4f} m, lateral offset ({:.4f}, {:.4f}) m) it would "
-        "overlap grain {} whose top under the projectile reaches z = {:.4f} m ({:.2f} mm above the "
-        "mean surface); start it higher (drop_height_m, start_gap_m or the vertical offset)",
-        bottom, ps.lateral_offset_x_m, ps.lateral_offset_y_m, touch->grain, touch_bottom,
-        1e3 * (touch_bottom - surface_height_m)));
+    throw ConfigError(
+        fmt::format("projectile: at release (bottom at z = {:.4f} m, lateral offset ({:.4f}, {:.4f}) m) it would "
+                    "overlap grain {} whose top under the projectile reaches z = {:.4f} m ({:.2f} mm above the "
+                    "mean surface); start it higher (drop_height_m, start_gap_m or the vertical offset)",
+                    bottom, ps.lateral_offset_x_m, ps.lateral_offset_y_m, touch->grain, touch_bottom,
+                    1e3 * (touch_bottom - surface_height_m)));
   res.release_height_m = bottom;
   res.release_speed_m_s = v0;
   const Vec3 centre(ps.lateral_offset_x_m, ps.lateral_offset_y_m, bottom + R);
@@ -94,8 +91,7 @@ DropResult drop_projectile(System& sys, double surface_height_m, const Projectil
   sys.initialize();
   res.projectile = ip;
 
-  const long long steps_per_sample =
-      std::max<long long>(1, std::llround(1.0 / (sample_rate_hz * dt)));
+  const long long steps_per_sample = std::max<long long>(1, std::llround(1.0 / (sample_rate_hz * dt)));
   const double sample_dt = static_cast<double>(steps_per_sample) * dt;
   const long long hold_samples = std::max<long long>(1, std::llround(stop.hold_time_s / sample_dt));
   const long long max_samples = static_cast<long long>(std::ceil(stop.max_time_s / sample_dt));
@@ -119,8 +115,7 @@ DropResult drop_projectile(System& sys, double surface_height_m, const Projectil
 
   // Snapshots every snapshot_every samples (0: off), the last one at the end of the run.
   const bool snap = snapshots.interval_s > 0 && snapshots.write;
-  const long long snapshot_every =
-      snap ? std::max<long long>(1, std::llround(snapshots.interval_s / sample_dt)) : 0;
+  const long long snapshot_every = snap ? std::max<long long>(1, std::llround(snapshots.interval_s / sample_dt)) : 0;
   long long last_snapshot = -1;
   auto snapshot = [&](long long k) {
     if (!snap || k == last_snapshot) return;
@@ -154,8 +149,8 @@ DropResult drop_projectile(System& sys, double surface_height_m, const Projectil
     }
     if (progress && k % 50 == 0)
       progress(static_cast<double>(k) / static_cast<double>(max_samples),
-               fmt::format("t={:.4f}s depth={:.2f}cm v={:.3f}m/s contacts={}", s.t_s,
-                           100 * s.depth_m, s.velocity_down_m_s, s.contacts));
+               fmt::format("t={:.4f}s depth={:.2f}cm v={:.3f}m/s contacts={}", s.t_s, 100 * s.depth_m,
+                           s.velocity_down_m_s, s.contacts));
   }
   snapshot(k_done);
   res.steps = sys.step_count() - step0;

@@ -15,53 +15,53 @@
 namespace gravsweep {
 
 struct ProjectileSpec {
-  double diameter_m = 0.10;              ///< paper: 10 cm
-  double mass_kg = 1.0;                  ///< paper: 1 kg
-  std::uint8_t material = 2;             ///< kProjectileMaterial
+  double diameter_m = 0.10;   ///< paper: 10 cm
+  double mass_kg = 1.0;       ///< paper: 1 kg
+  std::uint8_t material = 2;  ///< kProjectileMaterial
   /// Exactly one of the two: speed when the projectile first touches a grain (it starts
   /// start_gap_m above the highest grain under its footprint, with the velocity that free fall
   /// turns into this speed at the touch), or the height of the bottom above the mean surface for
   /// a release from rest. Either way a start that would overlap a grain is refused.
   std::optional<double> impact_speed_m_s;
   std::optional<double> drop_height_m;
-  double start_gap_m = 0.005;            ///< impact-speed mode: gap between the projectile's bottom
-                                         ///< and the first grain it would touch, at release
-  double lateral_offset_x_m = 0;         ///< start offset from the container axis (already drawn)
+  double start_gap_m = 0.005;     ///< impact-speed mode: gap between the projectile's bottom
+                                  ///< and the first grain it would touch, at release
+  double lateral_offset_x_m = 0;  ///< start offset from the container axis (already drawn)
   double lateral_offset_y_m = 0;
-  double vertical_offset_m = 0;          ///< added to the start height (already drawn)
+  double vertical_offset_m = 0;  ///< added to the start height (already drawn)
 };
 
 struct DropStop {
-  double speed_m_s = 1e-3;               ///< paper: projectile speed < 0.1 cm/s after contact
-  double hold_time_s = 0.005;            ///< the speed must stay below for this long (guards
-                                         ///< against stopping at the turning point of a bounce)
-  double max_time_s = 1.0;               ///< cap on simulated time after release
+  double speed_m_s = 1e-3;     ///< paper: projectile speed < 0.1 cm/s after contact
+  double hold_time_s = 0.005;  ///< the speed must stay below for this long (guards
+                               ///< against stopping at the turning point of a bounce)
+  double max_time_s = 1.0;     ///< cap on simulated time after release
 };
 
 /// One sample of the projectile (paper frame: z positive down from the bed surface, velocity
 /// positive down, acceleration positive up so that free fall reads -g).
 struct DropSample {
-  double t_s = 0;                  ///< time since release
-  double depth_m = 0;              ///< depth of the projectile's lowest point below the mean surface
+  double t_s = 0;      ///< time since release
+  double depth_m = 0;  ///< depth of the projectile's lowest point below the mean surface
   double velocity_down_m_s = 0;
-  double accel_up_m_s2 = 0;        ///< mean over the preceding sample interval (dv/dt), so the
-                                   ///< 10 kHz record is not aliased by the us-scale contact force
-  Vec3 omega_rad_s = Vec3::Zero(); ///< projectile's angular velocity (engine frame)
-  Vec3 position_m = Vec3::Zero();  ///< projectile centre (engine frame)
-  int contacts = 0;                ///< particles and walls touching the projectile
+  double accel_up_m_s2 = 0;           ///< mean over the preceding sample interval (dv/dt), so the
+                                      ///< 10 kHz record is not aliased by the us-scale contact force
+  Vec3 omega_rad_s = Vec3::Zero();    ///< projectile's angular velocity (engine frame)
+  Vec3 position_m = Vec3::Zero();     ///< projectile centre (engine frame)
+  int contacts = 0;                   ///< particles and walls touching the projectile
   double grain_kinetic_energy_J = 0;  ///< translational + rotational kinetic energy of the grains
 };
 
 struct DropResult {
   std::vector<DropSample> samples;
-  double surface_height_m = 0;     ///< engine z of the mean bed surface (depth 0)
-  double release_height_m = 0;     ///< engine z of the projectile's bottom at release
-  double release_speed_m_s = 0;    ///< downward speed at release
-  double first_touch_height_m = 0; ///< engine z of the projectile's bottom where it would first
-                                   ///< touch a grain falling straight down (mean surface if none)
+  double surface_height_m = 0;      ///< engine z of the mean bed surface (depth 0)
+  double release_height_m = 0;      ///< engine z of the projectile's bottom at release
+  double release_speed_m_s = 0;     ///< downward speed at release
+  double first_touch_height_m = 0;  ///< engine z of the projectile's bottom where it would first
+                                    ///< touch a grain falling straight down (mean surface if none)
   std::optional<double> first_contact_s;
-  bool stopped = false;            ///< stop criterion met (false: the time cap ended the run)
-  std::optional<double> rest_s;    ///< start of the hold window that met the stop criterion
+  bool stopped = false;          ///< stop criterion met (false: the time cap ended the run)
+  std::optional<double> rest_s;  ///< start of the hold window that met the stop criterion
   long long steps = 0;
   ParticleIndex projectile = 0;
 };
@@ -87,9 +87,9 @@ struct DropSnapshots {
 
 /// Adds the projectile to the bed held by `sys` (grains + container walls), releases it and runs
 /// to the stop criterion or the time cap. `surface_height_m` is the bed's mean surface (engine z).
-DropResult drop_projectile(System& sys, double surface_height_m, const ProjectileSpec& projectile,
-                           const DropStop& stop, double sample_rate_hz,
-                           const DropProgress& progress = {}, const DropSnapshots& snapshots = {});
+DropResult drop_projectile(System& sys, double surface_height_m, const ProjectileSpec& projectile, const DropStop& stop,
+                           double sample_rate_hz, const DropProgress& progress = {},
+                           const DropSnapshots& snapshots = {});
 
 /// Kinetic energy (translational + rotational) of the free grains.
 double grain_kinetic_energy_J(const System& sys);

@@ -98,12 +98,12 @@ PileResult measure_pile(const System& sys, double base_top_m, double base_radius
 }
 
 PileResult pour_pile(System& sys, const PileSpec& spec, const PileProgress& progress) {
-  if (!sys.particles.position_m.empty() || !sys.walls.empty())
-    throw ConfigError("pile: the system must start empty");
+  if (!sys.particles.position_m.empty() || !sys.walls.empty()) throw ConfigError("pile: the system must start empty");
   if (!(spec.base_radius_m > 2 * spec.grains.diameter_m) || !(spec.outlet_radius_m > 0) ||
       !(spec.pour_rate_per_s > 0) || spec.grains_poured == 0)
-    throw ConfigError("pile: base_radius_m > 2 grain diameters, outlet_radius_m, pour_rate_per_s and "
-                      "grains_poured must be positive");
+    throw ConfigError(
+        "pile: base_radius_m > 2 grain diameters, outlet_radius_m, pour_rate_per_s and "
+        "grains_poured must be positive");
   std::mt19937_64 rng(spec.seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const double base_top = add_rough_base(sys, spec, rng);
@@ -132,8 +132,8 @@ PileResult pour_pile(System& sys, const PileSpec& spec, const PileProgress& prog
         top = std::max(top, x.z() + p.radius_m[i]);
     }
     std::size_t released = 0;
-    for (int attempt = 0; attempt < 20 && released < static_cast<std::size_t>(owed) &&
-                          poured < spec.grains_poured; ++attempt) {
+    for (int attempt = 0; attempt < 20 && released < static_cast<std::size_t>(owed) && poured < spec.grains_poured;
+         ++attempt) {
       const double rr = spec.outlet_radius_m * std::sqrt(0.5 * (u(rng) + 1)), phi = kPi * u(rng);
       const double dia = d + spec.grains.diameter_spread_m * u(rng);
       const Vec3 x(rr * std::cos(phi), rr * std::sin(phi), top + spec.release_gap_m + d * (u(rng) + 1));

@@ -14,18 +14,18 @@
 namespace gravsweep {
 
 struct PileSpec {
-  GrainSpec grains;                     ///< poured grains (default: Table 1 glass beads)
-  double base_radius_m = 0.15;          ///< radius of the rough base (fixed grains of the mean size)
+  GrainSpec grains;             ///< poured grains (default: Table 1 glass beads)
+  double base_radius_m = 0.15;  ///< radius of the rough base (fixed grains of the mean size)
   std::size_t grains_poured = 2000;
-  double pour_rate_per_s = 1000;        ///< grains released per second (at most)
-  double outlet_radius_m = 0.02;        ///< grains are released at random points of this disk
-  double release_gap_m = 0.03;          ///< outlet height above the resting grains below it
-  double release_speed_m_s = 0.1;       ///< downward speed at release
-  double settle_rms_speed_m_s = 1e-3;   ///< after the pour: run until the grains are this slow
+  double pour_rate_per_s = 1000;       ///< grains released per second (at most)
+  double outlet_radius_m = 0.02;       ///< grains are released at random points of this disk
+  double release_gap_m = 0.03;         ///< outlet height above the resting grains below it
+  double release_speed_m_s = 0.1;      ///< downward speed at release
+  double settle_rms_speed_m_s = 1e-3;  ///< after the pour: run until the grains are this slow
   double settle_max_speed_m_s = 1e-2;
   double max_settle_time_s = 2.0;
   std::uint64_t seed = 7;
-  std::uint8_t grain_material = 0;      ///< for the poured and the base grains
+  std::uint8_t grain_material = 0;  ///< for the poured and the base grains
 };
 
 struct PileResult {

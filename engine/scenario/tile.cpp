@@ -28,8 +28,8 @@ std::size_t grains_in_patch(const System& source, double patch_side_m) {
 
 std::size_t tile_bed(const System& source, const TileSpec& spec, System& out) {
   if (!(spec.patch_side_m > 0) || spec.nx < 1 || spec.ny < 1)
-    throw ConfigError(fmt::format("tile_bed: patch side {} m and {} x {} copies must be positive",
-                                  spec.patch_side_m, spec.nx, spec.ny));
+    throw ConfigError(fmt::format("tile_bed: patch side {} m and {} x {} copies must be positive", spec.patch_side_m,
+                                  spec.nx, spec.ny));
   const double L = spec.patch_side_m, half = 0.5 * L;
   const auto& p = source.particles;
   double top = 0;

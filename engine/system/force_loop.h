@@ -24,10 +24,10 @@ inline constexpr double kMaxOverlapFraction = 0.5;
 /// The deepest overlap beyond kMaxOverlapFraction seen in a force pass: a particle against another
 /// particle or against a wall (the System turns it into a NumericalFailure naming both).
 struct OverlapFailure {
-  double ratio = 0;           ///< overlap / smaller radius
-  long long particle = -1;    ///< -1: no failure
-  long long other = -1;       ///< the other particle, or -1 when it is a wall
-  long long wall = -1;        ///< the wall's index when the other side is a wall
+  double ratio = 0;         ///< overlap / smaller radius
+  long long particle = -1;  ///< -1: no failure
+  long long other = -1;     ///< the other particle, or -1 when it is a wall
+  long long wall = -1;      ///< the wall's index when the other side is a wall
   bool failed() const { return particle >= 0; }
   void consider(double r, long long i, long long j, long long w) {
     if (r > kMaxOverlapFraction && r > ratio) *this = OverlapFailure{r, i, j, w};
@@ -38,8 +38,8 @@ struct ForceContext {
   Particles& p;
   const std::vector<Wall>& walls;
   VerletList& nlist;
-  std::vector<ContactHistory>& wall_history;        ///< [candidate]
-  std::vector<FrameHistory>& wall_frame_history;   ///< [candidate], or empty
+  std::vector<ContactHistory>& wall_history;          ///< [candidate]
+  std::vector<FrameHistory>& wall_frame_history;      ///< [candidate], or empty
   const std::vector<std::uint32_t>& wall_candidates;  ///< particle * walls + wall
   const PairTable& pairs;
   const ContactOptions& options;
@@ -119,8 +119,7 @@ GRAVSWEEP_INLINE void evaluate_contact(const ContactGeometry& g, const PairCoeff
 /// or none rolling): the touching pairs of this thread's share are gathered into batches,
 /// evaluated vectorised, and scattered back in list order.
 template <bool kRolling>
-void pair_loop_batched(ForceContext& c, Vec3* F, Vec3* T, long long& contacts, double& energy,
-                       OverlapFailure& worst) {
+void pair_loop_batched(ForceContext& c, Vec3* F, Vec3* T, long long& contacts, double& energy, OverlapFailure& worst) {
   const Particles& p = c.p;
   const Vec3* V = c.use_eval_velocities ? p.eval_velocity_m_s.data() : p.velocity_m_s.data();
   const Vec3* W = c.use_eval_velocities ? p.eval_omega_rad_s.data() : p.omega_rad_s.data();
@@ -153,8 +152,7 @@ void pair_loop_batched(ForceContext& c, Vec3* F, Vec3* T, long long& contacts, d
   };
   for_each_touching_pair(c, worst, [&](const TouchingPair& t, ContactHistory& h) {
     const std::uint32_t i = t.i, j = t.j;
-    batch.add(t.k, i, j, t.d_m, t.dist2_m2, R[i], R[j], t.m_eff_kg, V[i], V[j], W[i], W[j],
-              c.pairs(mat[i], mat[j]), h);
+    batch.add(t.k, i, j, t.d_m, t.dist2_m2, R[i], R[j], t.m_eff_kg, V[i], V[j], W[i], W[j], c.pairs(mat[i], mat[j]), h);
     if (batch.full()) flush();
   });
   if (batch.count > 0) flush();
@@ -163,8 +161,7 @@ void pair_loop_batched(ForceContext& c, Vec3* F, Vec3* T, long long& contacts, d
 /// The particle-particle part of force_loop for every other (law, rolling) pair: one contact at
 /// a time through evaluate_contact.
 template <class Law, class Rolling>
-void pair_loop_scalar(ForceContext& c, Vec3* F, Vec3* T, long long& contacts, double& energy,
-                      OverlapFailure& worst) {
+void pair_loop_scalar(ForceContext& c, Vec3* F, Vec3* T, long long& contacts, double& energy, OverlapFailure& worst) {
   constexpr bool kFrames = Law::uses_frame_history || Rolling::uses_frame_history;
   const Particles& p = c.p;
   const Vec3* V = c.use_eval_velocities ? p.eval_velocity_m_s.data() : p.velocity_m_s.data();
@@ -202,8 +199,7 @@ void pair_loop_scalar(ForceContext& c, Vec3* F, Vec3* T, long long& contacts, do
 
 /// Particle-wall contacts: this thread's static share of the wall candidates (particle, wall).
 template <class Law, class Rolling>
-void wall_loop(ForceContext& c, Vec3* F, Vec3* T, long long& wall_contacts, double& energy,
-               OverlapFailure& worst) {
+void wall_loop(ForceContext& c, Vec3* F, Vec3* T, long long& wall_contacts, double& energy, OverlapFailure& worst) {
   constexpr bool kFrames = Law::uses_frame_history || Rolling::uses_frame_history;
   const std::size_t n_walls = c.walls.size();
   if (n_walls == 0) return;

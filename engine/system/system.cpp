@@ -84,12 +84,11 @@ void System::initialize() {
       }
       const PairCoefficients pc = compose_pair(config_.materials[a], config_.materials[b], ov);
       auto bad = [&](const char* f, double v, const char* e) {
-        throw ConfigError(fmt::format("pair {}-{}: {} = {} is invalid; expected {}",
-                                      config_.materials[a].name, config_.materials[b].name, f, v, e));
+        throw ConfigError(fmt::format("pair {}-{}: {} = {} is invalid; expected {}", config_.materials[a].name,
+                                      config_.materials[b].name, f, v, e));
       };
       if (!(pc.cor_normal > 0 && pc.cor_normal <= 1)) bad("cor_normal", pc.cor_normal, "COR in (0, 1]");
-      if (!(pc.cor_tangential > 0 && pc.cor_tangential <= 1))
-        bad("cor_tangential", pc.cor_tangential, "COR in (0, 1]");
+      if (!(pc.cor_tangential > 0 && pc.cor_tangential <= 1)) bad("cor_tangential", pc.cor_tangential, "COR in (0, 1]");
       if (!(pc.mu_static >= 0)) bad("mu_static", pc.mu_static, ">= 0");
       pairs_.set(a, b, pc);
     }
@@ -97,22 +96,22 @@ void System::initialize() {
   std::vector<double> min_r(nm, 0), min_m(nm, 0);
   std::vector<bool> is_wall(nm, false);
   for (const auto& w : walls) {
-    if (w.material >= nm) throw ConfigError(fmt::format("wall '{}': material id {} is not defined", w.name, w.material));
+    if (w.material >= nm)
+      throw ConfigError(fmt::format("wall '{}': material id {} is not defined", w.name, w.material));
     is_wall[w.material] = true;
   }
   for (std::size_t i = 0; i < particles.size(); ++i) {
     const auto m = particles.material[i];
     if (m >= nm) throw ConfigError(fmt::format("particle {}: material id {} is not defined", i, m));
     if (!(particles.radius_m[i] > 0) || !(particles.mass_kg[i] > 0))
-      throw ConfigError(fmt::format("particle {}: radius {} m and mass {} kg must be > 0", i,
-                                    particles.radius_m[i], particles.mass_kg[i]));
+      throw ConfigError(fmt::format("particle {}: radius {} m and mass {} kg must be > 0", i, particles.radius_m[i],
+                                    particles.mass_kg[i]));
     min_r[m] = min_r[m] == 0 ? particles.radius_m[i] : std::min(min_r[m], particles.radius_m[i]);
     min_m[m] = min_m[m] == 0 ? particles.mass_kg[i] : std::min(min_m[m], particles.mass_kg[i]);
     is_wall[m] = false;  // a material used by particles is checked as a particle material
   }
   check_contact_law(config_.contact_law,
-                    LawSetup{config_.materials, pairs_, min_r, min_m, is_wall, config_.dt_s,
-                             config_.check_time_step});
+                    LawSetup{config_.materials, pairs_, min_r, min_m, is_wall, config_.dt_s, config_.check_time_step});
   force_fn_ = select_force_function(config_.contact_law, config_.rolling_model);
   prepare_contact_law(config_.contact_law, pairs_);
   integrator_ = make_integrator(config_.integrator);
@@ -207,11 +206,10 @@ void System::force_pass(bool displacement_checked) {
   if (const OverlapFailure& f = ctx.failure; f.failed()) {
     const std::string other = f.wall >= 0 ? fmt::format("wall '{}'", walls[static_cast<std::size_t>(f.wall)].name)
                                           : fmt::format("particle {}", f.other);
-    throw NumericalFailure(
-        fmt::format("step {} (t = {:.6g} s): particle {} overlaps {} by {:.0f} % of the smaller "
-                    "radius (limit {:.0f} %): the time step is too large or the contact too soft",
-                    step_, time_s_, f.particle, other, 100 * f.ratio, 100 * kMaxOverlapFraction),
-        step_, f.particle);
+    throw NumericalFailure(fmt::format("step {} (t = {:.6g} s): particle {} overlaps {} by {:.0f} % of the smaller "
+                                       "radius (limit {:.0f} %): the time step is too large or the contact too soft",
+                                       step_, time_s_, f.particle, other, 100 * f.ratio, 100 * kMaxOverlapFraction),
+                           step_, f.particle);
   }
 }
 
@@ -222,11 +220,10 @@ void System::raise_state_failure(long long bad, StateFault cause) {
                                        "position or velocity (NaN/inf)",
                                        step_, time_s_, bad),
                            step_, bad);
-  throw NumericalFailure(
-      fmt::format("step {} (t = {:.6g} s): particle {} left the container: position ({:.4g}, "
-                  "{:.4g}, {:.4g}) m is outside the domain",
-                  step_, time_s_, bad, x.x(), x.y(), x.z()),
-      step_, bad);
+  throw NumericalFailure(fmt::format("step {} (t = {:.6g} s): particle {} left the container: position ({:.4g}, "
+                                     "{:.4g}, {:.4g}) m is outside the domain",
+                                     step_, time_s_, bad, x.x(), x.y(), x.z()),
+                         step_, bad);
 }
 
 void System::step() {
@@ -247,8 +244,7 @@ void System::step() {
   ++step_;
   time_s_ += dt;
   if (check.bad_particle >= 0) raise_state_failure(check.bad_particle, check.bad_cause);
-  if (check.position_at_build == nullptr ||
-      check.max_displacement2_m2 > 0.25 * config_.skin_m * config_.skin_m)
+  if (check.position_at_build == nullptr || check.max_displacement2_m2 > 0.25 * config_.skin_m * config_.skin_m)
     rebuild_due_ = true;
   have_step_checks_ = true;
 }
@@ -270,8 +266,7 @@ double System::kinetic_energy_J() const {
 double System::potential_energy_J() const {
   double e = 0;
   for (std::size_t i = 0; i < particles.size(); ++i)
-    if (particles.inv_mass_1_kg[i] > 0)
-      e -= particles.mass_kg[i] * config_.gravity_m_s2.dot(particles.position_m[i]);
+    if (particles.inv_mass_1_kg[i] > 0) e -= particles.mass_kg[i] * config_.gravity_m_s2.dot(particles.position_m[i]);
   return e;
 }
 
@@ -282,8 +277,8 @@ int System::contact_count(ParticleIndex i) const {
     for (std::uint32_t k = nlist_.offset[a]; k < nlist_.offset[a + 1]; ++k)
       if ((a == i || nlist_.neighbor[k] == i) && nlist_.history[k].active) ++count;
   const std::size_t nw = wall_count_at_build_;
-  const auto first = std::lower_bound(wall_candidates_.begin(), wall_candidates_.end(),
-                                      static_cast<std::uint32_t>(i * nw));
+  const auto first =
+      std::lower_bound(wall_candidates_.begin(), wall_candidates_.end(), static_cast<std::uint32_t>(i * nw));
   for (auto it = first; it != wall_candidates_.end() && *it < (i + 1) * nw; ++it)
     if (wall_history_[static_cast<std::size_t>(it - wall_candidates_.begin())].active) ++count;
   return count;
@@ -305,10 +300,9 @@ double System::bytes_per_particle() const {
   const std::size_t n = std::max<std::size_t>(1, particles.size());
   const std::size_t per_particle_state =
       7 * sizeof(Vec3) + 4 * sizeof(double) + sizeof(std::uint8_t) + sizeof(SizeClass);
-  std::size_t bytes = particles.size() * per_particle_state + nlist_.bytes() +
-                      wall_candidates_.capacity() * sizeof(std::uint32_t) +
-                      wall_history_.capacity() * sizeof(ContactHistory) +
-                      wall_frame_history_.capacity() * sizeof(FrameHistory);
+  std::size_t bytes =
+      particles.size() * per_particle_state + nlist_.bytes() + wall_candidates_.capacity() * sizeof(std::uint32_t) +
+      wall_history_.capacity() * sizeof(ContactHistory) + wall_frame_history_.capacity() * sizeof(FrameHistory);
   for (const auto& v : thread_force_) bytes += v.capacity() * sizeof(Vec3);
   for (const auto& v : thread_torque_) bytes += v.capacity() * sizeof(Vec3);
   return static_cast<double>(bytes) / static_cast<double>(n);

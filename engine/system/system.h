@@ -18,7 +18,6 @@
 
 namespace gravsweep {
 
-
 /// Axis-aligned region; a particle centre outside it is a numerical failure ("left the container").
 struct Domain {
   Vec3 lo_m, hi_m;
@@ -30,25 +29,25 @@ struct SystemConfig {
   std::string integrator = "semi_implicit_euler";  ///< see integrator_table()
   double dt_s = 1e-6;
   Vec3 gravity_m_s2 = Vec3(0, 0, -9.81);
-  std::vector<Material> materials;                 ///< indexed by material id
+  std::vector<Material> materials;  ///< indexed by material id
   Composition composition = Composition::explicit_pair;
   /// explicit_pair overrides, keyed by (material a, material b) with a <= b.
   std::map<std::pair<int, int>, PairOverride> pair_overrides;
   ContactOptions options;
-  double skin_m = 0;                                ///< Verlet skin; 0 = 0.2 x smallest radius
-  int threads = 0;                                  ///< OpenMP threads; 0 = OpenMP default
+  double skin_m = 0;  ///< Verlet skin; 0 = 0.2 x smallest radius
+  int threads = 0;    ///< OpenMP threads; 0 = OpenMP default
   /// Systems smaller than this run on one thread (thread start-up costs more than it saves).
   std::size_t parallel_min_particles = 512;
   std::optional<Domain> domain;
-  bool track_energy = false;                        ///< accumulate the normal spring energy
-  bool check_time_step = true;                      ///< reject dt above the law's stability bound
+  bool track_energy = false;    ///< accumulate the normal spring energy
+  bool check_time_step = true;  ///< reject dt above the law's stability bound
 };
 
 /// Per-step counters from the force evaluation.
 struct StepStats {
-  long long contacts = 0;        ///< touching particle-particle pairs
-  long long wall_contacts = 0;   ///< touching particle-wall pairs
-  double elastic_energy_J = 0;   ///< sum of normal spring energies (track_energy only)
+  long long contacts = 0;       ///< touching particle-particle pairs
+  long long wall_contacts = 0;  ///< touching particle-wall pairs
+  double elastic_energy_J = 0;  ///< sum of normal spring energies (track_energy only)
 };
 
 class System {
@@ -79,7 +78,10 @@ class System {
   [[nodiscard]] double time_s() const { return time_s_; }
   [[nodiscard]] long long step_count() const { return step_; }
   [[nodiscard]] const SystemConfig& config() const { return config_; }
-  SystemConfig& mutable_config() { initialized_ = false; return config_; }
+  SystemConfig& mutable_config() {
+    initialized_ = false;
+    return config_;
+  }
   /// Changes gravity between steps without re-initialising (gravity enters only the force sum).
   void set_gravity(const Vec3& g_m_s2) { config_.gravity_m_s2 = g_m_s2; }
   [[nodiscard]] const StepStats& stats() const { return stats_; }
@@ -120,10 +122,10 @@ class System {
   /// contact histories of these pairs are stored beside them (sparse: a grain away from every
   /// wall holds none) and carried over, by code, when the candidates are rebuilt.
   std::vector<std::uint32_t> wall_candidates_;
-  std::vector<ContactHistory> wall_history_;        ///< [candidate]
-  std::vector<FrameHistory> wall_frame_history_;    ///< [candidate], when frame histories are kept
-  std::size_t wall_count_at_build_ = 0;             ///< walls.size() the codes were made with
-  bool rebuild_due_ = true;   ///< set by the step checks when a particle moved more than skin/2
+  std::vector<ContactHistory> wall_history_;      ///< [candidate]
+  std::vector<FrameHistory> wall_frame_history_;  ///< [candidate], when frame histories are kept
+  std::size_t wall_count_at_build_ = 0;           ///< walls.size() the codes were made with
+  bool rebuild_due_ = true;                       ///< set by the step checks when a particle moved more than skin/2
   /// The last step's end checks measured every displacement. Particles edited between steps
   /// (positions, walls) must be followed by invalidate() or compute_forces().
   bool have_step_checks_ = false;

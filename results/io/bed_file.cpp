@@ -21,8 +21,7 @@ void write_bed(const std::filesystem::path& path, const BedData& b) {
     h5::set_attr(f.id(), "report", b.report_json);
     {
       h5::Handle c = h5::create_group(f.id(), "container");
-      h5::set_attr(c, "description",
-                   "cylinder with a disk bottom at z = 0 (engine frame, z up), axis at x = y = 0");
+      h5::set_attr(c, "description", "cylinder with a disk bottom at z = 0 (engine frame, z up), axis at x = y = 0");
       h5::set_attr(c, "diameter_m", b.container_diameter_m);
       h5::set_attr(c, "wall_height_m", b.wall_height_m);
       h5::set_attr(c, "fill_height_m", b.fill_height_m);
@@ -46,12 +45,12 @@ void write_bed(const std::filesystem::path& path, const BedData& b) {
 BedData read_bed(const std::filesystem::path& path) {
   h5::File f = h5::File::open_read(path);
   if (!h5::has_attr(f.id(), "format") || h5::get_attr_string(f.id(), "format") != kBedFormat)
-    throw h5::H5Error(fmt::format("bed {}: not a gravsweep bed file (root attribute format != '{}')",
-                                  path.string(), kBedFormat));
+    throw h5::H5Error(
+        fmt::format("bed {}: not a gravsweep bed file (root attribute format != '{}')", path.string(), kBedFormat));
   const long long version = h5::get_attr_int(f.id(), "format_version");
   if (version != kBedFormatVersion)
-    throw h5::H5Error(fmt::format("bed {}: format_version {} is not supported (expected {})",
-                                  path.string(), version, kBedFormatVersion));
+    throw h5::H5Error(fmt::format("bed {}: format_version {} is not supported (expected {})", path.string(), version,
+                                  kBedFormatVersion));
   BedData b;
   b.code_version = h5::get_attr_string(f.id(), "code_version");
   b.bed_key_json = h5::get_attr_string(f.id(), "bed_key");

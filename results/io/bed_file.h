@@ -22,11 +22,11 @@
 namespace gravsweep::results {
 
 struct BedData {
-  std::vector<double> position_m;    ///< N x 3, row-major
-  std::vector<double> velocity_m_s;  ///< N x 3
-  std::vector<double> omega_rad_s;   ///< N x 3
-  std::vector<double> radius_m;      ///< N
-  std::vector<double> mass_kg;       ///< N
+  std::vector<double> position_m;      ///< N x 3, row-major
+  std::vector<double> velocity_m_s;    ///< N x 3
+  std::vector<double> omega_rad_s;     ///< N x 3
+  std::vector<double> radius_m;        ///< N
+  std::vector<double> mass_kg;         ///< N
   std::vector<std::uint8_t> material;  ///< N
   double container_diameter_m = 0;
   double wall_height_m = 0;

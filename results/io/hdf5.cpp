@@ -45,9 +45,9 @@ Handle open_dataset(hid_t parent, const std::string& name) {
   return d;
 }
 
-void write_dataset(hid_t parent, const std::string& name, hid_t file_type, hid_t mem_type,
-                   const void* data, const std::vector<hsize_t>& dims, const std::string& units,
-                   const std::string& description, Storage storage = Storage::compressed) {
+void write_dataset(hid_t parent, const std::string& name, hid_t file_type, hid_t mem_type, const void* data,
+                   const std::vector<hsize_t>& dims, const std::string& units, const std::string& description,
+                   Storage storage = Storage::compressed) {
   Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), &H5Sclose);
   if (space.get() < 0) fail(parent, fmt::format("cannot create dataspace for '{}'", name));
   Handle plist(H5Pcreate(H5P_DATASET_CREATE), &H5Pclose);
@@ -61,8 +61,7 @@ void write_dataset(hid_t parent, const std::string& name, hid_t file_type, hid_t
     H5Pset_shuffle(plist);
     H5Pset_deflate(plist, 4);
   }
-  Handle ds(H5Dcreate2(parent, name.c_str(), file_type, space, H5P_DEFAULT, plist, H5P_DEFAULT),
-            &H5Dclose);
+  Handle ds(H5Dcreate2(parent, name.c_str(), file_type, space, H5P_DEFAULT, plist, H5P_DEFAULT), &H5Dclose);
   if (ds.get() < 0) fail(parent, fmt::format("cannot create dataset '{}'", name));
   if (total > 0 && H5Dwrite(ds, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
     fail(parent, fmt::format("cannot write dataset '{}'", name));
@@ -71,8 +70,7 @@ void write_dataset(hid_t parent, const std::string& name, hid_t file_type, hid_t
 }
 
 template <class T>
-std::vector<T> read_dataset(hid_t parent, const std::string& name, hid_t mem_type,
-                            std::vector<hsize_t>* dims_out) {
+std::vector<T> read_dataset(hid_t parent, const std::string& name, hid_t mem_type, std::vector<hsize_t>* dims_out) {
   Handle ds = open_dataset(parent, name);
   Handle space(H5Dget_space(ds), &H5Sclose);
   const int rank = H5Sget_simple_extent_ndims(space);
@@ -104,15 +102,12 @@ void set_scalar_attr(hid_t obj, const std::string& name, hid_t file_type, hid_t 
   replace_attr(obj, name);
   Handle space(H5Screate(H5S_SCALAR), &H5Sclose);
   Handle a(H5Acreate2(obj, name.c_str(), file_type, space, H5P_DEFAULT, H5P_DEFAULT), &H5Aclose);
-  if (a.get() < 0 || H5Awrite(a, mem_type, &value) < 0)
-    fail(obj, fmt::format("cannot write attribute '{}'", name));
+  if (a.get() < 0 || H5Awrite(a, mem_type, &value) < 0) fail(obj, fmt::format("cannot write attribute '{}'", name));
 }
 
 }  // namespace
 
-std::string where(hid_t obj) {
-  return fmt::format("{}:{}", name_of(obj, &fget_name), name_of(obj, &iget_name));
-}
+std::string where(hid_t obj) { return fmt::format("{}:{}", name_of(obj, &fget_name), name_of(obj, &iget_name)); }
 
 std::filesystem::path temporary_sibling(const std::filesystem::path& final_path) {
   auto tmp = final_path;
@@ -126,17 +121,17 @@ File File::create(const std::filesystem::path& path) {
   f.path_ = path;
   f.handle_ = Handle(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), &H5Fclose);
   if (f.handle_.get() < 0)
-    throw H5Error(fmt::format("HDF5 {}: cannot create the file (does the folder exist and is it "
-                              "writable?)", path.string()));
+    throw H5Error(
+        fmt::format("HDF5 {}: cannot create the file (does the folder exist and is it "
+                    "writable?)",
+                    path.string()));
   return f;
 }
 
 File File::open_read(const std::filesystem::path& path) {
   silence_hdf5();
-  if (!std::filesystem::exists(path))
-    throw H5Error(fmt::format("HDF5 {}: no such file", path.string()));
-  if (H5Fis_hdf5(path.c_str()) <= 0)
-    throw H5Error(fmt::format("HDF5 {}: not an HDF5 file", path.string()));
+  if (!std::filesystem::exists(path)) throw H5Error(fmt::format("HDF5 {}: no such file", path.string()));
+  if (H5Fis_hdf5(path.c_str()) <= 0) throw H5Error(fmt::format("HDF5 {}: not an HDF5 file", path.string()));
   File f;
   f.path_ = path;
   f.handle_ = Handle(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), &H5Fclose);
@@ -146,8 +141,7 @@ File File::open_read(const std::filesystem::path& path) {
 
 void File::close() {
   if (handle_.get() >= 0) {
-    if (H5Fflush(handle_, H5F_SCOPE_LOCAL) < 0)
-      throw H5Error(fmt::format("HDF5 {}: flush failed", path_.string()));
+    if (H5Fflush(handle_, H5F_SCOPE_LOCAL) < 0) throw H5Error(fmt::format("HDF5 {}: flush failed", path_.string()));
     const hid_t id = handle_.release();
     if (H5Fclose(id) < 0) throw H5Error(fmt::format("HDF5 {}: close failed", path_.string()));
   }
@@ -166,13 +160,11 @@ Handle open_group(hid_t parent, const std::string& name) {
   return g;
 }
 
-bool exists(hid_t parent, const std::string& name) {
-  return H5Lexists(parent, name.c_str(), H5P_DEFAULT) > 0;
-}
+bool exists(hid_t parent, const std::string& name) { return H5Lexists(parent, name.c_str(), H5P_DEFAULT) > 0; }
 
 void write_doubles(hid_t parent, const std::string& name, const std::vector<double>& data,
-                   const std::vector<hsize_t>& dims, const std::string& units,
-                   const std::string& description, Storage storage) {
+                   const std::vector<hsize_t>& dims, const std::string& units, const std::string& description,
+                   Storage storage) {
   hsize_t total = 1;
   for (hsize_t d : dims) total *= d;
   if (total != data.size())
@@ -180,16 +172,14 @@ void write_doubles(hid_t parent, const std::string& name, const std::vector<doub
   write_dataset(parent, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, data.data(), dims, units, description, storage);
 }
 
-void write_int32(hid_t parent, const std::string& name, const std::vector<std::int32_t>& data,
-                 const std::string& units, const std::string& description, Storage storage) {
-  write_dataset(parent, name, H5T_STD_I32LE, H5T_NATIVE_INT32, data.data(), {data.size()}, units,
-                description, storage);
+void write_int32(hid_t parent, const std::string& name, const std::vector<std::int32_t>& data, const std::string& units,
+                 const std::string& description, Storage storage) {
+  write_dataset(parent, name, H5T_STD_I32LE, H5T_NATIVE_INT32, data.data(), {data.size()}, units, description, storage);
 }
 
-void write_uint8(hid_t parent, const std::string& name, const std::vector<std::uint8_t>& data,
-                 const std::string& units, const std::string& description) {
-  write_dataset(parent, name, H5T_STD_U8LE, H5T_NATIVE_UINT8, data.data(), {data.size()}, units,
-                description);
+void write_uint8(hid_t parent, const std::string& name, const std::vector<std::uint8_t>& data, const std::string& units,
+                 const std::string& description) {
+  write_dataset(parent, name, H5T_STD_U8LE, H5T_NATIVE_UINT8, data.data(), {data.size()}, units, description);
 }
 
 std::vector<double> read_doubles(hid_t parent, const std::string& name, std::vector<hsize_t>* dims_out) {
@@ -204,17 +194,14 @@ std::vector<std::uint8_t> read_uint8(hid_t parent, const std::string& name) {
   return read_dataset<std::uint8_t>(parent, name, H5T_NATIVE_UINT8, nullptr);
 }
 
-void set_attr(hid_t obj, const std::string& name, const std::string& value) {
-  set_attr(obj, name, value.c_str());
-}
+void set_attr(hid_t obj, const std::string& name, const std::string& value) { set_attr(obj, name, value.c_str()); }
 
 void set_attr(hid_t obj, const std::string& name, const char* value) {
   replace_attr(obj, name);
   Handle type = string_type();
   Handle space(H5Screate(H5S_SCALAR), &H5Sclose);
   Handle a(H5Acreate2(obj, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT), &H5Aclose);
-  if (a.get() < 0 || H5Awrite(a, type, &value) < 0)
-    fail(obj, fmt::format("cannot write attribute '{}'", name));
+  if (a.get() < 0 || H5Awrite(a, type, &value) < 0) fail(obj, fmt::format("cannot write attribute '{}'", name));
 }
 
 void set_attr(hid_t obj, const std::string& name, double value) {
@@ -251,16 +238,14 @@ std::string get_attr_string(hid_t obj, const std::string& name) {
 double get_attr_double(hid_t obj, const std::string& name) {
   Handle a = open_attr(obj, name);
   double v = 0;
-  if (H5Aread(a, H5T_NATIVE_DOUBLE, &v) < 0)
-    fail(obj, fmt::format("cannot read attribute '{}' as a number", name));
+  if (H5Aread(a, H5T_NATIVE_DOUBLE, &v) < 0) fail(obj, fmt::format("cannot read attribute '{}' as a number", name));
   return v;
 }
 
 long long get_attr_int(hid_t obj, const std::string& name) {
   Handle a = open_attr(obj, name);
   long long v = 0;
-  if (H5Aread(a, H5T_NATIVE_LLONG, &v) < 0)
-    fail(obj, fmt::format("cannot read attribute '{}' as an integer", name));
+  if (H5Aread(a, H5T_NATIVE_LLONG, &v) < 0) fail(obj, fmt::format("cannot read attribute '{}' as an integer", name));
   return v;
 }
 

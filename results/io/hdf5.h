@@ -87,17 +87,15 @@ enum class Storage { compressed, contiguous };
 
 /// Writes a dataset of doubles with shape `dims` (row-major), plus "units" and "description".
 void write_doubles(hid_t parent, const std::string& name, const std::vector<double>& data,
-                   const std::vector<hsize_t>& dims, const std::string& units,
-                   const std::string& description, Storage storage = Storage::compressed);
-void write_int32(hid_t parent, const std::string& name, const std::vector<std::int32_t>& data,
-                 const std::string& units, const std::string& description,
-                 Storage storage = Storage::compressed);
-void write_uint8(hid_t parent, const std::string& name, const std::vector<std::uint8_t>& data,
-                 const std::string& units, const std::string& description);
+                   const std::vector<hsize_t>& dims, const std::string& units, const std::string& description,
+                   Storage storage = Storage::compressed);
+void write_int32(hid_t parent, const std::string& name, const std::vector<std::int32_t>& data, const std::string& units,
+                 const std::string& description, Storage storage = Storage::compressed);
+void write_uint8(hid_t parent, const std::string& name, const std::vector<std::uint8_t>& data, const std::string& units,
+                 const std::string& description);
 
 /// Reads a dataset of any numeric type as doubles; `dims_out` receives its shape.
-std::vector<double> read_doubles(hid_t parent, const std::string& name,
-                                 std::vector<hsize_t>* dims_out = nullptr);
+std::vector<double> read_doubles(hid_t parent, const std::string& name, std::vector<hsize_t>* dims_out = nullptr);
 std::vector<std::int32_t> read_int32(hid_t parent, const std::string& name);
 std::vector<std::uint8_t> read_uint8(hid_t parent, const std::string& name);
 

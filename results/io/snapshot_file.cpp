@@ -55,11 +55,12 @@ SnapshotPoints read_points(hid_t parent, const std::string& name) {
 void xdmf_points(std::string& x, const std::string& h5, const std::string& name, std::size_t n, std::size_t k) {
   const std::string base = fmt::format("{}:/snapshots/{}/{}", h5, snapshot_group(k), name);
   auto item = [&](const std::string& dims, const char* type, int precision, const std::string& path) {
-    return fmt::format("<DataItem Dimensions=\"{}\" NumberType=\"{}\" Precision=\"{}\" Format=\"HDF\">{}</DataItem>", dims,
-                       type, precision, path);
+    return fmt::format("<DataItem Dimensions=\"{}\" NumberType=\"{}\" Precision=\"{}\" Format=\"HDF\">{}</DataItem>",
+                       dims, type, precision, path);
   };
   x += fmt::format("        <Grid Name=\"{}\" GridType=\"Uniform\">\n", name);
-  x += fmt::format("          <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{}\" NodesPerElement=\"1\"/>\n", n);
+  x += fmt::format("          <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{}\" NodesPerElement=\"1\"/>\n",
+                   n);
   x += fmt::format("          <Geometry GeometryType=\"XYZ\">{}</Geometry>\n",
                    item(fmt::format("{} 3", n), "Float", 8, base + "/position_m"));
   x += fmt::format("          <Attribute Name=\"radius_m\" AttributeType=\"Scalar\" Center=\"Node\">{}</Attribute>\n",
@@ -178,8 +179,8 @@ std::string snapshot_xdmf(const std::string& h5, std::size_t grains, const std::
 std::vector<double> read_snapshot_times(const std::filesystem::path& path) {
   h5::File f = h5::File::open_read(path);
   if (!h5::has_attr(f.id(), "format") || h5::get_attr_string(f.id(), "format") != kSnapshotFormat)
-    throw h5::H5Error(fmt::format("{}: not a gravsweep snapshots file (format attribute '{}' expected)",
-                                  path.string(), kSnapshotFormat));
+    throw h5::H5Error(fmt::format("{}: not a gravsweep snapshots file (format attribute '{}' expected)", path.string(),
+                                  kSnapshotFormat));
   h5::Handle g = h5::open_group(f.id(), "snapshots");
   return h5::read_doubles(g, "t_s");
 }

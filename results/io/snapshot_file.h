@@ -30,9 +30,9 @@ inline constexpr long long kSnapshotFormatVersion = 1;
 
 /// One point set (the grains, or the projectile) at one instant.
 struct SnapshotPoints {
-  std::vector<double> position_m;    ///< n x 3, row-major
-  std::vector<double> velocity_m_s;  ///< n x 3
-  std::vector<double> omega_rad_s;   ///< n x 3
+  std::vector<double> position_m;      ///< n x 3, row-major
+  std::vector<double> velocity_m_s;    ///< n x 3
+  std::vector<double> omega_rad_s;     ///< n x 3
   std::vector<std::int32_t> contacts;  ///< n
   [[nodiscard]] std::size_t size() const { return contacts.size(); }
 };

@@ -74,12 +74,12 @@ void write_trace(const std::filesystem::path& path, const TraceData& d) {
 TraceData read_trace(const std::filesystem::path& path) {
   h5::File f = h5::File::open_read(path);
   if (!h5::has_attr(f.id(), "format") || h5::get_attr_string(f.id(), "format") != kTraceFormat)
-    throw h5::H5Error(fmt::format("trace {}: not a gravsweep trace file (root attribute format != '{}')",
-                                  path.string(), kTraceFormat));
+    throw h5::H5Error(fmt::format("trace {}: not a gravsweep trace file (root attribute format != '{}')", path.string(),
+                                  kTraceFormat));
   const long long version = h5::get_attr_int(f.id(), "format_version");
   if (version != kTraceFormatVersion)
-    throw h5::H5Error(fmt::format("trace {}: format_version {} is not supported (expected {})",
-                                  path.string(), version, kTraceFormatVersion));
+    throw h5::H5Error(fmt::format("trace {}: format_version {} is not supported (expected {})", path.string(), version,
+                                  kTraceFormatVersion));
   TraceData d;
   d.code_version = h5::get_attr_string(f.id(), "code_version");
   d.scenario_json = h5::get_attr_string(f.id(), "scenario");

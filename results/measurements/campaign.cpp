@@ -102,25 +102,41 @@ int store_campaign(db::Database& db, const Campaign& c) {
     ins.bind(1, c.directory).bind(2, nlohmann::json(i.attributes).dump()).bind(3, to_string(i.source));
     int k = 4;
     for (const auto& f : trial_fields()) {
-      if (f.number) ins.bind(k++, i.*f.number);
-      else ins.bind(k++, i.*f.text);
+      if (f.number)
+        ins.bind(k++, i.*f.number);
+      else
+        ins.bind(k++, i.*f.text);
     }
     ins.run();
     const auto& p = t.processed;
     for (std::size_t s = 0; s < p.t_s.size(); ++s) {
       smp.reset();
-      smp.bind(1, i.trial_id).bind(2, static_cast<std::int64_t>(s)).bind(3, p.t_s[s])
-          .bind(4, t.raw.accel_up_m_s2[s]).bind(5, p.accel_up_m_s2[s])
-          .bind(6, p.velocity_down_m_s[s]).bind(7, p.depth_m[s]);
+      smp.bind(1, i.trial_id)
+          .bind(2, static_cast<std::int64_t>(s))
+          .bind(3, p.t_s[s])
+          .bind(4, t.raw.accel_up_m_s2[s])
+          .bind(5, p.accel_up_m_s2[s])
+          .bind(6, p.velocity_down_m_s[s])
+          .bind(7, p.depth_m[s]);
       smp.run();
     }
     const auto& m = p.metrics;
     met.reset();
-    met.bind(1, i.trial_id).bind(2, m.vc_m_s).bind(3, m.apeak_m_s2).bind(4, m.zstop_m)
-        .bind(5, m.tstop_s).bind(6, m.t_start_s).bind(7, m.t_end_s).bind(8, m.rebound ? 1 : 0)
-        .bind(9, p.bias_m_s2).bind(10, m.note).bind(11, static_cast<std::int64_t>(p.i_start))
-        .bind(12, static_cast<std::int64_t>(p.i_end)).bind(13, static_cast<std::int64_t>(t.fit_begin))
-        .bind(14, static_cast<std::int64_t>(t.fit_end)).bind(15, p.sample_rate_hz);
+    met.bind(1, i.trial_id)
+        .bind(2, m.vc_m_s)
+        .bind(3, m.apeak_m_s2)
+        .bind(4, m.zstop_m)
+        .bind(5, m.tstop_s)
+        .bind(6, m.t_start_s)
+        .bind(7, m.t_end_s)
+        .bind(8, m.rebound ? 1 : 0)
+        .bind(9, p.bias_m_s2)
+        .bind(10, m.note)
+        .bind(11, static_cast<std::int64_t>(p.i_start))
+        .bind(12, static_cast<std::int64_t>(p.i_end))
+        .bind(13, static_cast<std::int64_t>(t.fit_begin))
+        .bind(14, static_cast<std::int64_t>(t.fit_end))
+        .bind(15, p.sample_rate_hz);
     met.run();
     ++stored;
   }
@@ -136,11 +152,13 @@ Trial trial_of_row(db::Statement& q, const std::vector<std::string>& cols) {
   for (int c = 0; c < static_cast<int>(cols.size()); ++c) {
     if (q.is_null(c)) continue;
     const auto& name = cols[static_cast<std::size_t>(c)];
-    const auto it = std::find_if(trial_fields().begin(), trial_fields().end(),
-                                 [&](const TrialField& f) { return name == f.key; });
+    const auto it =
+        std::find_if(trial_fields().begin(), trial_fields().end(), [&](const TrialField& f) { return name == f.key; });
     if (it != trial_fields().end()) {
-      if (it->number) j[name] = q.get_double(c);
-      else j[name] = q.get_text(c);
+      if (it->number)
+        j[name] = q.get_double(c);
+      else
+        j[name] = q.get_text(c);
     } else if (name == "source") {
       j["source"] = q.get_text(c);
     } else if (name == "attributes_json") {
@@ -189,9 +207,10 @@ Campaign load_campaign_db(db::Database& db) {
     p.bias_m_s2 = q.get_double(b + 7);
     m.note = q.is_null(b + 8) ? "" : q.get_text(b + 8);
     if (q.is_null(b + 9) || q.is_null(b + 11))
-      throw std::runtime_error(fmt::format("{}: trial '{}' was imported by an older gravsweep without fit "
-                                           "windows; import the campaign again",
-                                           db.path(), i.trial_id));
+      throw std::runtime_error(
+          fmt::format("{}: trial '{}' was imported by an older gravsweep without fit "
+                      "windows; import the campaign again",
+                      db.path(), i.trial_id));
     p.i_start = static_cast<std::size_t>(q.get_int(b + 9));
     p.i_end = static_cast<std::size_t>(q.get_int(b + 10));
     t.fit_begin = static_cast<std::size_t>(q.get_int(b + 11));
@@ -210,8 +229,8 @@ Campaign load_campaign_db(db::Database& db) {
     }
     t.raw.source = i.source;
     if (t.fit_end > p.t_s.size() || t.fit_begin > t.fit_end)
-      throw std::runtime_error(fmt::format("{}: trial '{}': fit window [{}, {}) outside its {} samples",
-                                           db.path(), i.trial_id, t.fit_begin, t.fit_end, p.t_s.size()));
+      throw std::runtime_error(fmt::format("{}: trial '{}': fit window [{}, {}) outside its {} samples", db.path(),
+                                           i.trial_id, t.fit_begin, t.fit_end, p.t_s.size()));
     c.trials.push_back(std::move(t));
   }
   return c;

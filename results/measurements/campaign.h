@@ -35,8 +35,8 @@ struct MeasuredTrial {
 
 struct Campaign {
   std::string directory;
-  std::vector<MeasuredTrial> trials;  ///< the trials read and processed successfully
-  std::vector<ImportIssue> issues;    ///< one per rejected row, trace or unmeasurable trial
+  std::vector<MeasuredTrial> trials;                         ///< the trials read and processed successfully
+  std::vector<ImportIssue> issues;                           ///< one per rejected row, trace or unmeasurable trial
   [[nodiscard]] std::vector<double> gravity_levels() const;  ///< same_gravity_level(), descending
 };
 

@@ -57,7 +57,8 @@ bool CsvReader::next(std::vector<std::string>& fields, int& line) {
       for (;;) {
         if (i >= text.size()) {
           std::string more;
-          if (!std::getline(in_, more)) throw CsvSyntaxError{line, column, "unterminated quoted field (a closing \" expected)"};
+          if (!std::getline(in_, more))
+            throw CsvSyntaxError{line, column, "unterminated quoted field (a closing \" expected)"};
           ++line_;
           if (!more.empty() && more.back() == '\r') more.pop_back();
           cur.push_back('\n');

@@ -46,8 +46,9 @@ bool next_record(CsvReader& r, std::vector<std::string>& f, int& line, const std
 /// when it leads outside (an absolute path, '..', or a link pointing out).
 fs::path resolve_inside(const fs::path& dir, const std::string& rel, int line, int column) {
   auto refuse = [&](const std::string& why) {
-    return ParseError{{"trials.csv", line, column,
-                       fmt::format("column 'trace_file': '{}' {}; a path inside the campaign folder expected", rel, why)}};
+    return ParseError{
+        {"trials.csv", line, column,
+         fmt::format("column 'trace_file': '{}' {}; a path inside the campaign folder expected", rel, why)}};
   };
   if (rel.empty()) throw refuse("is empty");
   if (fs::path(rel).is_absolute()) throw refuse("is absolute");
@@ -70,7 +71,8 @@ Trace read_trace_csv(const fs::path& path, const std::string& rel, double declar
   CsvReader reader(in);
   std::vector<std::string> head, f;
   int ln = 0;
-  if (!next_record(reader, head, ln, rel)) throw ParseError{{rel, 1, 0, "empty file: header 't_s,accel_m_s2' expected"}};
+  if (!next_record(reader, head, ln, rel))
+    throw ParseError{{rel, 1, 0, "empty file: header 't_s,accel_m_s2' expected"}};
   int ct = -1, ca = -1, cz = -1, cv = -1;
   for (int i = 0; i < static_cast<int>(head.size()); ++i) {
     if (head[i] == "t_s") ct = i;
@@ -94,8 +96,8 @@ Trace read_trace_csv(const fs::path& path, const std::string& rel, double declar
     };
     const double t = get(ct, "t_s");
     if (!tr.t_s.empty() && !(t > tr.t_s.back()))
-      throw ParseError{{rel, ln, ct + 1,
-                        fmt::format("column 't_s': time must increase, got {} after {}", t, tr.t_s.back())}};
+      throw ParseError{
+          {rel, ln, ct + 1, fmt::format("column 't_s': time must increase, got {} after {}", t, tr.t_s.back())}};
     tr.t_s.push_back(t);
     lines.push_back(ln);
     tr.accel_up_m_s2.push_back(get(ca, "accel_m_s2"));
@@ -103,7 +105,8 @@ Trace read_trace_csv(const fs::path& path, const std::string& rel, double declar
     if (cv >= 0) tr.velocity_down_m_s.push_back(get(cv, "velocity_m_s"));
   }
   if (tr.t_s.size() < 8)
-    throw ParseError{{rel, ln, 0, fmt::format("only {} samples: a record from free fall to rest expected", tr.t_s.size())}};
+    throw ParseError{
+        {rel, ln, 0, fmt::format("only {} samples: a record from free fall to rest expected", tr.t_s.size())}};
   // The declared rate against the timestamps (median interval), then no gaps.
   std::vector<double> dt(tr.t_s.size() - 1);
   for (std::size_t i = 0; i + 1 < tr.t_s.size(); ++i) dt[i] = tr.t_s[i + 1] - tr.t_s[i];
@@ -158,7 +161,8 @@ MeasuredTrial read_row(const fs::path& dir, const std::map<std::string, int>& co
     const std::string s = text(name);
     double v;
     if (!parse_double(s, v))
-      throw ParseError{{"trials.csv", ln, i + 1, fmt::format("column '{}': expected a finite number, got '{}'", name, s)}};
+      throw ParseError{
+          {"trials.csv", ln, i + 1, fmt::format("column '{}': expected a finite number, got '{}'", name, s)}};
     if (positive && !(v > 0))
       throw ParseError{{"trials.csv", ln, i + 1, fmt::format("column '{}': expected a value > 0, got {}", name, v)}};
     return v;
@@ -187,8 +191,8 @@ MeasuredTrial read_row(const fs::path& dir, const std::map<std::string, int>& co
     ti.impact_velocity_m_s = num("impact_velocity_m_s", true);
   }
   for (const auto& [name, i] : col) {
-    const bool known = std::any_of(trial_fields().begin(), trial_fields().end(),
-                                   [&](const TrialField& fd) { return name == fd.key; });
+    const bool known =
+        std::any_of(trial_fields().begin(), trial_fields().end(), [&](const TrialField& fd) { return name == fd.key; });
     if (!known && i < static_cast<int>(f.size())) ti.attributes[name] = f[i];
   }
   // An explicit source column (`gravsweep export` writes "dem" for DEM drops as CSV traces).
@@ -220,8 +224,9 @@ MeasuredTrial read_row(const fs::path& dir, const std::map<std::string, int>& co
     if (ti.source == TraceSource::dem && !text("contact_start_s").empty()) {
       double s0;
       if (!parse_double(text("contact_start_s"), s0))
-        throw ParseError{{"trials.csv", ln, col.at("contact_start_s") + 1,
-                          fmt::format("column 'contact_start_s': expected a finite number, got '{}'", text("contact_start_s"))}};
+        throw ParseError{
+            {"trials.csv", ln, col.at("contact_start_s") + 1,
+             fmt::format("column 'contact_start_s': expected a finite number, got '{}'", text("contact_start_s"))}};
       t.raw.contact_start_s = s0;
     }
   }
@@ -237,9 +242,10 @@ Campaign load_campaign(const std::string& directory, double cutoff_hz) {
   const fs::path csv = dir / "trials.csv";
   std::ifstream in(csv);
   if (!in)
-    throw std::runtime_error(fmt::format("{}: cannot open (a campaign folder holds trials.csv and "
-                                         "traces/, see shared/formats/measurements.md)",
-                                         csv.string()));
+    throw std::runtime_error(
+        fmt::format("{}: cannot open (a campaign folder holds trials.csv and "
+                    "traces/, see shared/formats/measurements.md)",
+                    csv.string()));
   CsvReader reader(in);
   std::vector<std::string> head, f;
   int ln = 0;
@@ -252,7 +258,8 @@ Campaign load_campaign(const std::string& directory, double cutoff_hz) {
   std::map<std::string, int> col;
   for (int i = 0; i < static_cast<int>(head.size()); ++i) col[head[i]] = i;
   for (const auto& r : required_columns())
-    if (!col.count(r)) throw std::runtime_error(fmt::format("{}:{}: missing required column '{}'", csv.string(), ln, r));
+    if (!col.count(r))
+      throw std::runtime_error(fmt::format("{}:{}: missing required column '{}'", csv.string(), ln, r));
   std::set<std::string> ids;
   for (;;) {
     try {

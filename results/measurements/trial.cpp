@@ -36,8 +36,10 @@ void to_json(nlohmann::json& j, const Trial& t) {
   j = nlohmann::json::object();
   j["source"] = to_string(t.source);
   for (const auto& f : trial_fields()) {
-    if (f.number) j[f.key] = t.*f.number;
-    else j[f.key] = t.*f.text;
+    if (f.number)
+      j[f.key] = t.*f.number;
+    else
+      j[f.key] = t.*f.text;
   }
   j["attributes"] = t.attributes;
 }
@@ -47,8 +49,10 @@ void from_json(const nlohmann::json& j, Trial& t) {
   if (j.contains("source")) t.source = trace_source_of(j.at("source").get<std::string>());
   for (const auto& f : trial_fields()) {
     if (!j.contains(f.key) || j.at(f.key).is_null()) continue;
-    if (f.number) t.*f.number = j.at(f.key).get<double>();
-    else t.*f.text = j.at(f.key).get<std::string>();
+    if (f.number)
+      t.*f.number = j.at(f.key).get<double>();
+    else
+      t.*f.text = j.at(f.key).get<std::string>();
   }
   if (j.contains("attributes") && j.at("attributes").is_object())
     t.attributes = j.at("attributes").get<std::map<std::string, std::string>>();
@@ -67,9 +71,7 @@ MetricOptions metric_options(const Trial& t) {
   return o;
 }
 
-bool same_gravity_level(double a, double b) {
-  return std::abs(a - b) <= 1e-6 * std::max(std::abs(a), std::abs(b));
-}
+bool same_gravity_level(double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(std::abs(a), std::abs(b)); }
 
 std::vector<double> gravity_levels_of(const std::vector<double>& gs) {
   std::vector<double> levels;

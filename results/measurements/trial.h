@@ -18,24 +18,24 @@ namespace gravsweep::results {
 struct Trial {
   std::string trial_id;
   TraceSource source = TraceSource::lab;
-  std::string trace_file;             ///< relative to the campaign folder (lab) or absolute (dem)
+  std::string trace_file;  ///< relative to the campaign folder (lab) or absolute (dem)
   double gravity_m_s2 = 0;
-  double impact_velocity_m_s = 0;     ///< downward speed at first contact
-  double fill_height_m = 0;           ///< bed depth: the floor below the surface (dem: measured surface height)
+  double impact_velocity_m_s = 0;  ///< downward speed at first contact
+  double fill_height_m = 0;        ///< bed depth: the floor below the surface (dem: measured surface height)
   double projectile_mass_kg = 0;
   double projectile_diameter_m = 0;
   double grain_diameter_m = 0;
   double bulk_density_kg_m3 = 0;
-  double sample_rate_hz = 0;          ///< declared; checked against the timestamps
-  double drop_height_m = 0;           ///< 0 when absent; v = sqrt(2 g h) when the speed is empty
+  double sample_rate_hz = 0;  ///< declared; checked against the timestamps
+  double drop_height_m = 0;   ///< 0 when absent; v = sqrt(2 g h) when the speed is empty
   // Processing settings (Sunday et al. 2021 Sect. 2.3): the scenario's /output settings for a DEM
   // drop, the import's --cutoff and the paper's values for a lab record.
   double filter_cutoff_hz = 500.0;
   double end_threshold_g = 0.1;
   double end_speed_fraction = 0.1;
   // Provenance.
-  std::string job_id;                 ///< campaign drop job (dem), empty otherwise
-  std::string code_version;           ///< gravsweep version that wrote a DEM trace
+  std::string job_id;                             ///< campaign drop job (dem), empty otherwise
+  std::string code_version;                       ///< gravsweep version that wrote a DEM trace
   std::map<std::string, std::string> attributes;  ///< other trials.csv columns, kept as they are
 };
 
@@ -54,11 +54,11 @@ struct ImportIssue {
 
 /// One field of Trial and its names everywhere. A field is numeric (`number`) or text (`text`).
 struct TrialField {
-  const char* key;         ///< JSON key, CSV header and SQLite column (one name: units in it)
-  const char* hdf5_attr;   ///< attribute of /trace in trace.h5 that holds it, nullptr if none
-  const char* unit;        ///< SI unit ("" for text)
-  bool csv_required;       ///< required column of trials.csv (measurements.md)
-  double Trial::*number;   ///< nullptr for text fields
+  const char* key;        ///< JSON key, CSV header and SQLite column (one name: units in it)
+  const char* hdf5_attr;  ///< attribute of /trace in trace.h5 that holds it, nullptr if none
+  const char* unit;       ///< SI unit ("" for text)
+  bool csv_required;      ///< required column of trials.csv (measurements.md)
+  double Trial::*number;  ///< nullptr for text fields
   std::string Trial::*text;
 };
 /// The table, in the order of trials.csv's required columns first.

@@ -23,7 +23,7 @@ std::vector<AxisResidual> residual_axes(const FittedModel& m, const Campaign& c)
     double x[6];
     int trial;
   };
-  static const char* names[6] = {"depth_m", "speed_m_s", "time_since_contact_s",
+  static const char* names[6] = {"depth_m",      "speed_m_s",           "time_since_contact_s",
                                  "gravity_m_s2", "impact_velocity_m_s", "fill_height_m"};
   std::vector<S> s;
   for (std::size_t ti = 0; ti < c.trials.size(); ++ti) {
@@ -114,8 +114,8 @@ std::vector<AxisResidual> residual_axes(const FittedModel& m, const Campaign& c)
     }
     if (a < 3) {
       // Within-trial slope of r against the axis; sign test over trials.
-      std::vector<double> sx(c.trials.size()), sy(c.trials.size()), sxx(c.trials.size()),
-          sxy(c.trials.size()), sn(c.trials.size());
+      std::vector<double> sx(c.trials.size()), sy(c.trials.size()), sxx(c.trials.size()), sxy(c.trials.size()),
+          sn(c.trials.size());
       for (const auto& q : s) {
         const auto t = static_cast<std::size_t>(q.trial);
         sx[t] += q.x[a], sy[t] += q.r, sxx[t] += q.x[a] * q.x[a], sxy[t] += q.x[a] * q.r, sn[t] += 1;
@@ -170,9 +170,10 @@ std::string strongest_axis(const std::vector<AxisResidual>& axes) {
     if (a.axis == "depth_m" || a.axis == "speed_m_s" || a.axis == "time_since_contact_s")
       if (!best || a.eta2 > best->eta2) best = &a;
   if (!best) return "along no axis the binned residuals show";
-  return fmt::format("along {} (eta^2 = {:.2f}, split-half r = {:.2f}; shown by the held-out test below, not by the "
-                     "binned residuals alone)",
-                     best->axis, best->eta2, best->split_half_r);
+  return fmt::format(
+      "along {} (eta^2 = {:.2f}, split-half r = {:.2f}; shown by the held-out test below, not by the "
+      "binned residuals alone)",
+      best->axis, best->eta2, best->split_half_r);
 }
 
 /// Each candidate added to `current` on its own, ranked by held-out improvement over `current`
@@ -189,7 +190,9 @@ std::vector<Candidate> rank_candidates(const ModelSpec& current, const Campaign&
     s.terms.push_back(mt);
     const HeldOut h1 = cross_validate(s, c, folds, 1, false);
     Candidate cd;
-    cd.term = mt.term->name + (mt.per_gravity == mt.term->per_gravity ? "" : mt.per_gravity ? ":per_gravity" : ":shared");
+    cd.term = mt.term->name + (mt.per_gravity == mt.term->per_gravity ? ""
+                               : mt.per_gravity                       ? ":per_gravity"
+                                                                      : ":shared");
     double sum = 0;
     std::vector<double> rel_all;
     for (std::size_t i = 0; i < c.trials.size(); ++i) {
@@ -214,9 +217,10 @@ std::vector<Candidate> rank_candidates(const ModelSpec& current, const Campaign&
 }
 
 std::string improvement_words(const Candidate& cd) {
-  return fmt::format("held-out trace error down {:.0f} % on average, better on {} of {} trials (signed-rank test "
-                     "over trials p = {:.1e})",
-                     100 * cd.mean_rel_improvement, cd.trials_better, cd.trials, cd.p_value);
+  return fmt::format(
+      "held-out trace error down {:.0f} % on average, better on {} of {} trials (signed-rank test "
+      "over trials p = {:.1e})",
+      100 * cd.mean_rel_improvement, cd.trials_better, cd.trials, cd.p_value);
 }
 
 /// The sentence for users (issue 13 item 3: humble where the named terms leave structure).
@@ -230,8 +234,9 @@ std::string verdict_of(const Discovery& d, const std::string& where_named, const
   } else {
     const auto& first = d.rounds.front().front();
     const TermInfo& w = find_term(first.term.substr(0, first.term.find(':')));
-    v = fmt::format("{} {} ({}); {}; references: {}", d.structure_left ? "partly explained by" : "missing effect:",
-                    w.name, w.meaning, improvement_words(first), w.references);
+    v = fmt::format("{} {} ({}); {}; references: {}",
+                    d.structure_left ? "partly explained by" : "missing effect:", w.name, w.meaning,
+                    improvement_words(first), w.references);
     for (std::size_t i = 1; i < d.added.size(); ++i) v += "; then " + d.added[i];
     if (d.structure_left) v += "; structure left " + where_named;
   }
@@ -255,12 +260,12 @@ std::string verdict_of(const Discovery& d, const std::string& where_named, const
       "it: trace {:.1f} -> {:.1f} %, zstop {:.1f} -> {:.1f} %, tstop {:.1f} -> {:.1f} %, apeak {:.1f} -> {:.1f} %; "
       "fit it with --model '{}'",
       t.name, g.term.find(":shared") != std::string::npos ? " (shared by the gravity levels)" : "",
-      generated_words(t.name), improvement_words(g),
-      b.trace_rel_pct, a.trace_rel_pct, b.zstop_rel_pct, a.zstop_rel_pct, b.tstop_rel_pct, a.tstop_rel_pct,
-      b.apeak_rel_pct, a.apeak_rel_pct, d.generated_model);
+      generated_words(t.name), improvement_words(g), b.trace_rel_pct, a.trace_rel_pct, b.zstop_rel_pct, a.zstop_rel_pct,
+      b.tstop_rel_pct, a.tstop_rel_pct, b.apeak_rel_pct, a.apeak_rel_pct, d.generated_model);
   if (!d.generated_equivalent.empty()) {
     std::string list;
-    for (std::size_t i = 0; i < d.generated_equivalent.size() && i < 5; ++i) list += (i ? ", " : "") + d.generated_equivalent[i];
+    for (std::size_t i = 0; i < d.generated_equivalent.size() && i < 5; ++i)
+      list += (i ? ", " : "") + d.generated_equivalent[i];
     if (d.generated_equivalent.size() > 5) list += fmt::format(" and {} more", d.generated_equivalent.size() - 5);
     v += fmt::format("; forms these trials cannot tell apart from it (signed-rank p >= 0.05): {}", list);
   }

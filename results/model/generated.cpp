@@ -42,11 +42,16 @@ bool strip(const std::string& s, const std::string& head, const std::string& tai
 std::optional<Factor> parse_factor(const std::string& s) {
   std::string inner;
   Factor f{};
-  if (strip(s, "z^", "", inner)) f.kind = Factor::depth_power;
-  else if (strip(s, "v^", "", inner)) f.kind = Factor::speed_power;
-  else if (strip(s, "(1-exp(-z/", "))", inner)) f.kind = Factor::saturate;
-  else if (strip(s, "exp(-z/", ")", inner)) f.kind = Factor::decay;
-  else return std::nullopt;
+  if (strip(s, "z^", "", inner))
+    f.kind = Factor::depth_power;
+  else if (strip(s, "v^", "", inner))
+    f.kind = Factor::speed_power;
+  else if (strip(s, "(1-exp(-z/", "))", inner))
+    f.kind = Factor::saturate;
+  else if (strip(s, "exp(-z/", ")", inner))
+    f.kind = Factor::decay;
+  else
+    return std::nullopt;
   const auto p = number(inner);
   if (!p) return std::nullopt;
   f.p = *p;
@@ -73,9 +78,8 @@ std::optional<std::vector<Factor>> parse_form(const std::string& name) {
     begin = i + 1;
   }
   if (out.empty()) return std::nullopt;
-  std::stable_sort(out.begin(), out.end(), [](const Factor& a, const Factor& b) {
-    return a.kind != b.kind ? a.kind < b.kind : a.p < b.p;
-  });
+  std::stable_sort(out.begin(), out.end(),
+                   [](const Factor& a, const Factor& b) { return a.kind != b.kind ? a.kind < b.kind : a.p < b.p; });
   std::vector<Factor> kept;
   for (const auto& f : out)
     if (!((f.kind == Factor::depth_power || f.kind == Factor::speed_power) && f.p == 0)) kept.push_back(f);
@@ -88,10 +92,18 @@ std::string name_of(const std::vector<Factor>& fs) {
   for (const auto& f : fs) {
     if (!s.empty()) s += "*";
     switch (f.kind) {
-      case Factor::depth_power: s += fmt::format("z^{:g}", f.p); break;
-      case Factor::speed_power: s += fmt::format("v^{:g}", f.p); break;
-      case Factor::decay: s += fmt::format("exp(-z/{:g})", f.p); break;
-      case Factor::saturate: s += fmt::format("(1-exp(-z/{:g}))", f.p); break;
+      case Factor::depth_power:
+        s += fmt::format("z^{:g}", f.p);
+        break;
+      case Factor::speed_power:
+        s += fmt::format("v^{:g}", f.p);
+        break;
+      case Factor::decay:
+        s += fmt::format("exp(-z/{:g})", f.p);
+        break;
+      case Factor::saturate:
+        s += fmt::format("(1-exp(-z/{:g}))", f.p);
+        break;
     }
   }
   return s;
@@ -102,10 +114,18 @@ std::string words_of(const std::vector<Factor>& fs) {
   for (const auto& f : fs) {
     if (!s.empty()) s += " times ";
     switch (f.kind) {
-      case Factor::depth_power: s += f.p == 0 ? "a constant" : fmt::format("depth to the power {:g}", f.p); break;
-      case Factor::speed_power: s += fmt::format("speed to the power {:g}", f.p); break;
-      case Factor::decay: s += fmt::format("a decay with depth over {:g} mm", 1e3 * f.p); break;
-      case Factor::saturate: s += fmt::format("a rise with depth saturating over {:g} mm", 1e3 * f.p); break;
+      case Factor::depth_power:
+        s += f.p == 0 ? "a constant" : fmt::format("depth to the power {:g}", f.p);
+        break;
+      case Factor::speed_power:
+        s += fmt::format("speed to the power {:g}", f.p);
+        break;
+      case Factor::decay:
+        s += fmt::format("a decay with depth over {:g} mm", 1e3 * f.p);
+        break;
+      case Factor::saturate:
+        s += fmt::format("a rise with depth saturating over {:g} mm", 1e3 * f.p);
+        break;
     }
   }
   return s;
@@ -117,10 +137,18 @@ double phi(const std::vector<Factor>& fs, double z_m, double v_m_s) {
   double r = 1.0;
   for (const auto& f : fs) {
     switch (f.kind) {
-      case Factor::depth_power: r *= f.p == 0 ? 1.0 : std::pow(z, f.p); break;
-      case Factor::speed_power: r *= f.p == 0 ? 1.0 : std::pow(v, f.p); break;
-      case Factor::decay: r *= std::exp(-z / f.p); break;
-      case Factor::saturate: r *= 1.0 - std::exp(-z / f.p); break;
+      case Factor::depth_power:
+        r *= f.p == 0 ? 1.0 : std::pow(z, f.p);
+        break;
+      case Factor::speed_power:
+        r *= f.p == 0 ? 1.0 : std::pow(v, f.p);
+        break;
+      case Factor::decay:
+        r *= std::exp(-z / f.p);
+        break;
+      case Factor::saturate:
+        r *= 1.0 - std::exp(-z / f.p);
+        break;
     }
   }
   return r;

@@ -103,10 +103,13 @@ ModelSpec parse_model(const std::string& text) {
       }
       mt.term = &find_term(name);
       mt.per_gravity = mt.term->per_gravity;
-      if (mode == "shared") mt.per_gravity = false;
-      else if (mode == "per_gravity") mt.per_gravity = true;
+      if (mode == "shared")
+        mt.per_gravity = false;
+      else if (mode == "per_gravity")
+        mt.per_gravity = true;
       else if (!mode.empty())
-        throw std::invalid_argument(fmt::format("model '{}': '{}' after ':' must be shared or per_gravity", text, mode));
+        throw std::invalid_argument(
+            fmt::format("model '{}': '{}' after ':' must be shared or per_gravity", text, mode));
       mt.scale = scale;
       spec.terms.push_back(mt);
     }
@@ -185,8 +188,7 @@ double binom_tail_half(int k, int n) {
   // P(X >= k), X ~ Binomial(n, 1/2)
   double p = 0;
   for (int i = k; i <= n; ++i)
-    p += std::exp(std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) -
-                  n * std::log(2.0));
+    p += std::exp(std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) - n * std::log(2.0));
   return std::min(1.0, p);
 }
 
@@ -225,9 +227,8 @@ std::vector<int> fold_of(const Campaign& c, int folds, unsigned seed) {
   std::vector<int> level(idx.size(), 0);
   for (std::size_t i = 0; i < idx.size(); ++i)
     while (!same_gravity_level(levels[static_cast<std::size_t>(level[i])], c.trials[i].info.gravity_m_s2)) ++level[i];
-  std::sort(idx.begin(), idx.end(), [&](int a, int b) {
-    return level[a] != level[b] ? level[a] < level[b] : key[a] < key[b];
-  });
+  std::sort(idx.begin(), idx.end(),
+            [&](int a, int b) { return level[a] != level[b] ? level[a] < level[b] : key[a] < key[b]; });
   std::vector<int> f(idx.size());
   for (std::size_t r = 0; r < idx.size(); ++r) f[idx[r]] = static_cast<int>(r % folds);
   return f;
@@ -236,7 +237,6 @@ std::vector<int> fold_of(const Campaign& c, int folds, unsigned seed) {
 }  // namespace detail
 
 using namespace detail;
-
 
 int FittedModel::gravity_index(double g) const {
   for (std::size_t i = 0; i < gravity_levels.size(); ++i)
@@ -322,7 +322,8 @@ FittedModel fit_model(const ModelSpec& spec, const Campaign& c, const std::vecto
   Eigen::VectorXd u = Eigen::VectorXd::Zero(L.cols);
   for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(rows); ++i) {
     u += Xw.row(i).transpose() * res(i);
-    if (i + 1 == static_cast<Eigen::Index>(rows) || cluster[static_cast<std::size_t>(i + 1)] != cluster[static_cast<std::size_t>(i)]) {
+    if (i + 1 == static_cast<Eigen::Index>(rows) ||
+        cluster[static_cast<std::size_t>(i + 1)] != cluster[static_cast<std::size_t>(i)]) {
       meat += u * u.transpose();
       u.setZero();
     }
@@ -348,8 +349,8 @@ double trial_trace_mse(const FittedModel& m, const MeasuredTrial& t) {
 }
 
 std::vector<const std::vector<double>*> same_level_fluctuations(const Campaign& c,
-                                                              const std::vector<std::vector<double>>& fluct,
-                                                              std::size_t i) {
+                                                                const std::vector<std::vector<double>>& fluct,
+                                                                std::size_t i) {
   std::vector<const std::vector<double>*> out;
   for (std::size_t j = 0; j < fluct.size() && out.size() < kMaxFluctuationTrials; ++j)
     if (j != i && !fluct[j].empty() && same_gravity_level(c.trials[j].info.gravity_m_s2, c.trials[i].info.gravity_m_s2))
@@ -357,8 +358,7 @@ std::vector<const std::vector<double>*> same_level_fluctuations(const Campaign& 
   return out;
 }
 
-HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds, unsigned seed,
-                       bool with_predictions) {
+HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds, unsigned seed, bool with_predictions) {
   HeldOut h;
   h.trace_mse.assign(c.trials.size(), NAN);
   h.pred.assign(c.trials.size(), Prediction{});

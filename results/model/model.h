@@ -20,7 +20,7 @@ struct ModelTerm {
 
 struct ModelSpec {
   std::vector<ModelTerm> terms;
-  [[nodiscard]] std::string name() const;  ///< "base+depth_friction"
+  [[nodiscard]] std::string name() const;                      ///< "base+depth_friction"
   [[nodiscard]] bool has(const std::string& term_name) const;  ///< a term of that name is in the spec
 };
 
@@ -85,19 +85,18 @@ Trace model_record(const FittedModel& m, const MeasuredTrial& t);
 /// not to use) from trials at trial i's gravity level other than i itself, in trial order.
 inline constexpr std::size_t kMaxFluctuationTrials = 12;
 std::vector<const std::vector<double>*> same_level_fluctuations(const Campaign& c,
-                                                              const std::vector<std::vector<double>>& fluct,
-                                                              std::size_t i);
+                                                                const std::vector<std::vector<double>>& fluct,
+                                                                std::size_t i);
 
 /// Per-trial held-out results of grouped K-fold cross-validation (whole trials held out); apeak
 /// as measured with the training trials' fluctuations at the trial's level.
 struct HeldOut {
-  std::vector<double> trace_mse;   ///< per trial
-  std::vector<Prediction> pred;    ///< per trial, from the model fitted without that trial
+  std::vector<double> trace_mse;  ///< per trial
+  std::vector<Prediction> pred;   ///< per trial, from the model fitted without that trial
 };
 HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds = 6, unsigned seed = 1);
 /// The same; without predictions (trace residuals only) when with_predictions is false.
-HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds, unsigned seed,
-                       bool with_predictions);
+HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds, unsigned seed, bool with_predictions);
 
 /// Summary errors against the measured metrics (RMS over trials; relative in %).
 struct ErrorSummary {
@@ -152,9 +151,9 @@ struct Candidate {
 struct Discovery {
   std::string baseline;
   std::vector<std::vector<Candidate>> rounds;  ///< ranking of the named terms per forward step
-  std::vector<std::string> added;               ///< named winners, in order
-  std::string verdict;                          ///< the sentence for users
-  bool structure_left = false;                  ///< residuals structured after the named additions
+  std::vector<std::string> added;              ///< named winners, in order
+  std::string verdict;                         ///< the sentence for users
+  bool structure_left = false;                 ///< residuals structured after the named additions
   std::vector<AxisResidual> residual_before, residual_after;
   /// The search beyond the named library (generated.h), run when the named terms were added or
   /// left structure: the nested-CV test of choosing a form (its `term` is the form chosen on all
@@ -166,7 +165,7 @@ struct Discovery {
   std::vector<Candidate> generated_screened;
   std::string generated;
   std::vector<std::string> generated_equivalent;  ///< forms the trials cannot tell apart from it
-  bool generated_worsens_metrics = false;  ///< significant on the trace, but zstop or tstop worse held out
+  bool generated_worsens_metrics = false;         ///< significant on the trace, but zstop or tstop worse held out
   std::string generated_model;
   bool structure_left_after_generated = false;
   ErrorSummary errors_without_generated, errors_with_generated;

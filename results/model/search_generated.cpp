@@ -72,7 +72,8 @@ std::vector<std::string> equivalent_forms(const std::vector<Screened>& ranked, c
   for (std::size_t j = 1; j < ranked.size(); ++j) {
     std::vector<double> worse;
     for (std::size_t i = 0; i < before.size(); ++i)
-      if (std::isfinite(before[i]) && before[i] > 0 && std::isfinite(ranked[j].mse[i]) && std::isfinite(ranked[0].mse[i]))
+      if (std::isfinite(before[i]) && before[i] > 0 && std::isfinite(ranked[j].mse[i]) &&
+          std::isfinite(ranked[0].mse[i]))
         worse.push_back((ranked[j].mse[i] - ranked[0].mse[i]) / before[i]);
     if (signed_rank_p(worse) >= kEquivalentLevel) out.push_back(ranked[j].term->name);
   }
@@ -122,7 +123,8 @@ GeneratedSearch search_generated(const ModelSpec& current, const Campaign& c, in
     with.terms.push_back({on_train.ranked.front().term, chosen.per_gravity, 1.0});
     const FittedModel m1 = fit_model(with, c, train);
     for (std::size_t i = 0; i < n; ++i)
-      if (!train[i]) mse0[i] = trial_trace_mse(on_train.current, c.trials[i]), mse1[i] = trial_trace_mse(m1, c.trials[i]);
+      if (!train[i])
+        mse0[i] = trial_trace_mse(on_train.current, c.trials[i]), mse1[i] = trial_trace_mse(m1, c.trials[i]);
   }
   Candidate& cd = g.test;
   cd.term = chosen.term->name + (chosen.per_gravity ? "" : ":shared");

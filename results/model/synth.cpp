@@ -12,8 +12,7 @@
 
 namespace gravsweep::results {
 
-FittedModel truth_model(const ModelSpec& spec, const std::vector<double>& levels, double mass,
-                        double diameter) {
+FittedModel truth_model(const ModelSpec& spec, const std::vector<double>& levels, double mass, double diameter) {
   FittedModel m;
   m.spec = spec;
   m.gravity_levels = levels;
@@ -110,8 +109,10 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
           // advance to the next sample
           while (tc + dt <= t_next + 1e-15) {
             const double k1v = accel_down(z, v, tc, ou), k1z = v;
-            const double k2v = accel_down(z + 0.5 * dt * k1z, v + 0.5 * dt * k1v, tc + 0.5 * dt, ou), k2z = v + 0.5 * dt * k1v;
-            const double k3v = accel_down(z + 0.5 * dt * k2z, v + 0.5 * dt * k2v, tc + 0.5 * dt, ou), k3z = v + 0.5 * dt * k2v;
+            const double k2v = accel_down(z + 0.5 * dt * k1z, v + 0.5 * dt * k1v, tc + 0.5 * dt, ou),
+                         k2z = v + 0.5 * dt * k1v;
+            const double k3v = accel_down(z + 0.5 * dt * k2z, v + 0.5 * dt * k2v, tc + 0.5 * dt, ou),
+                         k3z = v + 0.5 * dt * k2v;
             const double k4v = accel_down(z + dt * k3z, v + dt * k3v, tc + dt, ou), k4z = v + dt * k3v;
             const double vn = v + dt / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
             const double zn = z + dt / 6 * (k1z + 2 * k2z + 2 * k3z + k4z);
@@ -144,15 +145,18 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
         const int total = first + static_cast<int>(a_samples.size()) + n_after;
         for (int i = 0; i < total; ++i) {
           double a;
-          if (i < first) a = -g;
-          else if (i < first + static_cast<int>(a_samples.size())) a = a_samples[static_cast<std::size_t>(i - first)];
-          else a = 0.0;
+          if (i < first)
+            a = -g;
+          else if (i < first + static_cast<int>(a_samples.size()))
+            a = a_samples[static_cast<std::size_t>(i - first)];
+          else
+            a = 0.0;
           a += bias + o.sensor_noise_g * g_sensor * n01(rng);
           tr << fmt::format("{:.6f},{:.5g}\n", i / fs_hz, a);
         }
         const double v_rep = v0 * (1.0 + o.speed_spread * n01(rng));
-        csv << fmt::format("{},{},{},{:.4f},{},{},{},{},{},{}\n", name, rel, g, v_rep, H, o.mass_kg,
-                           o.diameter_m, o.grain_diameter_m, o.bulk_density_kg_m3, fs_hz);
+        csv << fmt::format("{},{},{},{:.4f},{},{},{},{},{},{}\n", name, rel, g, v_rep, H, o.mass_kg, o.diameter_m,
+                           o.grain_diameter_m, o.bulk_density_kg_m3, fs_hz);
         truth_csv << fmt::format("{},{:.9g},{:.9g},{:.9g}\n", name, zstop, tstop, t_free);
       }
     }

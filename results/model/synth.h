@@ -20,25 +20,25 @@ struct SynthOptions {
   double bulk_density_kg_m3 = 1450;
   double sample_rate_hz = 1400;
   // Noise model
-  double sensor_noise_g = 0.015;   ///< white sensor noise, in units of the trial's g (see below)
-  double sensor_bias_g = 0.01;     ///< std of the constant per-trial bias, in g (see below)
+  double sensor_noise_g = 0.015;  ///< white sensor noise, in units of the trial's g (see below)
+  double sensor_bias_g = 0.01;    ///< std of the constant per-trial bias, in g (see below)
   /// true: noise and bias scale with the trial's g (an accelerometer range chosen for each
   /// level); false: they are in units of the standard 9.81 m/s2 at every level (one sensor for
   /// all, so 0.1 g of a low-gravity level drowns in it).
   bool noise_scales_with_g = true;
-  double rest_tail_s = 0.1;        ///< record length after the projectile comes to rest
-  double force_fluct = 0.2;        ///< multiplicative grain-scale fluctuation (std)
+  double rest_tail_s = 0.1;  ///< record length after the projectile comes to rest
+  double force_fluct = 0.2;  ///< multiplicative grain-scale fluctuation (std)
   double force_fluct_tau_s = 1.5e-3;
-  double bed_spread_f0 = 0.08;     ///< per-trial relative spread of friction-like terms
-  double bed_spread_drag = 0.05;   ///< per-trial relative spread of 1/d1
-  double speed_spread = 0.005;     ///< relative scatter of the reported impact speed
-  double contact_ramp_m = 1e-3;    ///< force ramps in over the first millimetre
+  double bed_spread_f0 = 0.08;    ///< per-trial relative spread of friction-like terms
+  double bed_spread_drag = 0.05;  ///< per-trial relative spread of 1/d1
+  double speed_spread = 0.005;    ///< relative scatter of the reported impact speed
+  double contact_ramp_m = 1e-3;   ///< force ramps in over the first millimetre
   unsigned seed = 1;
 };
 
 /// The model with its terms' typical values (times each term's scale) at the given levels.
-FittedModel truth_model(const ModelSpec& spec, const std::vector<double>& gravity_m_s2,
-                        double mass_kg, double diameter_m);
+FittedModel truth_model(const ModelSpec& spec, const std::vector<double>& gravity_m_s2, double mass_kg,
+                        double diameter_m);
 
 /// The file of true metrics that write_synthetic_campaign puts beside trials.csv: trial_id,
 /// zstop_m, tstop_s (contact to rest of the integrated motion, before noise and filtering) and

@@ -34,9 +34,10 @@ std::vector<Table3Row> table3_of(const Campaign& c, const std::vector<bool>& mas
     }
     if (r.trials < kTable3MinTrials || !(vmax >= kTable3MinSpeedRatio * vmin)) {
       r.note = ts.empty() ? "no trials"
-                          : fmt::format("not fitted: Eq. 2 needs >= {} trials over a vc range of x{} (found {}, vc "
-                                        "{:.3g}-{:.3g} m/s)",
-                                        kTable3MinTrials, kTable3MinSpeedRatio, r.trials, vmin, vmax);
+                          : fmt::format(
+                                "not fitted: Eq. 2 needs >= {} trials over a vc range of x{} (found {}, vc "
+                                "{:.3g}-{:.3g} m/s)",
+                                kTable3MinTrials, kTable3MinSpeedRatio, r.trials, vmin, vmax);
       rows.push_back(r);
       continue;
     }
@@ -56,8 +57,7 @@ std::vector<Table3Row> table3_of(const Campaign& c, const std::vector<bool>& mas
       Xl(i, 1) = std::log(drop + m.zstop_m);  // H = drop height + zstop (Fig. 10)
       yl(i) = std::log(std::max(m.zstop_m, 1e-9));
     }
-    auto ols = [](const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::Vector2d& beta,
-                  Eigen::Matrix2d& cov) {
+    auto ols = [](const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::Vector2d& beta, Eigen::Matrix2d& cov) {
       beta = A.colPivHouseholderQr().solve(b);
       const double dof = std::max<double>(1.0, static_cast<double>(A.rows()) - 2.0);
       const double s2 = (b - A * beta).squaredNorm() / dof;
@@ -88,9 +88,7 @@ std::vector<Table3Row> table3_of(const Campaign& c, const std::vector<bool>& mas
 
 }  // namespace
 
-std::vector<Table3Row> table3(const Campaign& c) {
-  return table3_of(c, std::vector<bool>(c.trials.size(), true));
-}
+std::vector<Table3Row> table3(const Campaign& c) { return table3_of(c, std::vector<bool>(c.trials.size(), true)); }
 
 Prediction predict_paper(const Table3Row& row, double m, double vc) {
   Prediction p;
@@ -98,9 +96,8 @@ Prediction predict_paper(const Table3Row& row, double m, double vc) {
   p.apeak_m_s2 = f0 / m + vc * vc * inv_d1 - g;  // Eq. 2
   if (!(f0 > m * g) || !(inv_d1 > 0)) return p;
   const double d1 = 1.0 / inv_d1;
-  p.zstop_m = 0.5 * d1 * std::log(1.0 + m * vc * vc / (d1 * (f0 - m * g)));           // Eq. 3
-  p.tstop_s = std::atan(vc * std::sqrt(m / (d1 * (f0 - m * g)))) /
-              std::sqrt((f0 / m - g) / d1);                                            // Eq. 4
+  p.zstop_m = 0.5 * d1 * std::log(1.0 + m * vc * vc / (d1 * (f0 - m * g)));                       // Eq. 3
+  p.tstop_s = std::atan(vc * std::sqrt(m / (d1 * (f0 - m * g)))) / std::sqrt((f0 / m - g) / d1);  // Eq. 4
   p.stopped = true;
   return p;
 }

@@ -25,10 +25,10 @@ struct TermContext {
 };
 
 struct TermInfo {
-  std::string name;        ///< as used in model specs: "depth_friction"
-  std::string meaning;     ///< one line of physics
-  std::string references;  ///< where it comes from
-  std::string signature;   ///< what the residual looks like when it is missing
+  std::string name;                 ///< as used in model specs: "depth_friction"
+  std::string meaning;              ///< one line of physics
+  std::string references;           ///< where it comes from
+  std::string signature;            ///< what the residual looks like when it is missing
   std::vector<std::string> params;  ///< parameter names with units: "k_N_m"
   bool per_gravity = true;          ///< default sharing: one value per gravity level, or shared
   /// Resisting force (N, positive up, i.e. opposing a downward motion) per unit of each parameter.

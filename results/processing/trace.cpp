@@ -75,18 +75,15 @@ std::vector<Section> butterworth_sections(double fs, double fc, int order) {
 void validate(const Trace& tr) {
   const std::size_t n = tr.t_s.size();
   if (tr.accel_up_m_s2.size() != n)
-    throw std::invalid_argument(fmt::format("accel_m_s2 has {} samples but t_s has {}",
-                                            tr.accel_up_m_s2.size(), n));
+    throw std::invalid_argument(fmt::format("accel_m_s2 has {} samples but t_s has {}", tr.accel_up_m_s2.size(), n));
   if (!tr.depth_m.empty() && tr.depth_m.size() != n)
-    throw std::invalid_argument(fmt::format("position_m has {} samples but t_s has {}",
-                                            tr.depth_m.size(), n));
+    throw std::invalid_argument(fmt::format("position_m has {} samples but t_s has {}", tr.depth_m.size(), n));
   if (!tr.velocity_down_m_s.empty() && tr.velocity_down_m_s.size() != n)
-    throw std::invalid_argument(fmt::format("velocity_m_s has {} samples but t_s has {}",
-                                            tr.velocity_down_m_s.size(), n));
+    throw std::invalid_argument(
+        fmt::format("velocity_m_s has {} samples but t_s has {}", tr.velocity_down_m_s.size(), n));
   if (tr.source == TraceSource::dem && (tr.velocity_down_m_s.empty() || tr.depth_m.empty()))
     throw std::invalid_argument("a DEM trace carries its own velocity and depth; this one has none");
-  if (n < 8)
-    throw std::invalid_argument(fmt::format("trace too short: {} samples, at least 8 expected", n));
+  if (n < 8) throw std::invalid_argument(fmt::format("trace too short: {} samples, at least 8 expected", n));
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isfinite(tr.t_s[i]) || !std::isfinite(tr.accel_up_m_s2[i]))
       throw TraceError(fmt::format("sample {} is not a finite number", i), i, !std::isfinite(tr.accel_up_m_s2[i]));
@@ -96,9 +93,8 @@ void validate(const Trace& tr) {
                                    i, tr.t_s[i], tr.accel_up_m_s2[i], kMaxAccel_m_s2),
                        i, true);
     if (i > 0 && !(tr.t_s[i] > tr.t_s[i - 1]))
-      throw TraceError(fmt::format("time does not increase at sample {} (t_s = {} after {})", i, tr.t_s[i],
-                                   tr.t_s[i - 1]),
-                       i);
+      throw TraceError(
+          fmt::format("time does not increase at sample {} (t_s = {} after {})", i, tr.t_s[i], tr.t_s[i - 1]), i);
   }
 }
 
@@ -112,12 +108,11 @@ TraceSource trace_source_of(const std::string& s) {
   throw std::invalid_argument(fmt::format("trace source '{}': expected 'lab' or 'dem'", s));
 }
 
-std::vector<double> butterworth_lowpass(const std::vector<double>& x, double sample_rate_hz,
-                                        double cutoff_hz, int order) {
+std::vector<double> butterworth_lowpass(const std::vector<double>& x, double sample_rate_hz, double cutoff_hz,
+                                        int order) {
   if (!(sample_rate_hz > 0) || !(cutoff_hz > 0) || cutoff_hz >= 0.5 * sample_rate_hz)
-    throw std::invalid_argument(fmt::format(
-        "butterworth_lowpass: cut-off {} Hz must lie in (0, sample_rate/2 = {} Hz)", cutoff_hz,
-        0.5 * sample_rate_hz));
+    throw std::invalid_argument(fmt::format("butterworth_lowpass: cut-off {} Hz must lie in (0, sample_rate/2 = {} Hz)",
+                                            cutoff_hz, 0.5 * sample_rate_hz));
   if (order < 1 || order > 12)
     throw std::invalid_argument(fmt::format("butterworth_lowpass: order {} not in 1..12", order));
   const std::size_t n = x.size();
@@ -136,8 +131,7 @@ std::vector<double> butterworth_lowpass(const std::vector<double>& x, double sam
   std::reverse(y.begin(), y.end());
   for (const auto& s : sections) s.run(y);
   std::reverse(y.begin(), y.end());
-  return {y.begin() + static_cast<std::ptrdiff_t>(pad),
-          y.begin() + static_cast<std::ptrdiff_t>(pad + n)};
+  return {y.begin() + static_cast<std::ptrdiff_t>(pad), y.begin() + static_cast<std::ptrdiff_t>(pad + n)};
 }
 
 namespace {
@@ -151,14 +145,15 @@ struct PassResult {
 };
 
 PassResult collision_pass(const Trace& trace, const MetricOptions& o, const std::vector<double>& af,
-                          const std::vector<double>& a, std::size_t ipk, std::size_t w, double fs,
-                          double sigma_ff, double step_rise_s) {
+                          const std::vector<double>& a, std::size_t ipk, std::size_t w, double fs, double sigma_ff,
+                          double step_rise_s) {
   const auto& t = trace.t_s;
   const std::size_t n = t.size();
   const double g = o.gravity_m_s2;
   const double thr = std::max(6.0 * sigma_ff, 0.03 * g);
   PassResult r;
-  r.start = trace.contact_start_s ? contact_start(t, *trace.contact_start_s) : free_fall_start(t, a, ipk, g, thr, w, step_rise_s);
+  r.start = trace.contact_start_s ? contact_start(t, *trace.contact_start_s)
+                                  : free_fall_start(t, a, ipk, g, thr, w, step_rise_s);
   // Free-fall segment: up to the edge width before the start.
   const std::size_t ff_end = r.start.i_start > w + 1 ? r.start.i_start - w - 1 : 0;
   // End: acceleration below end_threshold_g * g after the peak, staying there for 2 ms (at least
@@ -195,10 +190,10 @@ PassResult collision_pass(const Trace& trace, const MetricOptions& o, const std:
   if (!j) j = end_sample(a, ipk, ec);
   if (!j) {
     // The level, when the noise raised it above the paper's, is part of the reason.
-    const std::string level =
-        ec.end_level_m_s2 > o.end_threshold_g * g
-            ? fmt::format(" (raised to {:.3g} m/s2, {} sigma of the record's noise)", ec.end_level_m_s2, kEndNoiseSigmas)
-            : "";
+    const std::string level = ec.end_level_m_s2 > o.end_threshold_g * g
+                                  ? fmt::format(" (raised to {:.3g} m/s2, {} sigma of the record's noise)",
+                                                ec.end_level_m_s2, kEndNoiseSigmas)
+                                  : "";
     throw TraceError(fmt::format("trace shorter than the collision: after the peak at t = {:.4f} s the acceleration "
                                  "never stays below {} g{} with the speed below {} of the collision speed",
                                  t[ipk], o.end_threshold_g, level, o.end_speed_fraction),
@@ -269,8 +264,8 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
     integrate_from_start(t, a, i_start, m.t_start_s, m.vc_m_s, out.velocity_down_m_s, out.depth_m);
     // At rest the integrated speed reads zero (trace_steps.h): what it reads is removed from v and z.
     const double end_tolerance_m_s = 0.5 * pass.end.step_height_m_s2 / fs;  // half a sample of the end step
-    out.rest_speed_offset_m_s = bring_to_rest(t, rest_begin(i_end, w, n), m.t_start_s, end_tolerance_m_s,
-                                              out.velocity_down_m_s, out.depth_m);
+    out.rest_speed_offset_m_s =
+        bring_to_rest(t, rest_begin(i_end, w, n), m.t_start_s, end_tolerance_m_s, out.velocity_down_m_s, out.depth_m);
   }
   m.apeak_m_s2 = peak_acceleration(a, out.velocity_down_m_s, i_start, i_end, pass.start.step, pass.end.step, w,
                                    m.vc_m_s - out.rest_speed_offset_m_s, g);

@@ -35,9 +35,9 @@ struct Trace {
 
 struct MetricOptions {
   double gravity_m_s2 = 9.81;
-  double cutoff_hz = 500.0;            ///< 2nd-order Butterworth low-pass (paper: 500 Hz)
+  double cutoff_hz = 500.0;  ///< 2nd-order Butterworth low-pass (paper: 500 Hz)
   int filter_order = 2;
-  double end_threshold_g = 0.1;        ///< collision ends when |a| < 0.1 g (paper)
+  double end_threshold_g = 0.1;  ///< collision ends when |a| < 0.1 g (paper)
   /// ... and the projectile has lost this much of its collision speed: its downward speed is below
   /// end_speed_fraction * vc. A DEM projectile is stopped by bursts of force chains with lulls of
   /// near-zero acceleration between them (coasting at half its speed for 10-20 ms in a small bed);
@@ -60,15 +60,15 @@ struct MetricOptions {
 
 /// The paper's metrics of one collision.
 struct Metrics {
-  double vc_m_s = 0;         ///< collision velocity (speed at collision start)
-  double apeak_m_s2 = 0;     ///< peak (upward) acceleration of the filtered trace
-  double zstop_m = 0;        ///< penetration depth at collision end
-  double tstop_s = 0;        ///< collision duration (end - start)
-  double t_start_s = 0;      ///< collision start: no longer in free fall
-  double t_end_s = 0;        ///< collision end: acceleration below end_threshold_g after the peak,
-                             ///< with the speed below end_speed_fraction * vc
-  bool rebound = false;      ///< moved up after contact, or came within one grain of the floor
-  std::string note;          ///< why a metric could not be found, if so
+  double vc_m_s = 0;      ///< collision velocity (speed at collision start)
+  double apeak_m_s2 = 0;  ///< peak (upward) acceleration of the filtered trace
+  double zstop_m = 0;     ///< penetration depth at collision end
+  double tstop_s = 0;     ///< collision duration (end - start)
+  double t_start_s = 0;   ///< collision start: no longer in free fall
+  double t_end_s = 0;     ///< collision end: acceleration below end_threshold_g after the peak,
+                          ///< with the speed below end_speed_fraction * vc
+  bool rebound = false;   ///< moved up after contact, or came within one grain of the floor
+  std::string note;       ///< why a metric could not be found, if so
 };
 
 /// A processed trace: the filtered, bias-corrected acceleration, the velocity and depth (the
@@ -80,14 +80,14 @@ struct ProcessedTrace {
   std::vector<double> velocity_down_m_s;  ///< positive down
   std::vector<double> depth_m;            ///< positive down, 0 at first contact (integrated case)
   double sample_rate_hz = 0;
-  double bias_m_s2 = 0;                   ///< removed sensor bias
-  std::size_t free_fall_samples = 0;      ///< samples used for the bias from free fall
-  std::size_t rest_samples = 0;           ///< samples used for the bias from rest
+  double bias_m_s2 = 0;               ///< removed sensor bias
+  std::size_t free_fall_samples = 0;  ///< samples used for the bias from free fall
+  std::size_t rest_samples = 0;       ///< samples used for the bias from rest
   /// Lab records integrated from the impact speed: the speed the integration still read at rest,
   /// removed from velocity and depth (trace_steps::bring_to_rest); 0 for a record with its own.
   double rest_speed_offset_m_s = 0;
-  std::size_t i_start = 0;                ///< last sample before the collision start
-  std::size_t i_end = 0;                  ///< first sample after the collision end
+  std::size_t i_start = 0;  ///< last sample before the collision start
+  std::size_t i_end = 0;    ///< first sample after the collision end
 };
 
 /// Why a trace cannot be measured, and the sample the reason is about when there is one (the
@@ -97,8 +97,7 @@ struct ProcessedTrace {
 class TraceError : public std::invalid_argument {
  public:
   /// `bad_value`: the sample's acceleration value itself is the reason (a reader names its column).
-  explicit TraceError(const std::string& what, std::optional<std::size_t> sample = std::nullopt,
-                      bool bad_value = false)
+  explicit TraceError(const std::string& what, std::optional<std::size_t> sample = std::nullopt, bool bad_value = false)
       : std::invalid_argument(what), sample_(sample), bad_value_(bad_value) {}
   [[nodiscard]] std::optional<std::size_t> sample() const { return sample_; }
   [[nodiscard]] bool bad_value() const { return bad_value_; }
@@ -113,8 +112,8 @@ class TraceError : public std::invalid_argument {
 /// one near 1e308 would overflow the filter.
 inline constexpr double kMaxAccel_m_s2 = 1e6;
 /// Zero-phase (forward-backward) Butterworth low-pass of order `order` at `cutoff_hz`.
-std::vector<double> butterworth_lowpass(const std::vector<double>& x, double sample_rate_hz,
-                                        double cutoff_hz, int order = 2);
+std::vector<double> butterworth_lowpass(const std::vector<double>& x, double sample_rate_hz, double cutoff_hz,
+                                        int order = 2);
 
 /// Computes the metrics as the paper does; throws TraceError with the reason (and the sample) when
 /// the trace is too short, holds a sample beyond kMaxAccel_m_s2, does not start in free fall,

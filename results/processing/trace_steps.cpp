@@ -46,8 +46,7 @@ std::vector<double> filter_acceleration(const std::vector<double>& accel_up_m_s2
                                         std::string& note) {
   if (o.cutoff_hz > 0 && o.cutoff_hz < 0.5 * fs)
     return butterworth_lowpass(accel_up_m_s2, fs, o.cutoff_hz, o.filter_order);
-  note = fmt::format("not filtered: cut-off {} Hz is not below the Nyquist frequency {:.0f} Hz", o.cutoff_hz,
-                     0.5 * fs);
+  note = fmt::format("not filtered: cut-off {} Hz is not below the Nyquist frequency {:.0f} Hz", o.cutoff_hz, 0.5 * fs);
   return accel_up_m_s2;
 }
 
@@ -81,8 +80,7 @@ double median_of(std::vector<double> x) {
 
 }  // namespace
 
-void check_starts_in_free_fall(const std::vector<double>& t, const std::vector<double>& af, std::size_t ipk,
-                               double g) {
+void check_starts_in_free_fall(const std::vector<double>& t, const std::vector<double>& af, std::size_t ipk, double g) {
   const std::size_t n = af.size();
   const std::size_t k = std::clamp<std::size_t>(ipk / 3, 1, kFreeFallProbeSamples);
   const double head = median_of({af.begin(), af.begin() + static_cast<std::ptrdiff_t>(k)});
@@ -125,8 +123,8 @@ double rise_10_90_s(const std::vector<double>& t, const std::vector<double>& y, 
   return t_hi - t_lo;
 }
 
-CollisionStart free_fall_start(const std::vector<double>& t, const std::vector<double>& a, std::size_t ipk,
-                               double g, double thr, std::size_t w, double step_rise_s) {
+CollisionStart free_fall_start(const std::vector<double>& t, const std::vector<double>& a, std::size_t ipk, double g,
+                               double thr, std::size_t w, double step_rise_s) {
   const std::size_t n = t.size();
   std::size_t i = ipk;
   while (i > 0 && a[i] > -g + thr) --i;
@@ -189,7 +187,8 @@ std::optional<std::size_t> end_sample(const std::vector<double>& a, std::size_t 
 double robust_sigma(const std::vector<double>& x, std::size_t b, std::size_t e) {
   if (e < b + 3) return 0.0;
   constexpr double kMadToSigma = 1.4826;  // 1 / Phi^-1(3/4)
-  const double med = median_of({x.begin() + static_cast<std::ptrdiff_t>(b), x.begin() + static_cast<std::ptrdiff_t>(e)});
+  const double med =
+      median_of({x.begin() + static_cast<std::ptrdiff_t>(b), x.begin() + static_cast<std::ptrdiff_t>(e)});
   std::vector<double> dev;
   dev.reserve(e - b);
   for (std::size_t i = b; i < e; ++i) dev.push_back(std::abs(x[i] - med));
@@ -215,8 +214,8 @@ std::optional<std::size_t> last_exceedance_end(const std::vector<double>& a, std
   return j;
 }
 
-CollisionEnd end_edge(const std::vector<double>& t, const std::vector<double>& a, std::size_t j,
-                      std::size_t i_start, std::size_t w, double end_level) {
+CollisionEnd end_edge(const std::vector<double>& t, const std::vector<double>& a, std::size_t j, std::size_t i_start,
+                      std::size_t w, double end_level) {
   CollisionEnd e{j, j > 0 ? crossing_time(t, a, j - 1, end_level) : t[j], false};
   if (j > w + 1 && j - w - 1 > i_start) {
     // Level before the edge; a fall to half of it within w samples before j is a step.
@@ -323,8 +322,8 @@ double peak_acceleration(const std::vector<double>& a, const std::vector<double>
   return peak;
 }
 
-Rebound rebound_of(const std::vector<double>& v, const std::vector<double>& z, std::size_t i_start,
-                   std::size_t i_end, double vc, const MetricOptions& o) {
+Rebound rebound_of(const std::vector<double>& v, const std::vector<double>& z, std::size_t i_start, std::size_t i_end,
+                   double vc, const MetricOptions& o) {
   Rebound r;
   double vmin = 0, zmax = 0;
   for (std::size_t k = i_start; k <= std::min(v.size() - 1, i_end); ++k) {

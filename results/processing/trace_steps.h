@@ -22,8 +22,8 @@ double stddev_of(const std::vector<double>& x, std::size_t b, std::size_t e);  /
 
 /// The options' low-pass of the raw acceleration; unfiltered (and `note` says why) when the
 /// cut-off is not below the Nyquist frequency.
-std::vector<double> filter_acceleration(const std::vector<double>& accel_up_m_s2, double fs_hz,
-                                        const MetricOptions& o, std::string& note);
+std::vector<double> filter_acceleration(const std::vector<double>& accel_up_m_s2, double fs_hz, const MetricOptions& o,
+                                        std::string& note);
 
 /// Edge width in samples: a zero-phase Butterworth spreads (and rings around) a step over about
 /// fs/fc samples on each side.
@@ -71,25 +71,23 @@ double filter_step_rise_s(double fs_hz, const MetricOptions& o);
 /// band -g + thr, the start at the threshold crossing. An edge about as fast as the filter (the
 /// ramp it is, the filter's own rise step_rise_s taken out of its 10-90 % rise, lasts no longer
 /// than kStepRampRises times step_rise_s; its height reached within 2w samples) starts at its
-/// onset instead: its half height less half that ramp. The filter's spread and ringing cross the threshold early there (about
-/// two samples at 1.4 kHz); a contact that ramps in over several samples (a slow impact in high
-/// gravity, issue 13) starts at its foot, the threshold crossing extrapolated back along the
-/// ramp (the crossings of thr and 2 thr), not ms later at its half height. `step` says the
-/// half-height onset was used. Throws std::invalid_argument when no sample before the peak
-/// reads -g.
-/// A contact ramp up to this many filter rises long counts as a step (2 ms at 500 Hz: a 1 mm
-/// contact ramp at 0.5 m/s and faster), so that its peak is extrapolated as a step's, as a model's
-/// record of it (with no ramp) is; noise moves a ramp of about one filter rise across the line.
+/// onset instead: its half height less half that ramp. The filter's spread and ringing cross the threshold early there
+/// (about two samples at 1.4 kHz); a contact that ramps in over several samples (a slow impact in high gravity, issue
+/// 13) starts at its foot, the threshold crossing extrapolated back along the ramp (the crossings of thr and 2 thr),
+/// not ms later at its half height. `step` says the half-height onset was used. Throws std::invalid_argument when no
+/// sample before the peak reads -g. A contact ramp up to this many filter rises long counts as a step (2 ms at 500 Hz:
+/// a 1 mm contact ramp at 0.5 m/s and faster), so that its peak is extrapolated as a step's, as a model's record of it
+/// (with no ramp) is; noise moves a ramp of about one filter rise across the line.
 inline constexpr double kStepRampRises = 2.0;
 CollisionStart free_fall_start(const std::vector<double>& t, const std::vector<double>& a, std::size_t ipk,
                                double g_m_s2, double thr_m_s2, std::size_t w, double step_rise_s);
 
 /// What the collision end is searched with.
 struct EndCriteria {
-  double end_level_m_s2 = 0;            ///< end_threshold_g * g
-  double v_end_m_s = 0;                 ///< end_speed_fraction * |vc|
+  double end_level_m_s2 = 0;                   ///< end_threshold_g * g
+  double v_end_m_s = 0;                        ///< end_speed_fraction * |vc|
   const std::vector<double>* speed = nullptr;  ///< downward speed per sample, when known
-  std::size_t hold = 3;                 ///< samples the acceleration must stay below the level
+  std::size_t hold = 3;                        ///< samples the acceleration must stay below the level
 };
 /// Samples to hold the end level: 2 ms, at least 3 samples.
 std::size_t end_hold_samples(double fs_hz);
@@ -129,8 +127,8 @@ struct CollisionEnd {
   bool step = false;
   double step_height_m_s2 = 0;  ///< a step's height (the level before it), 0 otherwise
 };
-CollisionEnd end_edge(const std::vector<double>& t, const std::vector<double>& a, std::size_t j,
-                      std::size_t i_start, std::size_t w, double end_level_m_s2);
+CollisionEnd end_edge(const std::vector<double>& t, const std::vector<double>& a, std::size_t j, std::size_t i_start,
+                      std::size_t w, double end_level_m_s2);
 
 /// Rest segment [rest_begin, n): the last three quarters of what follows the collision end and
 /// its edge, so that late settling stays out of it.
@@ -144,7 +142,7 @@ inline constexpr std::size_t kMinRestSamples = 10;
 /// samples are unused.
 struct BiasEstimate {
   double bias_m_s2 = 0;
-  bool any = false;           ///< false: neither segment long enough (keep the previous bias)
+  bool any = false;  ///< false: neither segment long enough (keep the previous bias)
   std::size_t free_fall_samples = 0, rest_samples = 0;
   std::optional<double> sigma_free_fall_m_s2;  ///< noise of the free-fall segment, when used
 };
@@ -185,7 +183,7 @@ struct Rebound {
   bool rebound = false;
   std::string note;  ///< "moved up at ... m/s; reached ... m, within one grain of the floor ..."
 };
-Rebound rebound_of(const std::vector<double>& v, const std::vector<double>& z, std::size_t i_start,
-                   std::size_t i_end, double vc_m_s, const MetricOptions& o);
+Rebound rebound_of(const std::vector<double>& v, const std::vector<double>& z, std::size_t i_start, std::size_t i_end,
+                   double vc_m_s, const MetricOptions& o);
 
 }  // namespace gravsweep::results::trace_steps

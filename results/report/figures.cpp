@@ -53,9 +53,10 @@ MeasuredTrial load_lab_record(const fs::path& path) {
     throw ConfigError(fmt::format("{}: no row of {} names this trace (column trace_file)", path.string(),
                                   (dir / "trials.csv").string()));
   }
-  throw ConfigError(fmt::format("{}: a lab trace needs its campaign's trials.csv (gravity, impact speed, ...) in "
-                                "the same folder or the one above; none found",
-                                path.string()));
+  throw ConfigError(
+      fmt::format("{}: a lab trace needs its campaign's trials.csv (gravity, impact speed, ...) in "
+                  "the same folder or the one above; none found",
+                  path.string()));
 }
 
 /// One record of Fig. 2 with the paper's green line: velocity and depth integrated from the
@@ -83,9 +84,8 @@ Fig2Record load_record(const std::string& path) {
       throw ConfigError(fmt::format("{}: cannot process the record: {}", path, e.what()));
     }
     const auto parent = fs::path(path).parent_path().filename().string();
-    r.label = fmt::format("DEM {}", fs::path(path).filename() == "trace.h5" && !parent.empty()
-                                        ? parent
-                                        : fs::path(path).stem().string());
+    r.label = fmt::format(
+        "DEM {}", fs::path(path).filename() == "trace.h5" && !parent.empty() ? parent : fs::path(path).stem().string());
     const ProcessedTrace& p = r.trial.processed;
     // "processed using the same method as the experimental data" (Sect. 2.3, Fig. 2): as a lab
     // record (no own velocity and depth, bias taken from free fall and rest: about 0 for a DEM
@@ -170,10 +170,10 @@ Metrics draw_fig2(const Fig2Request& rq) {
     records.push_back(write_fig2_record(tmp.path, 1, other));
   }
   const Metrics& m = main.trial.processed.metrics;
-  const json spec{{"out", fs::absolute(rq.out).string()},
-                  {"records", records},
-                  {"title", fmt::format("{}: g = {:g} m/s2, vc = {:.3f} m/s", main.label,
-                                        main.trial.info.gravity_m_s2, m.vc_m_s)}};
+  const json spec{
+      {"out", fs::absolute(rq.out).string()},
+      {"records", records},
+      {"title", fmt::format("{}: g = {:g} m/s2, vc = {:.3f} m/s", main.label, main.trial.info.gravity_m_s2, m.vc_m_s)}};
   plot(tmp, "trace", spec, rq.out);
   return m;
 }
@@ -212,20 +212,27 @@ std::string draw_fig1(const Fig1Request& rq) {
   json panels = json::array();
   const double R = 0.5 * td.projectile_diameter_m;
   auto projectile = [&](std::size_t k) {
-    return json{{"x_m", td.position_m[3 * k]}, {"y_m", td.position_m[3 * k + 1]}, {"z_m", td.position_m[3 * k + 2]},
-                {"radius_m", R}, {"t_s", td.t_s[k]}, {"depth_m", td.depth_m[k]}};
+    return json{{"x_m", td.position_m[3 * k]},
+                {"y_m", td.position_m[3 * k + 1]},
+                {"z_m", td.position_m[3 * k + 2]},
+                {"radius_m", R},
+                {"t_s", td.t_s[k]},
+                {"depth_m", td.depth_m[k]}};
   };
   std::string what = fmt::format("{} grains", bed.size());
   if (rq.trace.empty()) panels.push_back(json{{"title", "prepared bed"}, {"grains", "bed.csv"}});
   if (!rq.trace.empty() && rq.at != "rest")
     panels.push_back(json{{"title", fmt::format("(a) release, {:.1f} cm above the surface",
                                                 100 * (td.release_height_m - td.surface_height_m))},
-                          {"grains", "bed.csv"}, {"projectile", projectile(0)}});
+                          {"grains", "bed.csv"},
+                          {"projectile", projectile(0)}});
   if (!rq.trace.empty() && rq.at != "release") {
     const std::size_t k = td.size() - 1;
-    json panel{{"title", fmt::format("(b) {} at t = {:.0f} ms, {:.2f} cm deep", td.stopped ? "at rest" : "at the time cap",
-                                     1000 * td.t_s[k], 100 * td.depth_m[k])},
-               {"grains", "bed.csv"}, {"projectile", projectile(k)}};
+    json panel{
+        {"title", fmt::format("(b) {} at t = {:.0f} ms, {:.2f} cm deep", td.stopped ? "at rest" : "at the time cap",
+                              1000 * td.t_s[k], 100 * td.depth_m[k])},
+        {"grains", "bed.csv"},
+        {"projectile", projectile(k)}};
     const std::string snaps = rq.snapshots.empty() ? snapshot_path_for(rq.trace).string() : rq.snapshots;
     if (fs::exists(snaps)) {
       try {

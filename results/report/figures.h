@@ -25,11 +25,11 @@ struct Fig2Request {
 Metrics draw_fig2(const Fig2Request& request);
 
 struct Fig1Request {
-  std::string bed;    ///< bed.h5
-  std::string trace;  ///< optional trace.h5: the projectile at release / at rest
-  std::string at;     ///< "release", "rest" or "" (both, when a trace is given)
+  std::string bed;        ///< bed.h5
+  std::string trace;      ///< optional trace.h5: the projectile at release / at rest
+  std::string at;         ///< "release", "rest" or "" (both, when a trace is given)
   std::string snapshots;  ///< optional snapshots.h5 of the drop: the grains at rest (default: next to the trace)
-  std::string out;    ///< PNG
+  std::string out;        ///< PNG
 };
 
 /// Draws Fig. 1; returns a one-line description of what was drawn.

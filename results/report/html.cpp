@@ -61,9 +61,10 @@ std::string base64(const std::string& in) {
 
 std::filesystem::path write_html_report(const std::string& dir, const HtmlReport& r) {
   namespace fs = std::filesystem;
-  std::string h = fmt::format("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n"
-                              "<style>{}</style>\n</head>\n<body>\n<h1>{}</h1>\n",
-                              html_escape(r.title), kStyle, html_escape(r.title));
+  std::string h = fmt::format(
+      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n"
+      "<style>{}</style>\n</head>\n<body>\n<h1>{}</h1>\n",
+      html_escape(r.title), kStyle, html_escape(r.title));
   h += fmt::format("<p class=\"summary\">{}</p>\n", html_escape(r.summary));
   if (!r.issues.empty()) {
     h += "<details><summary>" + fmt::format("{} trials not usable", r.issues.size()) + "</summary><ul>\n";
@@ -83,10 +84,10 @@ std::filesystem::path write_html_report(const std::string& dir, const HtmlReport
   for (const auto& f : r.figures) {
     const fs::path p = fs::path(dir) / f.file;
     if (!fs::exists(p)) continue;
-    h += fmt::format("<figure id=\"{}\">\n<img alt=\"{}\" src=\"data:image/png;base64,{}\">\n"
-                     "<figcaption><b>{}</b>: {}</figcaption>\n</figure>\n",
-                     html_escape(f.file), html_escape(f.file), base64(read_bytes(p)), html_escape(f.file),
-                     html_escape(f.caption));
+    h += fmt::format(
+        "<figure id=\"{}\">\n<img alt=\"{}\" src=\"data:image/png;base64,{}\">\n"
+        "<figcaption><b>{}</b>: {}</figcaption>\n</figure>\n",
+        html_escape(f.file), html_escape(f.file), base64(read_bytes(p)), html_escape(f.file), html_escape(f.caption));
   }
   h += "</body>\n</html>\n";
   const fs::path out = fs::path(dir) / "index.html";

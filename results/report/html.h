@@ -12,7 +12,7 @@ namespace gravsweep::results {
 
 struct HtmlSection {
   std::string heading;
-  std::string text;           ///< a paragraph before the tables (plain text, escaped)
+  std::string text;                                   ///< a paragraph before the tables (plain text, escaped)
   std::vector<std::pair<std::string, Table>> tables;  ///< (label, table); the label may be empty
 };
 
@@ -23,11 +23,11 @@ struct HtmlFigure {
 
 struct HtmlReport {
   std::string title;
-  std::string summary;               ///< what was read (plain text)
-  std::vector<std::string> issues;   ///< trials that could not be used, one line each
+  std::string summary;              ///< what was read (plain text)
+  std::vector<std::string> issues;  ///< trials that could not be used, one line each
   std::string verdict;
   std::vector<HtmlSection> sections;
-  std::vector<HtmlFigure> figures;   ///< those missing from the folder are left out
+  std::vector<HtmlFigure> figures;  ///< those missing from the folder are left out
 };
 
 /// RFC 4648 base64 of `bytes`.

@@ -16,8 +16,7 @@
 
 namespace gravsweep::results {
 
-std::vector<ComparedModel> compare_models(const Campaign& c, const std::vector<ModelSpec>& specs,
-                                          int folds) {
+std::vector<ComparedModel> compare_models(const Campaign& c, const std::vector<ModelSpec>& specs, int folds) {
   std::vector<ComparedModel> out;
   ComparedModel paper;
   paper.name = "paper_eq2-4";
@@ -116,8 +115,7 @@ void write_residuals(const std::filesystem::path& D, const Campaign& c, const st
 
 }  // namespace
 
-void write_report_data(const std::string& dir, const Campaign& c,
-                       const std::vector<ComparedModel>& compared,
+void write_report_data(const std::string& dir, const Campaign& c, const std::vector<ComparedModel>& compared,
                        const std::vector<ModelSpec>& specs, const Discovery* d) {
   namespace fs = std::filesystem;
   fs::create_directories(dir);
@@ -132,8 +130,8 @@ void write_report_data(const std::string& dir, const Campaign& c,
       double level = t.info.gravity_m_s2;
       for (double g : levels)
         if (same_gravity_level(g, level)) level = g;
-      const double drop = t.info.drop_height_m > 0 ? t.info.drop_height_m
-                                                   : m.vc_m_s * m.vc_m_s / (2 * t.info.gravity_m_s2);
+      const double drop =
+          t.info.drop_height_m > 0 ? t.info.drop_height_m : m.vc_m_s * m.vc_m_s / (2 * t.info.gravity_m_s2);
       f.add(cells(t.info.trial_id, level, m.vc_m_s, t.info.fill_height_m, drop, m.apeak_m_s2, m.zstop_m, m.tstop_s,
                   m.rebound ? 1 : 0));
     }

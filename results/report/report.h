@@ -16,14 +16,12 @@ struct ComparedModel {
 };
 
 /// The paper's method first, then each spec, all by grouped K-fold CV on whole trials.
-std::vector<ComparedModel> compare_models(const Campaign& c, const std::vector<ModelSpec>& specs,
-                                          int folds = 6);
+std::vector<ComparedModel> compare_models(const Campaign& c, const std::vector<ModelSpec>& specs, int folds = 6);
 
 /// Writes the CSV files the plots read into `dir`: trials.csv (each trial's gravity level, vc,
-/// fill and drop height and measured apeak, zstop, tstop, rebound), residuals.csv (fit-window samples with residuals of the first and
-/// last spec), errors.csv, ranking.csv, table3.csv, model_curves.csv (metrics vs vc per g).
-void write_report_data(const std::string& dir, const Campaign& c,
-                       const std::vector<ComparedModel>& compared,
+/// fill and drop height and measured apeak, zstop, tstop, rebound), residuals.csv (fit-window samples with residuals of
+/// the first and last spec), errors.csv, ranking.csv, table3.csv, model_curves.csv (metrics vs vc per g).
+void write_report_data(const std::string& dir, const Campaign& c, const std::vector<ComparedModel>& compared,
                        const std::vector<ModelSpec>& specs, const Discovery* discovery);
 
 /// Runs the plotting script on `dir` (writes the PNGs there); returns the script's exit status

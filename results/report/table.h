@@ -15,7 +15,8 @@ namespace gravsweep::results {
 /// &, <, >, " escaped for HTML text and attributes.
 inline std::string html_escape(const std::string& x) {
   std::string o;
-  for (char c : x) o += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : c == '"' ? "&quot;" : std::string(1, c);
+  for (char c : x)
+    o += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : c == '"' ? "&quot;" : std::string(1, c);
   return o;
 }
 

@@ -45,8 +45,10 @@ CampaignInput load_queue_campaign(const std::string& path, db::Database& db, con
     refs.push_back({job, job, paths.abs(r[2].get<std::string>())});
   }
   {
-    db::Statement st(db, "SELECT state, count(*) FROM jobs WHERE kind='drop' AND state != 'done' GROUP BY state ORDER BY state");
-    while (st.step()) in.note += fmt::format("{}{} drop jobs {}", in.note.empty() ? "" : ", ", st.get_int(1), st.get_text(0));
+    db::Statement st(
+        db, "SELECT state, count(*) FROM jobs WHERE kind='drop' AND state != 'done' GROUP BY state ORDER BY state");
+    while (st.step())
+      in.note += fmt::format("{}{} drop jobs {}", in.note.empty() ? "" : ", ", st.get_int(1), st.get_text(0));
     if (!in.note.empty()) in.note += " (not finished: not trials yet; `gravsweep work` runs them)";
   }
   in.campaign = results::load_dem_campaign(path, refs);
@@ -93,21 +95,24 @@ CampaignInput load_campaign_input(const std::string& path, const std::vector<std
       in.campaign = results::load_campaign(path, cutoff_hz);
     } else if (fs::is_regular_file(path)) {
       if (fs::file_size(path) == 0)
-        throw UsageError(fmt::format("{}: an empty file: a campaign database, an imported SQLite file or a lab "
-                                     "campaign folder expected",
-                                     path));
+        throw UsageError(
+            fmt::format("{}: an empty file: a campaign database, an imported SQLite file or a lab "
+                        "campaign folder expected",
+                        path));
       db::Database db(path, 30000, true);
       if (has_table(db, "jobs") && has_table(db, "results")) return load_queue_campaign(path, db, where);
       if (!has_table(db, "trials"))
-        throw UsageError(fmt::format("{}: neither a campaign database (tables jobs, results) nor an imported "
-                                     "SQLite file (table trials)",
-                                     path));
+        throw UsageError(
+            fmt::format("{}: neither a campaign database (tables jobs, results) nor an imported "
+                        "SQLite file (table trials)",
+                        path));
       in.kind = "imported SQLite file";
       in.campaign = results::load_campaign_db(db);
     } else {
-      throw UsageError(fmt::format("{}: no such file or folder: a campaign database, an imported SQLite file or "
-                                   "a lab campaign folder expected",
-                                   path));
+      throw UsageError(
+          fmt::format("{}: no such file or folder: a campaign database, an imported SQLite file or "
+                      "a lab campaign folder expected",
+                      path));
     }
   } catch (const UsageError&) {
     throw;
@@ -134,8 +139,8 @@ CampaignInput load_campaign_inputs(const std::vector<std::string>& paths, const 
     describe_input(p, in);
     for (auto& t : in.campaign.trials) {
       if (!ids.insert(t.info.trial_id).second)
-        throw UsageError(fmt::format("{}: trial '{}' is also in an earlier input: each trial may be read once", p,
-                                     t.info.trial_id));
+        throw UsageError(
+            fmt::format("{}: trial '{}' is also in an earlier input: each trial may be read once", p, t.info.trial_id));
       all.campaign.trials.push_back(std::move(t));
     }
     for (auto& is : in.campaign.issues) all.campaign.issues.push_back(std::move(is));

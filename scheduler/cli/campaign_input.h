@@ -14,7 +14,7 @@ namespace gravsweep::cli {
 
 struct CampaignInput {
   results::Campaign campaign;
-  std::string kind;  ///< "campaign database (submit/work)", "imported SQLite file", "lab campaign folder"
+  std::string kind;              ///< "campaign database (submit/work)", "imported SQLite file", "lab campaign folder"
   std::size_t filtered_out = 0;  ///< trials left out by --where
   std::string note;              ///< e.g. drop jobs not finished
 };

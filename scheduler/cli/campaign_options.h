@@ -10,8 +10,7 @@ namespace gravsweep::cli {
 /// Adds --db with `what` (e.g. "campaign database") and, when `files` is given, --files.
 inline void add_campaign_options(CLI::App* sub, std::string& db, std::string* files,
                                  const std::string& what = "campaign database") {
-  sub->add_option("--db", db, what + ": an SQLite file, or postgresql://user@host:port/dbname")
-      ->capture_default_str();
+  sub->add_option("--db", db, what + ": an SQLite file, or postgresql://user@host:port/dbname")->capture_default_str();
   if (files)
     sub->add_option("--files", *files,
                     "the campaign's files root (beds/, traces/, ...): default <db stem>.files/ beside an SQLite "

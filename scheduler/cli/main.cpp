@@ -18,23 +18,12 @@ namespace {
 using SetupFn = void (*)(CLI::App&);
 // The verb table: one row per verb, in the order `gravsweep --help` lists them.
 constexpr SetupFn kVerbs[] = {
-    &gravsweep::cli::setup_run,
-    &gravsweep::cli::setup_bench,
-    &gravsweep::cli::setup_pile,
-    &gravsweep::cli::setup_measurements,
-    &gravsweep::cli::setup_model,
-    &gravsweep::cli::setup_synth,
-    &gravsweep::cli::setup_report,
-    &gravsweep::cli::setup_submit,
-    &gravsweep::cli::setup_work,
-    &gravsweep::cli::setup_status,
-    &gravsweep::cli::setup_resume,
-    &gravsweep::cli::setup_results,
-    &gravsweep::cli::setup_plot,
-    &gravsweep::cli::setup_export,
-    &gravsweep::cli::setup_bench_queue,
-    &gravsweep::cli::setup_campaign,
-    &gravsweep::cli::setup_slurm,
+    &gravsweep::cli::setup_run,          &gravsweep::cli::setup_bench,  &gravsweep::cli::setup_pile,
+    &gravsweep::cli::setup_measurements, &gravsweep::cli::setup_model,  &gravsweep::cli::setup_synth,
+    &gravsweep::cli::setup_report,       &gravsweep::cli::setup_submit, &gravsweep::cli::setup_work,
+    &gravsweep::cli::setup_status,       &gravsweep::cli::setup_resume, &gravsweep::cli::setup_results,
+    &gravsweep::cli::setup_plot,         &gravsweep::cli::setup_export, &gravsweep::cli::setup_bench_queue,
+    &gravsweep::cli::setup_campaign,     &gravsweep::cli::setup_slurm,
 };
 
 }  // namespace

@@ -41,8 +41,8 @@ void ProgressBar::update(const std::string& phase, double fraction, const std::s
   constexpr int kWidth = 30;
   const int filled = static_cast<int>(std::lround(fraction * kWidth));
   const std::string bar = std::string(filled, '#') + std::string(kWidth - filled, '-');
-  const std::string line = fmt::format("{:<8} [{}] {:5.1f}%  elapsed {:>7}  ETA {:>7}  {}", phase, bar,
-                                       100 * fraction, format_duration(elapsed), format_duration(eta), detail);
+  const std::string line = fmt::format("{:<8} [{}] {:5.1f}%  elapsed {:>7}  ETA {:>7}  {}", phase, bar, 100 * fraction,
+                                       format_duration(elapsed), format_duration(eta), detail);
   if (tty_) {
     std::fprintf(stderr, "\r%-120s", line.c_str());
     open_line_ = true;

@@ -73,8 +73,8 @@ BenchRow time_bed(const System& bed, const std::string& label, const BenchOption
                   static_cast<double>(sys.neighbor_list().builds() - builds0)};
 }
 
-std::unique_ptr<System> make_bed(double container_diameter_m, const BenchOptions& o,
-                                 ProgressBar& bar, std::string& note) {
+std::unique_ptr<System> make_bed(double container_diameter_m, const BenchOptions& o, ProgressBar& bar,
+                                 std::string& note) {
   SystemConfig cfg = chrono_table1_config();
   cfg.dt_s = o.settle_dt_s;
   auto sys = std::make_unique<System>(cfg);
@@ -84,16 +84,15 @@ std::unique_ptr<System> make_bed(double container_diameter_m, const BenchOptions
   spec.settle.max_time_s = o.settle_cap_s;
   spec.relax_time_s = 0.05;
   const auto t0 = std::chrono::steady_clock::now();
-  const BedReport rep = prepare_bed(*sys, spec, [&](BedPhase ph, double f, const std::string& d) {
-    bar.update(to_string(ph), f, d);
-  });
+  const BedReport rep =
+      prepare_bed(*sys, spec, [&](BedPhase ph, double f, const std::string& d) { bar.update(to_string(ph), f, d); });
   bar.finish();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  note = fmt::format("{} grains, bulk density {:.0f} kg/m3, surface {:.2f} cm, {} (rms {:.1e} m/s), "
-                     "prepared in {} wall",
-                     rep.grains_kept, rep.bulk_density_kg_m3, 100 * rep.surface_height_m,
-                     rep.settled ? "settled to the paper's criteria" : "settling capped",
-                     rep.rms_speed_m_s, format_duration(wall));
+  note = fmt::format(
+      "{} grains, bulk density {:.0f} kg/m3, surface {:.2f} cm, {} (rms {:.1e} m/s), "
+      "prepared in {} wall",
+      rep.grains_kept, rep.bulk_density_kg_m3, 100 * rep.surface_height_m,
+      rep.settled ? "settled to the paper's criteria" : "settling capped", rep.rms_speed_m_s, format_duration(wall));
   return sys;
 }
 
@@ -109,8 +108,8 @@ std::unique_ptr<System> load_bed_file(const std::string& path) {
 
 /// The base bed tiled to about `target` grains (square patches of the inscribed square), relaxed
 /// for o.tile_relax_s so the seams between copies close, with a label naming the layout.
-std::unique_ptr<System> make_tiled_bed(const System& base, double target, const BenchOptions& o,
-                                       ProgressBar& bar, std::string& label) {
+std::unique_ptr<System> make_tiled_bed(const System& base, double target, const BenchOptions& o, ProgressBar& bar,
+                                       std::string& label) {
   double radius = 0;
   for (const auto& w : base.walls)
     if (w.kind == WallKind::cylinder) radius = w.radius_m;
@@ -162,42 +161,53 @@ void run_bench(const BenchOptions& o) {
       for (int t : o.threads) rows.push_back(time_bed(*wide, label, o, t));
     }
   }
-  fmt::print("\n{:<18} {:>9} {:>8} {:>22} {:>22} {:>20} {:>16}\n", "bed", "grains", "threads",
-             "ns_per_particle_step", "contacts_per_particle", "bytes_per_particle", "nlist_rebuilds");
+  fmt::print("\n{:<18} {:>9} {:>8} {:>22} {:>22} {:>20} {:>16}\n", "bed", "grains", "threads", "ns_per_particle_step",
+             "contacts_per_particle", "bytes_per_particle", "nlist_rebuilds");
   for (const auto& r : rows)
-    fmt::print("{:<18} {:>9} {:>8} {:>22.1f} {:>22.2f} {:>20.0f} {:>16.0f}\n", r.bed, r.grains,
-               r.threads, r.ns_per_particle_step, r.contacts_per_particle, r.bytes_per_particle,
-               r.neighbour_builds);
-  fmt::print("\n{} steps at dt = {} s, Table 1 Chrono set (hertz + sunday rolling, mu_r = 0.09).\n",
-             o.steps, o.dt_s);
+    fmt::print("{:<18} {:>9} {:>8} {:>22.1f} {:>22.2f} {:>20.0f} {:>16.0f}\n", r.bed, r.grains, r.threads,
+               r.ns_per_particle_step, r.contacts_per_particle, r.bytes_per_particle, r.neighbour_builds);
+  fmt::print("\n{} steps at dt = {} s, Table 1 Chrono set (hertz + sunday rolling, mu_r = 0.09).\n", o.steps, o.dt_s);
 }
 
 }  // namespace
 
 void setup_bench(CLI::App& app) {
   auto opt = std::make_shared<BenchOptions>();
-  auto* sub = app.add_subcommand(
-      "bench",
-      "Time the engine on the paper's bed: prepares a settled bed (31.5 cm cylinder, grains\n"
-      "1 +/- 0.05 cm, 10 cm fill, about 8,000 grains, Table 1 Chrono parameters), then times\n"
-      "--steps steps at dt = 1 us with each thread count and prints ns per particle-step,\n"
-      "contacts per particle and bytes per particle.\n\n"
-      "Example:\n"
-      "  gravsweep bench --threads 1,2              # the issue's figures\n"
-      "  gravsweep bench --bed runs/1g/bed.h5       # time a bed prepared by `gravsweep run`\n"
-      "  gravsweep bench --scaling --steps 300      # also about 64,000 and 512,000 grains\n\n"
-      "--scaling copies the settled base bed's inscribed square side by side into a wide box\n"
-      "(tiles), relaxes it briefly and times it too: cost per particle-step against N at the\n"
-      "settled bed's contact density (settling 500,000 poured grains would take hours).");
-  sub->add_option("--steps", opt->steps, "timed steps per thread count")->check(CLI::PositiveNumber)->capture_default_str();
-  sub->add_option("--threads", opt->threads, "thread counts to time, comma separated")->delimiter(',')->capture_default_str();
-  sub->add_option("--dt", opt->dt_s, "time step of the timed run, s")->check(CLI::PositiveNumber)->capture_default_str();
+  auto* sub =
+      app.add_subcommand("bench",
+                         "Time the engine on the paper's bed: prepares a settled bed (31.5 cm cylinder, grains\n"
+                         "1 +/- 0.05 cm, 10 cm fill, about 8,000 grains, Table 1 Chrono parameters), then times\n"
+                         "--steps steps at dt = 1 us with each thread count and prints ns per particle-step,\n"
+                         "contacts per particle and bytes per particle.\n\n"
+                         "Example:\n"
+                         "  gravsweep bench --threads 1,2              # the issue's figures\n"
+                         "  gravsweep bench --bed runs/1g/bed.h5       # time a bed prepared by `gravsweep run`\n"
+                         "  gravsweep bench --scaling --steps 300      # also about 64,000 and 512,000 grains\n\n"
+                         "--scaling copies the settled base bed's inscribed square side by side into a wide box\n"
+                         "(tiles), relaxes it briefly and times it too: cost per particle-step against N at the\n"
+                         "settled bed's contact density (settling 500,000 poured grains would take hours).");
+  sub->add_option("--steps", opt->steps, "timed steps per thread count")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  sub->add_option("--threads", opt->threads, "thread counts to time, comma separated")
+      ->delimiter(',')
+      ->capture_default_str();
+  sub->add_option("--dt", opt->dt_s, "time step of the timed run, s")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   sub->add_option("--settle-cap", opt->settle_cap_s, "cap on simulated settling time, s")->capture_default_str();
-  sub->add_option("--diameter", opt->diameter_m, "container diameter of the bed to build, m")->check(CLI::PositiveNumber)->capture_default_str();
-  sub->add_option("--bed", opt->bed_file, "time a bed written by `gravsweep run` (DIR/bed.h5) instead of building one")->check(CLI::ExistingFile);
+  sub->add_option("--diameter", opt->diameter_m, "container diameter of the bed to build, m")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  sub->add_option("--bed", opt->bed_file, "time a bed written by `gravsweep run` (DIR/bed.h5) instead of building one")
+      ->check(CLI::ExistingFile);
   sub->add_flag("--scaling", opt->scaling, "also time the base bed tiled to about 64,000 and 512,000 grains");
-  sub->add_option("--scaling-grains", opt->scaling_grains, "target sizes of the tiled beds, comma separated")->delimiter(',')->capture_default_str();
-  sub->add_option("--tile-relax", opt->tile_relax_s, "relaxation of a tiled bed before timing, s")->check(CLI::NonNegativeNumber)->capture_default_str();
+  sub->add_option("--scaling-grains", opt->scaling_grains, "target sizes of the tiled beds, comma separated")
+      ->delimiter(',')
+      ->capture_default_str();
+  sub->add_option("--tile-relax", opt->tile_relax_s, "relaxation of a tiled bed before timing, s")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   sub->callback([opt]() { run_bench(*opt); });
 }
 

@@ -72,10 +72,11 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 
 /// A noop sweep of n jobs into a fresh database; returns the submit time.
 double make_campaign(const std::string& db_path, long n) {
-  nlohmann::json doc = {{"sweep", "bench"},
-                        {"job", "noop"},
-                        {"base", {{"i", 0}}},
-                        {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"range", {{"start", 0}, {"stop", n - 1}, {"step", 1}}}}}}};
+  nlohmann::json doc = {
+      {"sweep", "bench"},
+      {"job", "noop"},
+      {"base", {{"i", 0}}},
+      {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"range", {{"start", 0}, {"stop", n - 1}, {"step", 1}}}}}}};
   const auto spec = sweep::parse_spec(doc, "<bench-queue>", ".");
   const auto jobs = sweep::expand(spec, {});
   const auto t0 = Clock::now();
@@ -102,9 +103,10 @@ void run_bench_queue(const BenchQueueOptions& o) {
   fs::create_directories(dir);
   BenchStore store{o.server, dir, {}};
   const std::string exe = queue::self_exe();
-  fmt::print("scheduler overhead with no-op jobs on {} (each: claim in one transaction, one heartbeat, output file "
-             "written + fsynced + renamed + checksummed, fenced completion with results row)\n\n",
-             o.server.empty() ? std::string("SQLite") : "PostgreSQL at " + o.server);
+  fmt::print(
+      "scheduler overhead with no-op jobs on {} (each: claim in one transaction, one heartbeat, output file "
+      "written + fsynced + renamed + checksummed, fenced completion with results row)\n\n",
+      o.server.empty() ? std::string("SQLite") : "PostgreSQL at " + o.server);
 
   // 1. In-process latency of each operation (one connection, no contention).
   {
@@ -132,8 +134,8 @@ void run_bench_queue(const BenchQueueOptions& o) {
       queue::complete(db, *c, done);
       t_done += since(t0);
     }
-    fmt::print("per operation, one process, {} jobs:  claim {:.3f} ms   heartbeat {:.3f} ms   complete {:.3f} ms\n\n", k,
-               1e3 * t_claim / std::max(1L, k), 1e3 * t_beat / std::max(1L, k), 1e3 * t_done / std::max(1L, k));
+    fmt::print("per operation, one process, {} jobs:  claim {:.3f} ms   heartbeat {:.3f} ms   complete {:.3f} ms\n\n",
+               k, 1e3 * t_claim / std::max(1L, k), 1e3 * t_beat / std::max(1L, k), 1e3 * t_done / std::max(1L, k));
   }
 
   // 2. Worker processes end to end.
@@ -141,8 +143,8 @@ void run_bench_queue(const BenchQueueOptions& o) {
   for (int w : o.workers) {
     const std::string db_path = store.fresh(fmt::format("work_{}", w));
     make_campaign(db_path, o.jobs);
-    std::vector<std::string> args{"work", "--db", db_path, "--workers", std::to_string(w), "--threads", "1", "--quiet",
-                                  "--poll", "0.01"};
+    std::vector<std::string> args{"work",      "--db", db_path,   "--workers", std::to_string(w),
+                                  "--threads", "1",    "--quiet", "--poll",    "0.01"};
     if (!store.files(db_path).empty()) args.insert(args.end(), {"--files", store.files(db_path).string()});
     const auto t0 = Clock::now();
     const pid_t pid = queue::spawn_process(exe, args);
@@ -169,13 +171,16 @@ void run_bench_queue(const BenchQueueOptions& o) {
     const pid_t pid = queue::spawn_process(exe, {"status", "--db", db_path}, true);
     const int code = queue::wait_process(pid);
     const double cli_s = since(t0);
-    fmt::print("\n{} queued jobs: submit {:.2f} s ({:.0f} jobs/s); status query {:.1f} ms (best of 5); "
-               "`gravsweep status` process {:.1f} ms (exit {})\n",
-               o.status_jobs, submit_s, static_cast<double>(o.status_jobs) / submit_s, 1e3 * best, 1e3 * cli_s, code);
+    fmt::print(
+        "\n{} queued jobs: submit {:.2f} s ({:.0f} jobs/s); status query {:.1f} ms (best of 5); "
+        "`gravsweep status` process {:.1f} ms (exit {})\n",
+        o.status_jobs, submit_s, static_cast<double>(o.status_jobs) / submit_s, 1e3 * best, 1e3 * cli_s, code);
   }
   if (!o.keep) store.drop_all();
-  if (!o.keep && o.dir.empty()) fs::remove_all(dir);
-  else fmt::print("databases kept in {}{}\n", dir.string(), o.server.empty() ? "" : " and on the server");
+  if (!o.keep && o.dir.empty())
+    fs::remove_all(dir);
+  else
+    fmt::print("databases kept in {}{}\n", dir.string(), o.server.empty() ? "" : " and on the server");
 }
 
 }  // namespace
@@ -193,12 +198,17 @@ void setup_bench_queue(CLI::App& app) {
       "  gravsweep bench-queue                              # 2000 jobs, 1 and 4 workers, status on 100,000\n"
       "  gravsweep bench-queue --jobs 500 --workers 1,2,4 --status-jobs 20000\n"
       "  gravsweep bench-queue --postgres postgresql://postgres@127.0.0.1:54329/postgres --workers 1,4,16");
-  sub->add_option("--jobs", opt->jobs, "no-op jobs per worker count")->check(CLI::Range(1L, 10000000L))->capture_default_str();
+  sub->add_option("--jobs", opt->jobs, "no-op jobs per worker count")
+      ->check(CLI::Range(1L, 10000000L))
+      ->capture_default_str();
   sub->add_option("--workers", opt->workers, "worker counts, comma separated")->delimiter(',')->capture_default_str();
-  sub->add_option("--status-jobs", opt->status_jobs, "queued jobs for the status timing")->check(CLI::Range(1L, 10000000L))->capture_default_str();
+  sub->add_option("--status-jobs", opt->status_jobs, "queued jobs for the status timing")
+      ->check(CLI::Range(1L, 10000000L))
+      ->capture_default_str();
   sub->add_option("--dir", opt->dir, "directory for the databases (kept)");
-  sub->add_option("--postgres", opt->server, "PostgreSQL URL of a database to connect to for creating the benchmark's "
-                                             "databases (e.g. postgresql://postgres@127.0.0.1:5432/postgres)");
+  sub->add_option("--postgres", opt->server,
+                  "PostgreSQL URL of a database to connect to for creating the benchmark's "
+                  "databases (e.g. postgresql://postgres@127.0.0.1:5432/postgres)");
   sub->add_flag("--keep", opt->keep, "keep the temporary databases");
   sub->callback([opt]() { run_bench_queue(*opt); });
 }

@@ -23,10 +23,10 @@ void run_copy(const CopyOptions& o) {
   db::Database dst = queue::open_campaign(o.dst, queue::OpenMode::create, o.dst_files);
   const queue::CampaignPaths dst_paths(o.dst, o.dst_files);
   const auto rep = queue::copy_campaign(src, src_paths, dst, dst_paths);
-  fmt::print("copied {} -> {}: {} jobs, {} attempts, {} results rows ({} parameter and metric columns); {} files "
-             "copied to {}\n",
-             o.src, o.dst, rep.jobs, rep.attempts, rep.results, rep.result_columns, rep.files,
-             dst_paths.root.string());
+  fmt::print(
+      "copied {} -> {}: {} jobs, {} attempts, {} results rows ({} parameter and metric columns); {} files "
+      "copied to {}\n",
+      o.src, o.dst, rep.jobs, rep.attempts, rep.results, rep.result_columns, rep.files, dst_paths.root.string());
 }
 
 }  // namespace
@@ -46,7 +46,8 @@ void setup_campaign(CLI::App& app) {
       "  gravsweep campaign copy campaign.db postgresql://me@dbhost:5432/sweep --files /shared/sweep\n"
       "  gravsweep campaign copy postgresql://me@dbhost:5432/sweep back.db --from-files /shared/sweep");
   copy->add_option("SRC", o->src, "source campaign: an SQLite file or postgresql://user@host:port/dbname")->required();
-  copy->add_option("DST", o->dst, "destination (new): an SQLite file or postgresql://user@host:port/dbname")->required();
+  copy->add_option("DST", o->dst, "destination (new): an SQLite file or postgresql://user@host:port/dbname")
+      ->required();
   copy->add_option("--from-files", o->src_files, "the source's files root (required for a PostgreSQL source)");
   copy->add_option("--files", o->dst_files, "the destination's files root (required for a PostgreSQL destination)");
   copy->callback([o]() { run_copy(*o); });

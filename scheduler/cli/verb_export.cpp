@@ -46,8 +46,8 @@ struct ExportOptions {
 
 /// Columns of trials.csv after the trial record's own (results::trial_fields()): the DEM
 /// provenance that the record does not carry.
-const std::vector<std::string> kDemColumns = {"source", "contact_start_s", "sweep", "scenario_file",
-                                              "dt_s", "grains", "lateral_offset_m"};
+const std::vector<std::string> kDemColumns = {"source", "contact_start_s", "sweep",           "scenario_file",
+                                              "dt_s",   "grains",          "lateral_offset_m"};
 
 std::vector<std::string> trials_header() {
   std::vector<std::string> h;
@@ -76,7 +76,8 @@ std::optional<results::BedData> bed_of(db::Database& db, const queue::CampaignPa
 /// Writes traces/<job>.csv: t_s, accel_m_s2 (decimated with its anti-alias filter), position_m
 /// and velocity_m_s (every k-th sample: they are smooth). Returns the new sample rate.
 double write_trace_csv(const fs::path& path, const results::TraceData& td, double rate_hz) {
-  const std::size_t step = std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(td.sample_rate_hz / rate_hz)));
+  const std::size_t step =
+      std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(td.sample_rate_hz / rate_hz)));
   const auto t = results::every_nth(td.t_s, step);
   const auto a = results::decimate(td.accel_up_m_s2, td.sample_rate_hz, step);
   const auto z = results::every_nth(td.depth_m, step);
@@ -84,8 +85,7 @@ double write_trace_csv(const fs::path& path, const results::TraceData& td, doubl
   std::ofstream f(path, std::ios::binary);
   if (!f) throw std::runtime_error(fmt::format("{}: cannot write", path.string()));
   f << "t_s,accel_m_s2,position_m,velocity_m_s\n";
-  for (std::size_t i = 0; i < t.size(); ++i)
-    f << fmt::format("{:.6f},{:.6g},{:.7g},{:.6g}\n", t[i], a[i], z[i], v[i]);
+  for (std::size_t i = 0; i < t.size(); ++i) f << fmt::format("{:.6f},{:.6g},{:.7g},{:.6g}\n", t[i], a[i], z[i], v[i]);
   if (!f) throw std::runtime_error(fmt::format("{}: write error", path.string()));
   return td.sample_rate_hz / static_cast<double>(step);
 }
@@ -136,7 +136,8 @@ void run_export(const ExportOptions& o) {
   }
   const auto col = [&](const std::string& name) {
     const auto it = std::find(t.columns.begin(), t.columns.end(), name);
-    if (it == t.columns.end()) throw std::runtime_error(fmt::format("{}: results table has no column '{}'", o.db, name));
+    if (it == t.columns.end())
+      throw std::runtime_error(fmt::format("{}: results table has no column '{}'", o.db, name));
     return static_cast<std::size_t>(it - t.columns.begin());
   };
   const std::size_t c_job = col("job_id"), c_sweep = col("sweep"), c_kind = col("kind"), c_trace = col("trace_path"),

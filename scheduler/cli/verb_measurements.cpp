@@ -97,18 +97,18 @@ void setup_measurements(CLI::App& app) {
     std::size_t bad = 0;
     for (const auto& is : c.issues) bad += is.kind == results::ImportIssue::Kind::bad_input;
     if (bad > 0 && !o->keep_going)
-      throw UsageError(fmt::format("{}: {} trial{} with bad input (listed above); nothing written to {} "
-                                   "(--keep-going stores the others)",
-                                   o->dir, bad, bad == 1 ? "" : "s", o->db));
-    if (c.trials.empty())
-      throw UsageError(fmt::format("{}: no usable trials; nothing written to {}", o->dir, o->db));
+      throw UsageError(
+          fmt::format("{}: {} trial{} with bad input (listed above); nothing written to {} "
+                      "(--keep-going stores the others)",
+                      o->dir, bad, bad == 1 ? "" : "s", o->db));
+    if (c.trials.empty()) throw UsageError(fmt::format("{}: no usable trials; nothing written to {}", o->dir, o->db));
     int stored = 0;
     {
       db::Database db(o->db);
       stored = results::store_campaign(db, c);
     }
-    results::Table t({"trial_id", "source", "gravity_m_s2", "vc_m_s", "apeak_m_s2", "zstop_mm", "tstop_ms",
-                      "bias_m_s2", "rebound"});
+    results::Table t(
+        {"trial_id", "source", "gravity_m_s2", "vc_m_s", "apeak_m_s2", "zstop_mm", "tstop_ms", "bias_m_s2", "rebound"});
     for (const auto& tr : c.trials) {
       const auto& m = tr.processed.metrics;
       t.add({tr.info.trial_id, results::to_string(tr.info.source), results::num(tr.info.gravity_m_s2),

@@ -71,8 +71,8 @@ void print_params(const results::FittedModel& m, const std::string& format) {
 }
 
 results::Table error_table(const std::vector<results::ComparedModel>& cm) {
-  results::Table t({"model", "trace_rms_m_s2", "trace_rel_pct", "zstop_rms_mm", "zstop_rel_pct",
-                    "tstop_rms_ms", "tstop_rel_pct", "apeak_rms_m_s2", "apeak_rel_pct", "trials"});
+  results::Table t({"model", "trace_rms_m_s2", "trace_rel_pct", "zstop_rms_mm", "zstop_rel_pct", "tstop_rms_ms",
+                    "tstop_rel_pct", "apeak_rms_m_s2", "apeak_rel_pct", "trials"});
   for (const auto& m : cm) {
     const auto& e = m.errors;
     t.add({m.name, num(e.trace_rms_m_s2, 3), num(e.trace_rel_pct, 3), num(e.zstop_rms_mm, 3), num(e.zstop_rel_pct, 3),
@@ -99,41 +99,48 @@ void explain_rises(const std::vector<results::ComparedModel>& cm) {
                         Pair{"apeak", "m_s2", b.apeak_rms_m_s2, a.apeak_rms_m_s2, b.apeak_rel_pct, a.apeak_rel_pct}}) {
     const bool rms_up = p.rms_a > p.rms_b, rel_up = p.rel_a > p.rel_b;
     if (rms_up && !rel_up)
-      fmt::print("note: {0}_rms_{1} rises {2:.3g} -> {3:.3g} while {0}_rel_pct falls {4:.3g} -> {5:.3g}: the RMS in "
-                 "{1} is set by the trials with the largest {0} (the fastest, at the highest gravity), the relative "
-                 "error weighs every trial alike; see `model residuals` for the trials\n",
-                 p.metric, p.unit, p.rms_b, p.rms_a, p.rel_b, p.rel_a);
+      fmt::print(
+          "note: {0}_rms_{1} rises {2:.3g} -> {3:.3g} while {0}_rel_pct falls {4:.3g} -> {5:.3g}: the RMS in "
+          "{1} is set by the trials with the largest {0} (the fastest, at the highest gravity), the relative "
+          "error weighs every trial alike; see `model residuals` for the trials\n",
+          p.metric, p.unit, p.rms_b, p.rms_a, p.rel_b, p.rel_a);
     else if (rel_up && !rms_up)
-      fmt::print("note: {0}_rel_pct rises {2:.3g} -> {3:.3g} while {0}_rms_{1} falls: the relative error is set by "
-                 "the trials with the smallest {0} (slow or low-gravity ones); see `model residuals`\n",
-                 p.metric, p.unit, p.rel_b, p.rel_a);
+      fmt::print(
+          "note: {0}_rel_pct rises {2:.3g} -> {3:.3g} while {0}_rms_{1} falls: the relative error is set by "
+          "the trials with the smallest {0} (slow or low-gravity ones); see `model residuals`\n",
+          p.metric, p.unit, p.rel_b, p.rel_a);
     else if (rms_up && rel_up)
-      fmt::print("note: both {0} errors rise with {1}: it fits the trace better but predicts {0} worse held out; "
-                 "see `model residuals` for where\n",
-                 p.metric, cm.back().name);
+      fmt::print(
+          "note: both {0} errors rise with {1}: it fits the trace better but predicts {0} worse held out; "
+          "see `model residuals` for where\n",
+          p.metric, cm.back().name);
   }
 }
 
 void print_axes(const std::vector<results::AxisResidual>& axes, const std::string& format) {
-  results::Table t({"axis", "eta2", "split_half_r", "trials_slope_up", "trials_slope_down", "sign_test_p", "mean_residual_over_g_by_bin"});
+  results::Table t({"axis", "eta2", "split_half_r", "trials_slope_up", "trials_slope_down", "sign_test_p",
+                    "mean_residual_over_g_by_bin"});
   for (const auto& a : axes) {
     std::string bins;
     for (std::size_t i = 0; i < a.bin_center.size(); ++i)
       bins += fmt::format("{}{:.3g}:{:+.3f}", i ? " " : "", a.bin_center[i], a.bin_mean_r_over_g[i]);
     const bool trial_level = a.trials_positive + a.trials_negative == 0;
     t.add({a.axis, num(a.eta2, 3), num(a.split_half_r, 2), trial_level ? "-" : std::to_string(a.trials_positive),
-           trial_level ? "-" : std::to_string(a.trials_negative), trial_level ? "-" : num(a.slope_sign_trials_p, 2), bins});
+           trial_level ? "-" : std::to_string(a.trials_negative), trial_level ? "-" : num(a.slope_sign_trials_p, 2),
+           bins});
   }
   t.print(format);
 }
 
 void print_ranking(const results::Discovery& d, const std::string& format) {
-  results::Table t({"round", "rank", "term", "mean_rel_improvement_pct", "trials_better", "trials", "p_signed_rank", "significant"});
+  results::Table t(
+      {"round", "rank", "term", "mean_rel_improvement_pct", "trials_better", "trials", "p_signed_rank", "significant"});
   for (std::size_t r = 0; r < d.rounds.size(); ++r)
     for (std::size_t i = 0; i < d.rounds[r].size(); ++i) {
       const auto& c = d.rounds[r][i];
       t.add({std::to_string(r + 1), std::to_string(i + 1), c.term, num(100 * c.mean_rel_improvement, 3),
-             std::to_string(c.trials_better), std::to_string(c.trials), num(c.p_value, 2), c.significant ? "yes" : "no"});
+             std::to_string(c.trials_better), std::to_string(c.trials), num(c.p_value, 2),
+             c.significant ? "yes" : "no"});
     }
   // The search beyond the named library: the nested-CV test of choosing a form, then the forms by
   // in-sample improvement (screening only: no test of their own).
@@ -142,25 +149,26 @@ void print_ranking(const results::Discovery& d, const std::string& format) {
     t.add({"generated", "1", g.term, num(100 * g.mean_rel_improvement, 3), std::to_string(g.trials_better),
            std::to_string(g.trials), num(g.p_value, 2), g.significant ? "yes" : "no"});
   }
-  const std::size_t shown = format == "table" ? std::min<std::size_t>(6, d.generated_screened.size()) : d.generated_screened.size();
+  const std::size_t shown =
+      format == "table" ? std::min<std::size_t>(6, d.generated_screened.size()) : d.generated_screened.size();
   for (std::size_t i = 0; i < shown; ++i) {
     const auto& c = d.generated_screened[i];
     t.add({"screened", std::to_string(i + 1), c.term, num(100 * c.mean_rel_improvement, 3), "-", "-", "-", "-"});
   }
   t.print(format);
   if (format == "table" && shown < d.generated_screened.size())
-    fmt::print("(round 'generated': the held-out test of choosing a form, nested CV; 'screened': in-sample gain of "
-               "each form, {} more with --format csv)\n",
-               d.generated_screened.size() - shown);
+    fmt::print(
+        "(round 'generated': the held-out test of choosing a form, nested CV; 'screened': in-sample gain of "
+        "each form, {} more with --format csv)\n",
+        d.generated_screened.size() - shown);
 }
 
 }  // namespace
 
 void setup_model(CLI::App& app) {
-  auto* sub = app.add_subcommand(
-      "model",
-      "Collision models m dv/dt = m g - R(z, v, g) as sums of named terms, compared with a\n"
-      "measurement campaign. Run `gravsweep model terms` for the term library.");
+  auto* sub = app.add_subcommand("model",
+                                 "Collision models m dv/dt = m g - R(z, v, g) as sums of named terms, compared with a\n"
+                                 "measurement campaign. Run `gravsweep model terms` for the term library.");
   sub->require_subcommand(1);
 
   auto* terms = sub->add_subcommand("terms", "List the registered model terms.\n\nExample:\n  gravsweep model terms");
@@ -177,19 +185,19 @@ void setup_model(CLI::App& app) {
   });
 
   auto o3 = std::make_shared<ModelOptions>();
-  auto* t3 = sub->add_subcommand(
-      "table3",
-      "The paper's method (Sunday et al. 2021 Sect. 4): per gravity level fit Eq. 2 to apeak(vc),\n"
-      "print f0, 1/d1, vt (Eq. 5) and alpha (zstop ~ H^alpha) with standard errors, as Table 3.\n\n"
-      "Examples:\n  gravsweep model table3 ../shared/data/measurements/depth-friction-dev\n"
-      "  gravsweep model table3 campaign.db --where 'impact_speed_m_s>=0.5'");
+  auto* t3 =
+      sub->add_subcommand("table3",
+                          "The paper's method (Sunday et al. 2021 Sect. 4): per gravity level fit Eq. 2 to apeak(vc),\n"
+                          "print f0, 1/d1, vt (Eq. 5) and alpha (zstop ~ H^alpha) with standard errors, as Table 3.\n\n"
+                          "Examples:\n  gravsweep model table3 ../shared/data/measurements/depth-friction-dev\n"
+                          "  gravsweep model table3 campaign.db --where 'impact_speed_m_s>=0.5'");
   t3->add_option("dir", o3->dir, kDirHelp)->required();
   t3->add_option("--where", o3->where, kWhereHelp);
   add_format_option(t3, o3->format);
   t3->callback([o3]() {
     const auto c = load(o3->dir, o3->where);
-    results::Table t({"gravity_m_s2", "trials", "f0_N", "f0_se_N", "inv_d1_1_m", "inv_d1_se_1_m", "vt_m_s",
-                      "vt_se_m_s", "alpha", "alpha_se", "note"});
+    results::Table t({"gravity_m_s2", "trials", "f0_N", "f0_se_N", "inv_d1_1_m", "inv_d1_se_1_m", "vt_m_s", "vt_se_m_s",
+                      "alpha", "alpha_se", "note"});
     for (const auto& r : results::table3(c))
       t.add({num(r.g_m_s2), std::to_string(r.trials), num(r.f0_N, 3), num(r.f0_se_N, 2), num(r.inv_d1_1_m, 3),
              num(r.inv_d1_se_1_m, 2), num(r.vt_m_s, 3), num(r.vt_se_m_s, 2), num(r.alpha, 3), num(r.alpha_se, 2),
@@ -212,7 +220,9 @@ void setup_model(CLI::App& app) {
   fit->add_option("--where", of->where, kWhereHelp);
   fit->add_option("--model", of->model, "model: 'base+depth_friction' or a JSON spec file")->capture_default_str();
   fit->add_option("--baseline", of->baseline, "the 'before' model")->capture_default_str();
-  fit->add_option("--folds", of->folds, "cross-validation folds (whole trials)")->check(CLI::Range(2, 100))->capture_default_str();
+  fit->add_option("--folds", of->folds, "cross-validation folds (whole trials)")
+      ->check(CLI::Range(2, 100))
+      ->capture_default_str();
   of->plot = "error_falls.png";
   fit->add_option("--plot", of->plot, "write the error-falling figure (PNG) here")->capture_default_str();
   auto no_plot = std::make_shared<bool>(false);
@@ -224,10 +234,12 @@ void setup_model(CLI::App& app) {
     const auto base = spec_of(of->baseline);
     const auto spec = spec_of(of->model);
     const auto fm = results::fit_model(spec, c);
-    if (of->format == "table") fmt::print("Model {} fitted on {} trials ({} samples):\n", spec.name(), fm.trials_used, fm.samples_used);
+    if (of->format == "table")
+      fmt::print("Model {} fitted on {} trials ({} samples):\n", spec.name(), fm.trials_used, fm.samples_used);
     print_params(fm, of->format);
     const auto cm = results::compare_models(c, {base, spec}, of->folds);
-    if (of->format == "table") fmt::print("\nHeld-out errors ({}-fold grouped CV, whole trials held out), before and after:\n", of->folds);
+    if (of->format == "table")
+      fmt::print("\nHeld-out errors ({}-fold grouped CV, whole trials held out), before and after:\n", of->folds);
     error_table(cm).print(of->format);
     if (of->format == "table") explain_rises(cm);
     if (!of->plot.empty()) {
@@ -268,8 +280,8 @@ void setup_model(CLI::App& app) {
   res->callback([ores]() {
     const auto c = load(ores->dir, ores->where);
     const auto fm = results::fit_model(spec_of(ores->model), c);
-    results::Table t({"trial_id", "gravity_m_s2", "vc_m_s", "fill_height_m", "trace_rms_m_s2", "dzstop_mm",
-                      "dtstop_ms", "dapeak_m_s2"});
+    results::Table t({"trial_id", "gravity_m_s2", "vc_m_s", "fill_height_m", "trace_rms_m_s2", "dzstop_mm", "dtstop_ms",
+                      "dapeak_m_s2"});
     // apeak as measured: the model's record filtered like the trial, with the other trials'
     // fluctuations about the model at its level (results/model/model.h).
     std::vector<std::vector<double>> fluct;
@@ -279,7 +291,8 @@ void setup_model(CLI::App& app) {
       const auto p = results::predict(fm, tr, results::same_level_fluctuations(c, fluct, i));
       const auto& m = tr.processed.metrics;
       t.add({tr.info.trial_id, num(tr.info.gravity_m_s2), num(m.vc_m_s), num(tr.info.fill_height_m),
-             num(std::sqrt(results::trial_trace_mse(fm, tr)), 3), p.stopped ? num(1e3 * (p.zstop_m - m.zstop_m), 3) : "nan",
+             num(std::sqrt(results::trial_trace_mse(fm, tr)), 3),
+             p.stopped ? num(1e3 * (p.zstop_m - m.zstop_m), 3) : "nan",
              p.stopped ? num(1e3 * (p.tstop_s - m.tstop_s), 3) : "nan", num(p.apeak_m_s2 - m.apeak_m_s2, 3)});
     }
     if (ores->format == "table") fmt::print("Per trial ({} fitted on all trials; model - measured):\n", fm.spec.name());
@@ -330,8 +343,9 @@ void setup_model(CLI::App& app) {
     for (const auto& term : od->terms) {
       int first = 0, sig = 0, any = 0;
       for (int s = 1; s <= od->seeds; ++s) {
-        const auto d = run_one("base+" + term, static_cast<unsigned>(s),
-                               term == "bottom_stiffening" ? std::vector<double>{0.05, 0.06, 0.08} : std::vector<double>{});
+        const auto d =
+            run_one("base+" + term, static_cast<unsigned>(s),
+                    term == "bottom_stiffening" ? std::vector<double>{0.05, 0.06, 0.08} : std::vector<double>{});
         const auto& top = d.rounds.front().front();
         const bool ok = top.term == term || (term == "depth_friction" && top.term == "gravity_depth_friction");
         first += ok;
@@ -371,7 +385,8 @@ void setup_model(CLI::App& app) {
   rank->add_option("--baseline", orank->baseline, "starting model")->capture_default_str();
   rank->add_option("--folds", orank->folds, "cross-validation folds")->check(CLI::Range(2, 100))->capture_default_str();
   rank->add_option("--alpha", orank->alpha, "family-wise significance level")->capture_default_str();
-  rank->add_option("--min-improvement", orank->min_improvement, "minimum mean relative improvement")->capture_default_str();
+  rank->add_option("--min-improvement", orank->min_improvement, "minimum mean relative improvement")
+      ->capture_default_str();
   add_format_option(rank, orank->format);
   rank->callback([orank]() {
     const auto c = load(orank->dir, orank->where);
@@ -381,8 +396,10 @@ void setup_model(CLI::App& app) {
     print_axes(d.residual_before, orank->format);
     if (orank->format == "table") fmt::print("\nCandidate terms by held-out improvement:\n");
     print_ranking(d, orank->format);
-    if (orank->format == "table") fmt::print("\nVerdict: {}\n", d.verdict);
-    else std::fprintf(stderr, "verdict: %s\n", d.verdict.c_str());
+    if (orank->format == "table")
+      fmt::print("\nVerdict: {}\n", d.verdict);
+    else
+      std::fprintf(stderr, "verdict: %s\n", d.verdict.c_str());
   });
 }
 

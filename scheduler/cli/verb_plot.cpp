@@ -132,9 +132,11 @@ void setup_plot(CLI::App& app) {
       "it for every run). A record without contact is refused (exit 2).\n\n"
       "Examples:\n"
       "  gravsweep plot trace runs/1g/trace.h5\n"
-      "  gravsweep plot trace runs/1g/trace.h5 --compare ../shared/data/measurements/depth-friction-dev/traces/t001.csv\n"
+      "  gravsweep plot trace runs/1g/trace.h5 --compare "
+      "../shared/data/measurements/depth-friction-dev/traces/t001.csv\n"
       "  gravsweep plot trace campaign.files/traces/<job>.a1.h5 --out fig2.png");
-  tr->add_option("record", ot->record, "a trace.h5 of `gravsweep run` or of a campaign, or a lab trace .csv")->required();
+  tr->add_option("record", ot->record, "a trace.h5 of `gravsweep run` or of a campaign, or a lab trace .csv")
+      ->required();
   tr->add_option("--compare", ot->compare, "another record (trace.h5 or lab .csv) drawn over the first");
   tr->add_option("--out", ot->out, "PNG file to write (default: fig2.png next to the record)");
   tr->callback([ot]() { run_plot_trace(*ot); });

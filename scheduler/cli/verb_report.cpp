@@ -62,8 +62,9 @@ results::HtmlReport report_page(const std::string& dir, const CampaignInput& in,
   {
     results::HtmlSection s;
     s.heading = fmt::format("Where {} fails", d.baseline);
-    s.text = "Residual a_meas - a_model (in g) by quantile bins of each axis; eta2 is the share of the residual "
-             "variance the bins explain, the sign test counts trials whose within-trial slope is up or down.";
+    s.text =
+        "Residual a_meas - a_model (in g) by quantile bins of each axis; eta2 is the share of the residual "
+        "variance the bins explain, the sign test counts trials whose within-trial slope is up or down.";
     for (const auto* axes : {&d.residual_before, &d.residual_after}) {
       results::Table t({"axis", "eta2", "trials_up", "trials_down", "mean_residual_over_g_by_bin"});
       for (const auto& a : *axes) {
@@ -73,12 +74,14 @@ results::HtmlReport report_page(const std::string& dir, const CampaignInput& in,
         t.add({a.axis, results::num(a.eta2, 3), std::to_string(a.trials_positive), std::to_string(a.trials_negative),
                bins});
       }
-      s.tables.emplace_back(axes == &d.residual_before ? "before (" + d.baseline + ")" : "after (with the added terms)", t);
+      s.tables.emplace_back(axes == &d.residual_before ? "before (" + d.baseline + ")" : "after (with the added terms)",
+                            t);
     }
     page.sections.push_back(std::move(s));
   }
   {
-    results::Table t({"gravity_m_s2", "trials", "f0_N", "f0_se_N", "inv_d1_1_m", "inv_d1_se_1_m", "vt_m_s", "alpha", "alpha_se"});
+    results::Table t(
+        {"gravity_m_s2", "trials", "f0_N", "f0_se_N", "inv_d1_1_m", "inv_d1_se_1_m", "vt_m_s", "alpha", "alpha_se"});
     for (const auto& r : results::table3(c))
       t.add({results::num(r.g_m_s2), std::to_string(r.trials), results::num(r.f0_N, 3), results::num(r.f0_se_N, 2),
              results::num(r.inv_d1_1_m, 3), results::num(r.inv_d1_se_1_m, 2), results::num(r.vt_m_s, 3),
@@ -86,7 +89,8 @@ results::HtmlReport report_page(const std::string& dir, const CampaignInput& in,
     page.sections.push_back({"Table 3 (paper's method: Eq. 2 fitted to apeak per gravity level)", "", {{"", t}}});
   }
   {
-    results::Table t({"model", "trace_rel_pct", "zstop_rms_mm", "zstop_rel_pct", "tstop_rms_ms", "tstop_rel_pct", "apeak_rel_pct"});
+    results::Table t(
+        {"model", "trace_rel_pct", "zstop_rms_mm", "zstop_rel_pct", "tstop_rms_ms", "tstop_rel_pct", "apeak_rel_pct"});
     for (const auto& m : cm)
       t.add({m.name, results::num(m.errors.trace_rel_pct, 3), results::num(m.errors.zstop_rms_mm, 3),
              results::num(m.errors.zstop_rel_pct, 3), results::num(m.errors.tstop_rms_ms, 3),
@@ -94,7 +98,8 @@ results::HtmlReport report_page(const std::string& dir, const CampaignInput& in,
     page.sections.push_back({"Held-out errors (grouped CV, whole trials held out)", "", {{"", t}}});
   }
   {
-    results::Table t({"round", "term", "mean_rel_improvement_pct", "trials_better", "trials", "p_signed_rank", "significant"});
+    results::Table t(
+        {"round", "term", "mean_rel_improvement_pct", "trials_better", "trials", "p_signed_rank", "significant"});
     for (std::size_t r = 0; r < d.rounds.size(); ++r)
       for (const auto& cd : d.rounds[r])
         t.add({std::to_string(r + 1), cd.term, results::num(100 * cd.mean_rel_improvement, 3),
@@ -113,7 +118,8 @@ void setup_report(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "report",
       "Compare collision models with a measurement campaign and write PNG figures, a summary\n"
-      "page (summary.md) and index.html (one self-contained page, figures embedded, to send) into --out: fig9_metrics_vs_vc.png (apeak, zstop, tstop vs vc with the\n"
+      "page (summary.md) and index.html (one self-contained page, figures embedded, to send) into --out: "
+      "fig9_metrics_vs_vc.png (apeak, zstop, tstop vs vc with the\n"
       "model lines), residual_vs_depth_speed.png (coloured by gravity), fig10_zstop_vs_H.png,\n"
       "ranking.png and error_falls.png, plus the CSV files behind them. Without --model the\n"
       "missing effect is searched for (as `gravsweep model rank`) and the winner is added.\n\n"

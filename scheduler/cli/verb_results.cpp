@@ -84,8 +84,9 @@ bool same_key(const nlohmann::json& a, const nlohmann::json& b, const std::strin
 
 std::vector<std::string> metric_columns(db::Database& db) {
   std::vector<std::string> m;
-  db::Statement st(db, "SELECT name FROM results_columns WHERE role='metric' AND sql_type IN ('REAL','INTEGER') "
-                       "ORDER BY position");
+  db::Statement st(db,
+                   "SELECT name FROM results_columns WHERE role='metric' AND sql_type IN ('REAL','INTEGER') "
+                   "ORDER BY position");
   while (st.step()) m.push_back(st.get_text(0));
   return m;
 }

@@ -65,8 +65,11 @@ void setup_resume(CLI::App& app) {
       "  gravsweep resume --db campaign.db --dry-run");
   add_campaign_options(sub, opt->db, &opt->files);
   sub->add_flag("--dead", opt->dead, "also requeue dead jobs (and the drops waiting on a dead bed)");
-  sub->add_option("--extra-attempts", opt->extra_attempts, "attempts added to a dead job's budget")->check(CLI::Range(1, 100))->capture_default_str();
-  sub->add_flag("--keep-orphans", opt->keep_orphans, "do not look for orphaned files (nor check that the folder belongs to the database)");
+  sub->add_option("--extra-attempts", opt->extra_attempts, "attempts added to a dead job's budget")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  sub->add_flag("--keep-orphans", opt->keep_orphans,
+                "do not look for orphaned files (nor check that the folder belongs to the database)");
   sub->add_flag("--dry-run", opt->dry_run, "report only");
   sub->callback([opt]() { run_resume(*opt); });
 }

@@ -51,8 +51,8 @@ void draw_run_fig2(const std::filesystem::path& trace, const std::filesystem::pa
   const auto png = trace.parent_path() / "fig2.png";
   try {
     results::draw_fig2({trace.string(), "", png.string()});
-    fmt::print("wrote {} (Fig. 2; `gravsweep plot bed {} --trace {}` draws Fig. 1)\n", png.string(),
-               bed.string(), trace.string());
+    fmt::print("wrote {} (Fig. 2; `gravsweep plot bed {} --trace {}` draws Fig. 1)\n", png.string(), bed.string(),
+               trace.string());
   } catch (const ConfigError& e) {
     fmt::print("no fig2.png: {}\n", e.what());
   }
@@ -117,18 +117,20 @@ void run_impact(const RunOptions& o) {
       bar.finish();
       pipeline::write_bed_checksum(bed_path);
       bed_report = b.report;
-      fmt::print("bed: {} grains kept of {} poured, surface at {:.2f} cm, bulk density {:.0f} kg/m3, {} "
-                 "(rms {:.1e} m/s, max {:.1e} m/s), prepared in {}\n",
-                 b.report["grains_kept"].get<long>(), b.report["grains_placed"].get<long>(),
-                 100 * b.report["surface_height_m"].get<double>(), b.report["bulk_density_kg_m3"].get<double>(),
-                 b.report["settled"].get<bool>() ? "settled to the criteria" : "settling stopped by the time cap",
-                 b.report["rms_speed_m_s"].get<double>(), b.report["max_speed_m_s"].get<double>(),
-                 format_duration(b.report["wall_time_s"].get<double>()));
+      fmt::print(
+          "bed: {} grains kept of {} poured, surface at {:.2f} cm, bulk density {:.0f} kg/m3, {} "
+          "(rms {:.1e} m/s, max {:.1e} m/s), prepared in {}\n",
+          b.report["grains_kept"].get<long>(), b.report["grains_placed"].get<long>(),
+          100 * b.report["surface_height_m"].get<double>(), b.report["bulk_density_kg_m3"].get<double>(),
+          b.report["settled"].get<bool>() ? "settled to the criteria" : "settling stopped by the time cap",
+          b.report["rms_speed_m_s"].get<double>(), b.report["max_speed_m_s"].get<double>(),
+          format_duration(b.report["wall_time_s"].get<double>()));
     } else {
       bed_path = o.bed;
       fmt::print("bed: reusing {}\n", bed_path.string());
     }
-    const auto d = pipeline::run_drop_job(scenario, bed_path, out / "trace.h5", o.threads, progress, &pipeline::stop_requested());
+    const auto d =
+        pipeline::run_drop_job(scenario, bed_path, out / "trace.h5", o.threads, progress, &pipeline::stop_requested());
     bar.finish();
     nlohmann::json metrics = d.metrics;
     metrics["scenario"] = std::filesystem::absolute(o.scenario).string();
@@ -168,7 +170,8 @@ void setup_run(CLI::App& app) {
       "and the rebound flag.\n"
       "Writes DIR/bed.h5 (the prepared bed, reusable) with its checksum DIR/bed.h5.sha256,\n"
       "DIR/trace.h5 (the projectile at 10 kHz), DIR/metrics.json, DIR/fig2.png (Sunday et al.\n"
-      "Fig. 2, as `gravsweep plot trace`), grain snapshots DIR/snapshots.h5 with DIR/snapshots.xdmf (open it in ParaView: grains and\n"
+      "Fig. 2, as `gravsweep plot trace`), grain snapshots DIR/snapshots.h5 with DIR/snapshots.xdmf (open it in "
+      "ParaView: grains and\n"
       "projectile as point sets, every 5 ms unless the scenario or --snapshot-interval says\n"
       "otherwise), and prints the metrics. The spec is checked against\n"
       "schemas/scenario.schema.json before any work; errors name the JSON pointer of the field.\n\n"
@@ -184,7 +187,9 @@ void setup_run(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   sub->add_option("--out", opt->out, "output folder (created if missing)")->required();
-  sub->add_option("--bed", opt->bed, "reuse this prepared bed (bed.h5 of an earlier run, verified against bed.h5.sha256) instead of preparing one");
+  sub->add_option(
+      "--bed", opt->bed,
+      "reuse this prepared bed (bed.h5 of an earlier run, verified against bed.h5.sha256) instead of preparing one");
   sub->add_option("--threads", opt->threads, "OpenMP threads (0: the scenario's, else all cores)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();

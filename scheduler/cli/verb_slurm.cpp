@@ -71,10 +71,11 @@ std::string run_capture(const std::string& cmd) {
 
 void run_submit(const SlurmOptions& o) {
   if (!db::is_postgres_url(o.db))
-    throw UsageError(fmt::format("--db '{}': Slurm workers on a cluster need a PostgreSQL campaign "
-                                 "(postgresql://user@host:port/dbname); an SQLite file must not be shared between "
-                                 "nodes (WAL needs one host). Copy it: gravsweep campaign copy {} postgresql://...",
-                                 o.db, o.db));
+    throw UsageError(
+        fmt::format("--db '{}': Slurm workers on a cluster need a PostgreSQL campaign "
+                    "(postgresql://user@host:port/dbname); an SQLite file must not be shared between "
+                    "nodes (WAL needs one host). Copy it: gravsweep campaign copy {} postgresql://...",
+                    o.db, o.db));
   { db::Database db = queue::open_campaign(o.db, queue::OpenMode::write, o.files); }  // refuses a non-campaign
   const queue::CampaignPaths paths(o.db, o.files);
   const fs::path logs = paths.root / "slurm";
@@ -84,9 +85,9 @@ void run_submit(const SlurmOptions& o) {
     return;
   }
   fs::create_directories(logs);
-  const auto stamp = std::chrono::duration_cast<std::chrono::milliseconds>(
-                         std::chrono::system_clock::now().time_since_epoch())
-                         .count();
+  const auto stamp =
+      std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
+          .count();
   const fs::path file = logs / fmt::format("submit-{}.sh", stamp);
   std::ofstream(file) << script;
   const std::string id = run_capture("sbatch --parsable " + sh_quote(file.string()));
@@ -134,12 +135,18 @@ void setup_slurm(CLI::App& app) {
       "  gravsweep slurm submit --db postgresql://me@dbhost:5432/sweep --files /shared/sweep \\\n"
       "      --workers 16 --threads 4 --partition small --time 04:00:00");
   add_campaign_options(sub, o->db, &o->files);
-  sub->add_option("--workers", o->workers, "array tasks (pilot workers)")->check(CLI::Range(1, 100000))->capture_default_str();
-  sub->add_option("--threads", o->threads, "engine threads per worker (= cpus-per-task)")->check(CLI::Range(1, 1024))->capture_default_str();
+  sub->add_option("--workers", o->workers, "array tasks (pilot workers)")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  sub->add_option("--threads", o->threads, "engine threads per worker (= cpus-per-task)")
+      ->check(CLI::Range(1, 1024))
+      ->capture_default_str();
   sub->add_option("--partition", o->partition, "Slurm partition");
   sub->add_option("--time", o->time_limit, "time limit per task, HH:MM:SS");
   sub->add_option("--account", o->account, "Slurm account");
-  sub->add_option("--lease", o->lease_s, "lease length, s, passed to the workers")->check(CLI::Range(0.5, 86400.0))->capture_default_str();
+  sub->add_option("--lease", o->lease_s, "lease length, s, passed to the workers")
+      ->check(CLI::Range(0.5, 86400.0))
+      ->capture_default_str();
   sub->add_flag("--dry-run", o->dry_run, "print the sbatch script, submit nothing");
   sub->callback([o]() { run_submit(*o); });
   auto* cancel = slurm->add_subcommand(

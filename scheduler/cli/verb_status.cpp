@@ -60,9 +60,10 @@ std::string render_status(const queue::Status& s, const std::string& db, double 
     out += r.text();
   }
   if (s.stale_leases > 0)
-    out += fmt::format("\n{} stale lease(s): their workers stopped heartbeating; the next claim or `gravsweep resume` "
-                       "requeues them.\n",
-                       s.stale_leases);
+    out += fmt::format(
+        "\n{} stale lease(s): their workers stopped heartbeating; the next claim or `gravsweep resume` "
+        "requeues them.\n",
+        s.stale_leases);
   if (!s.runtimes.empty()) {
     results::Table k({"kind", "finished", "median_runtime_s", "remaining"}, results::kRuledText);
     for (const auto& r : s.runtimes)
@@ -71,9 +72,11 @@ std::string render_status(const queue::Status& s, const std::string& db, double 
     out += "\nruntimes by kind:\n" + k.text();
   }
   if (all.waiting + all.queued + all.failed + all.running > 0) {
-    out += s.eta_s >= 0 ? fmt::format("\nETA {} with {} active worker(s) (median runtime of finished jobs of each sweep and kind)\n",
-                                      format_duration(s.eta_s), std::max<std::int64_t>(1, s.active_workers))
-                        : "\nETA unknown: no job of some remaining kind has finished yet\n";
+    out += s.eta_s >= 0
+               ? fmt::format(
+                     "\nETA {} with {} active worker(s) (median runtime of finished jobs of each sweep and kind)\n",
+                     format_duration(s.eta_s), std::max<std::int64_t>(1, s.active_workers))
+               : "\nETA unknown: no job of some remaining kind has finished yet\n";
   }
   if (s.blocked > 0) out += fmt::format("{} job(s) dead because a bed they need is dead\n", s.blocked);
   if (!s.recent_errors.empty()) {
@@ -93,21 +96,34 @@ nlohmann::json status_json(const queue::Status& s) {
   json j;
   j["sweeps"] = json::array();
   for (const auto& c : s.per_sweep)
-    j["sweeps"].push_back({{"sweep", c.sweep}, {"kind", c.kind}, {"waiting", c.waiting}, {"queued", c.queued},
-                           {"running", c.running}, {"failed", c.failed}, {"done", c.done}, {"dead", c.dead}});
+    j["sweeps"].push_back({{"sweep", c.sweep},
+                           {"kind", c.kind},
+                           {"waiting", c.waiting},
+                           {"queued", c.queued},
+                           {"running", c.running},
+                           {"failed", c.failed},
+                           {"done", c.done},
+                           {"dead", c.dead}});
   j["running"] = json::array();
   for (const auto& r : s.running)
-    j["running"].push_back({{"job_id", r.job_id}, {"kind", r.kind}, {"attempt", r.attempt}, {"worker", r.owner},
-                            {"phase", r.phase}, {"progress", r.progress}, {"detail", r.detail},
-                            {"started_at", r.started_at}, {"heartbeat_at", r.heartbeat_at},
-                            {"lease_expires", r.lease_expires}, {"stale", r.stale}});
+    j["running"].push_back({{"job_id", r.job_id},
+                            {"kind", r.kind},
+                            {"attempt", r.attempt},
+                            {"worker", r.owner},
+                            {"phase", r.phase},
+                            {"progress", r.progress},
+                            {"detail", r.detail},
+                            {"started_at", r.started_at},
+                            {"heartbeat_at", r.heartbeat_at},
+                            {"lease_expires", r.lease_expires},
+                            {"stale", r.stale}});
   j["stale_leases"] = s.stale_leases;
   j["active_workers"] = s.active_workers;
   j["eta_s"] = s.eta_s >= 0 ? json(s.eta_s) : json(nullptr);
   j["runtimes"] = json::array();
   for (const auto& r : s.runtimes)
-    j["runtimes"].push_back({{"kind", r.kind}, {"finished", r.finished}, {"median_runtime_s", r.median_s},
-                             {"remaining", r.remaining}});
+    j["runtimes"].push_back(
+        {{"kind", r.kind}, {"finished", r.finished}, {"median_runtime_s", r.median_s}, {"remaining", r.remaining}});
   j["dead_recent"] = json::array();
   for (const auto& [id, err] : s.recent_errors) j["dead_recent"].push_back({{"job_id", id}, {"error", err}});
   j["bed_checksum_mismatches"] = json::array();
@@ -131,8 +147,9 @@ void run_status(const StatusOptions& o) {
       if (o.watch_s > 0) fmt::print("\x1b[H\x1b[2J");
       fmt::print("{}", render_status(s, o.db, secs));
       // Provenance: results from another build of gravsweep (like Snakemake's code rerun trigger).
-      db::Statement other(db, "SELECT code_version, count(*) FROM results WHERE code_version <> ? GROUP BY code_version "
-                              "ORDER BY code_version");
+      db::Statement other(db,
+                          "SELECT code_version, count(*) FROM results WHERE code_version <> ? GROUP BY code_version "
+                          "ORDER BY code_version");
       other.bind(1, std::string(pipeline::build_version()));
       std::int64_t n_other = 0;
       std::string versions;

@@ -54,10 +54,21 @@ int final_code(const std::string& db_path) {
 
 int supervise(const WorkOptions& o, int threads) {
   // Children are this binary again with --workers 1: each opens its own connection after exec.
-  std::vector<std::string> args = {"work", "--db", o.db, "--workers", "1", "--threads", std::to_string(threads),
-                                   "--pool-threads", std::to_string(threads * o.workers),
-                                   "--lease", fmt::format("{}", o.lease_s), "--poll", fmt::format("{}", o.poll_s),
-                                   "--backoff", fmt::format("{}", o.backoff_s)};
+  std::vector<std::string> args = {"work",
+                                   "--db",
+                                   o.db,
+                                   "--workers",
+                                   "1",
+                                   "--threads",
+                                   std::to_string(threads),
+                                   "--pool-threads",
+                                   std::to_string(threads * o.workers),
+                                   "--lease",
+                                   fmt::format("{}", o.lease_s),
+                                   "--poll",
+                                   fmt::format("{}", o.poll_s),
+                                   "--backoff",
+                                   fmt::format("{}", o.backoff_s)};
   if (!o.files.empty()) args.insert(args.end(), {"--files", o.files});
   if (o.heartbeat_s > 0) args.insert(args.end(), {"--heartbeat", fmt::format("{}", o.heartbeat_s)});
   if (o.follow) args.push_back("--follow");
@@ -117,7 +128,8 @@ int supervise(const WorkOptions& o, int threads) {
         k = -1;
         --alive;
         const int code = WIFEXITED(status) ? WEXITSTATUS(status) : kExitSignalBase + WTERMSIG(status);
-        if (code == kExitInterrupted) interrupted = true;
+        if (code == kExitInterrupted)
+          interrupted = true;
         else if (code != kExitOk && code != kExitIncomplete) {
           ++failures;
           fmt::print(stderr, "gravsweep work: worker {} exited with code {}\n", done, code);
@@ -135,9 +147,10 @@ int run_work(const WorkOptions& o) {
   // Refuses what is not a campaign before any worker starts (migrates a version-1 campaign).
   { db::Database db = queue::open_campaign(o.db, queue::OpenMode::write, o.files); }
   if (o.heartbeat_s > 0 && o.heartbeat_s * 2 > o.lease_s)
-    throw UsageError(fmt::format("--heartbeat: found {} s, expected at most half of --lease ({} s), or the lease "
-                                 "lapses between heartbeats",
-                                 o.heartbeat_s, o.lease_s));
+    throw UsageError(
+        fmt::format("--heartbeat: found {} s, expected at most half of --lease ({} s), or the lease "
+                    "lapses between heartbeats",
+                    o.heartbeat_s, o.lease_s));
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int threads = o.threads > 0 ? o.threads : std::max(1, cores / std::max(1, o.workers));
   if (o.workers > 1) return supervise(o, threads);
@@ -158,7 +171,9 @@ int run_work(const WorkOptions& o) {
   w.bed_cache = o.bed_cache;
   const auto rep = queue::run_worker(w, queue::all_runners());
   if (!o.quiet)
-    fmt::print(stderr, "worker {}: {} done, {} failed (will retry), {} dead, {} released, {} fenced out, {} expired leases reclaimed\n",
+    fmt::print(stderr,
+               "worker {}: {} done, {} failed (will retry), {} dead, {} released, {} fenced out, {} expired leases "
+               "reclaimed\n",
                getpid(), rep.done, rep.failed, rep.dead, rep.released, rep.fenced_out, rep.reclaimed);
   if (rep.interrupted) return kExitInterrupted;
   return final_code(o.db);
@@ -184,17 +199,30 @@ void setup_work(CLI::App& app) {
       "  gravsweep work --db postgresql://me@dbhost:5432/sweep --files /shared/sweep --threads 4");
   add_campaign_options(sub, opt->db, &opt->files);
   sub->add_option("--workers", opt->workers, "worker processes")->check(CLI::Range(1, 256))->capture_default_str();
-  sub->add_option("--threads", opt->threads, "engine threads per worker (0: cores / workers)")->check(CLI::Range(0, 1024))->capture_default_str();
+  sub->add_option("--threads", opt->threads, "engine threads per worker (0: cores / workers)")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
   sub->add_option("--pool-threads", opt->pool_threads,
                   "threads all the workers hold together (the supervisor passes workers x threads): a bed "
                   "job that runs alone, with nothing else running or claimable, uses them all (0: --threads)")
-      ->check(CLI::Range(0, 4096))->capture_default_str();
+      ->check(CLI::Range(0, 4096))
+      ->capture_default_str();
   sub->add_flag("--follow", opt->follow, "keep waiting for new jobs when none is left");
-  sub->add_option("--lease", opt->lease_s, "lease length, s: a worker silent this long is presumed dead")->check(CLI::Range(0.5, 86400.0))->capture_default_str();
-  sub->add_option("--heartbeat", opt->heartbeat_s, "heartbeat (lease renewal + progress) interval, s (0: min(lease/4, 2 s))")->check(CLI::Range(0.0, 3600.0))->capture_default_str();
-  sub->add_option("--poll", opt->poll_s, "wait between claims when nothing is runnable, s")->check(CLI::Range(0.01, 60.0))->capture_default_str();
-  sub->add_option("--backoff", opt->backoff_s, "retry backoff base, s (base * 2^(attempt-1), capped at 300 s)")->check(CLI::Range(0.0, 3600.0))->capture_default_str();
-  sub->add_option("--max-jobs", opt->max_jobs, "stop after this many jobs per worker (-1: no limit)")->capture_default_str();
+  sub->add_option("--lease", opt->lease_s, "lease length, s: a worker silent this long is presumed dead")
+      ->check(CLI::Range(0.5, 86400.0))
+      ->capture_default_str();
+  sub->add_option("--heartbeat", opt->heartbeat_s,
+                  "heartbeat (lease renewal + progress) interval, s (0: min(lease/4, 2 s))")
+      ->check(CLI::Range(0.0, 3600.0))
+      ->capture_default_str();
+  sub->add_option("--poll", opt->poll_s, "wait between claims when nothing is runnable, s")
+      ->check(CLI::Range(0.01, 60.0))
+      ->capture_default_str();
+  sub->add_option("--backoff", opt->backoff_s, "retry backoff base, s (base * 2^(attempt-1), capped at 300 s)")
+      ->check(CLI::Range(0.0, 3600.0))
+      ->capture_default_str();
+  sub->add_option("--max-jobs", opt->max_jobs, "stop after this many jobs per worker (-1: no limit)")
+      ->capture_default_str();
   sub->add_option("--bed-cache", opt->bed_cache,
                   "folder of prepared beds shared between campaigns and machines: a bed job whose bed is "
                   "there (<bed job id>.h5 + .sha256, checksum and bed key verified) copies it instead of "

@@ -11,9 +11,7 @@ namespace gravsweep::pipeline {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
-fs::path cached_bed_path(const fs::path& cache, const std::string& bed_job_id) {
-  return cache / (bed_job_id + ".h5");
-}
+fs::path cached_bed_path(const fs::path& cache, const std::string& bed_job_id) { return cache / (bed_job_id + ".h5"); }
 
 std::optional<json> take_cached_bed(const fs::path& cache, const std::string& bed_job_id, const json& scenario,
                                     const fs::path& bed_out) {
@@ -21,16 +19,17 @@ std::optional<json> take_cached_bed(const fs::path& cache, const std::string& be
   std::error_code ec;
   if (!fs::exists(cached, ec)) return std::nullopt;
   if (!fs::exists(bed_checksum_path(cached), ec))
-    throw ConfigError(fmt::format("bed cache: {} has no checksum file {}: it cannot be verified; delete it or "
-                                  "restore its checksum file",
-                                  cached.string(), bed_checksum_path(cached).string()));
+    throw ConfigError(
+        fmt::format("bed cache: {} has no checksum file {}: it cannot be verified; delete it or "
+                    "restore its checksum file",
+                    cached.string(), bed_checksum_path(cached).string()));
   results::BedData bed;
   try {
     bed = read_user_bed(cached, nullptr);  // checksum verified here
     require_bed_key(bed, validate_scenario(scenario), cached);
   } catch (const ConfigError& e) {
-    throw ConfigError(fmt::format("bed cache: {}; delete {} and its checksum file to prepare the bed again",
-                                  e.what(), cached.string()));
+    throw ConfigError(fmt::format("bed cache: {}; delete {} and its checksum file to prepare the bed again", e.what(),
+                                  cached.string()));
   }
   const fs::path tmp = bed_out.string() + ".from-cache";
   fs::copy_file(cached, tmp, fs::copy_options::overwrite_existing);

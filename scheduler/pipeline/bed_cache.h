@@ -20,8 +20,7 @@ std::filesystem::path cached_bed_path(const std::filesystem::path& cache, const 
 /// "from_cache": the cached file). std::nullopt when the cache has no such file. Throws ConfigError
 /// naming the cached file when it has no checksum file, does not match it, or holds another bed key.
 std::optional<nlohmann::json> take_cached_bed(const std::filesystem::path& cache, const std::string& bed_job_id,
-                                              const nlohmann::json& scenario,
-                                              const std::filesystem::path& bed_out);
+                                              const nlohmann::json& scenario, const std::filesystem::path& bed_out);
 
 /// Copies a prepared bed into the cache under its job id, with its checksum file (temporary names,
 /// then rename: a reader never sees half a bed). Creates the folder. Keeps an existing entry.

@@ -20,7 +20,6 @@
 #include "scheduler/pipeline/scenario_spec.h"
 #include "scheduler/sweep/canonical.h"
 
-
 namespace gravsweep::pipeline {
 
 using nlohmann::json;
@@ -83,8 +82,10 @@ BedJobResult run_bed_job(const json& scenario, const std::filesystem::path& bed_
   const BedReport rep = prepare_bed(sys, p.bed, [&](BedPhase ph, double f, const std::string& d) {
     check_stop(stop, "bed preparation");
     if (!progress) return;
-    if (ph == BedPhase::relax) progress("flatten", f, "relaxing the surface: " + d);
-    else progress(to_string(ph), f, d);
+    if (ph == BedPhase::relax)
+      progress("flatten", f, "relaxing the surface: " + d);
+    else
+      progress(to_string(ph), f, d);
   });
   const double wall_s = seconds_since(t0);
 
@@ -166,9 +167,10 @@ results::BedData read_user_bed(const std::filesystem::path& bed, std::string* un
           "changed since (one flipped bit changes every drop's results): prepare the bed again (omit --bed)",
           bed.string(), sum_path.string(), found, recorded));
   } else if (unverified) {
-    *unverified = fmt::format("bed {} has no checksum file {} (written before `run` recorded one, or copied "
-                              "without it): it cannot be verified",
-                              bed.string(), sum_path.string());
+    *unverified = fmt::format(
+        "bed {} has no checksum file {} (written before `run` recorded one, or copied "
+        "without it): it cannot be verified",
+        bed.string(), sum_path.string());
   }
   try {
     return results::read_bed(bed);
@@ -187,18 +189,19 @@ void require_bed_key(const results::BedData& bed, const json& scenario, const st
   }
   if (have == want) return;
   const json::json_pointer at(first_difference(have, want));
-  throw ConfigError(fmt::format(
-      "bed {} was prepared for another scenario: its bed key differs at {} (found {}, the scenario "
-      "needs {}); prepare a bed for this scenario (omit --bed)",
-      bed_path.string(), at.to_string(), have.contains(at) ? have[at].dump() : "nothing",
-      want.contains(at) ? want[at].dump() : "nothing"));
+  throw ConfigError(
+      fmt::format("bed {} was prepared for another scenario: its bed key differs at {} (found {}, the scenario "
+                  "needs {}); prepare a bed for this scenario (omit --bed)",
+                  bed_path.string(), at.to_string(), have.contains(at) ? have[at].dump() : "nothing",
+                  want.contains(at) ? want[at].dump() : "nothing"));
 }
 
 void load_bed(System& sys, const results::BedData& bed) {
   for (std::size_t i = 0; i < bed.size(); ++i) {
     const Vec3 x(bed.position_m[3 * i], bed.position_m[3 * i + 1], bed.position_m[3 * i + 2]);
     const ParticleIndex k = sys.particles.add(x, bed.radius_m[i], bed.mass_kg[i], bed.material[i], SizeClass::grain);
-    sys.particles.set_velocity(k, Vec3(bed.velocity_m_s[3 * i], bed.velocity_m_s[3 * i + 1], bed.velocity_m_s[3 * i + 2]),
+    sys.particles.set_velocity(k,
+                               Vec3(bed.velocity_m_s[3 * i], bed.velocity_m_s[3 * i + 1], bed.velocity_m_s[3 * i + 2]),
                                Vec3(bed.omega_rad_s[3 * i], bed.omega_rad_s[3 * i + 1], bed.omega_rad_s[3 * i + 2]));
   }
   ContainerSpec cs;
@@ -238,12 +241,13 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
       snaps->append(sn);
     };
   }
-  const DropResult dr = drop_projectile(sys, bed.surface_height_m, p.projectile, p.stop, p.sample_rate_hz,
-                                        [&](double f, const std::string& d) {
-                                          check_stop(stop, "drop");
-                                          if (progress) progress("drop", f, d);
-                                        },
-                                        ds);
+  const DropResult dr = drop_projectile(
+      sys, bed.surface_height_m, p.projectile, p.stop, p.sample_rate_hz,
+      [&](double f, const std::string& d) {
+        check_stop(stop, "drop");
+        if (progress) progress("drop", f, d);
+      },
+      ds);
   const double wall_s = seconds_since(t0);
 
   results::TraceData td;
@@ -283,13 +287,11 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
     results::MeasuredTrial trial = results::dem_trial_of(td, {"", "", trace_out});
     results::process_trial(trial);
     const results::Metrics& r = trial.processed.metrics;
-    m = json{{"vc_m_s", r.vc_m_s},     {"apeak_m_s2", r.apeak_m_s2}, {"zstop_m", r.zstop_m},
-             {"tstop_s", r.tstop_s},   {"t_start_s", r.t_start_s},   {"t_end_s", r.t_end_s},
-             {"rebound", r.rebound},   {"note", r.note}};
+    m = json{{"vc_m_s", r.vc_m_s},       {"apeak_m_s2", r.apeak_m_s2}, {"zstop_m", r.zstop_m}, {"tstop_s", r.tstop_s},
+             {"t_start_s", r.t_start_s}, {"t_end_s", r.t_end_s},       {"rebound", r.rebound}, {"note", r.note}};
   } catch (const std::exception& e) {
-    m = json{{"vc_m_s", nullptr},  {"apeak_m_s2", nullptr}, {"zstop_m", nullptr}, {"tstop_s", nullptr},
-             {"t_start_s", nullptr}, {"t_end_s", nullptr}, {"rebound", nullptr},
-             {"metrics_error", e.what()}};
+    m = json{{"vc_m_s", nullptr},    {"apeak_m_s2", nullptr}, {"zstop_m", nullptr}, {"tstop_s", nullptr},
+             {"t_start_s", nullptr}, {"t_end_s", nullptr},    {"rebound", nullptr}, {"metrics_error", e.what()}};
   }
   double max_depth = -1e300;
   for (double z : td.depth_m) max_depth = std::max(max_depth, z);
@@ -300,9 +302,8 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   // Sect. 2.2's stop criterion (speed < stop.speed_m_s after contact): when the projectile came to
   // rest, and how long after the collision start (a DEM-side duration next to the paper's tstop).
   m["rest_time_s"] = dr.rest_s ? json(*dr.rest_s) : json(nullptr);
-  m["duration_to_rest_s"] = dr.rest_s && m["t_start_s"].is_number()
-                                ? json(*dr.rest_s - m["t_start_s"].get<double>())
-                                : json(nullptr);
+  m["duration_to_rest_s"] =
+      dr.rest_s && m["t_start_s"].is_number() ? json(*dr.rest_s - m["t_start_s"].get<double>()) : json(nullptr);
   m["simulated_time_s"] = td.t_s.empty() ? 0.0 : td.t_s.back();
   m["steps"] = dr.steps;
   m["dt_s"] = td.dt_s;

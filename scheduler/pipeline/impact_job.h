@@ -27,7 +27,8 @@ class Interrupted : public std::runtime_error {
 
 struct BedJobResult {
   std::filesystem::path bed_path;
-  nlohmann::json report;  ///< grains_placed, grains_kept, settled, surface_height_m, bulk_density_kg_m3, wall_time_s, ...
+  nlohmann::json
+      report;  ///< grains_placed, grains_kept, settled, surface_height_m, bulk_density_kg_m3, wall_time_s, ...
 };
 
 struct DropJobResult {
@@ -37,7 +38,6 @@ struct DropJobResult {
   std::filesystem::path snapshot_path, snapshot_xdmf;
   std::size_t snapshots = 0, snapshot_bytes = 0;  ///< count, state bytes per snapshot
 };
-
 
 /// Validates `scenario` (throws SpecError, a ConfigError, with the JSON pointer on bad input),
 /// prepares the bed and writes it to bed_out (HDF5), written under a temporary name then renamed.

@@ -53,9 +53,13 @@ void from_json(const nlohmann::json& j, PairOverride& o) {
 /// handed a scenario the schema did not see).
 void from_json(const nlohmann::json& j, Composition& c) {
   const std::string name = j.get<std::string>();
-  if (name == "explicit_pair") c = Composition::explicit_pair;
-  else if (name == "chrono_min") c = Composition::chrono_min;
-  else throw ConfigError(fmt::format("/contact/composition: found \"{}\", expected \"explicit_pair\" or \"chrono_min\"", name));
+  if (name == "explicit_pair")
+    c = Composition::explicit_pair;
+  else if (name == "chrono_min")
+    c = Composition::chrono_min;
+  else
+    throw ConfigError(
+        fmt::format("/contact/composition: found \"{}\", expected \"explicit_pair\" or \"chrono_min\"", name));
 }
 
 }  // namespace gravsweep
@@ -318,8 +322,9 @@ void check_output(Checks& ck) {
 json validate_scenario(const json& scenario, const std::string& source) {
   json s = scenario;
   std::vector<SpecProblem> problems;
-  spec::validator(spec::Schema::scenario).collect(s, problems);  // the schema: types, ranges, unknown and missing fields
-  Checks ck(s, problems);            // then the rules across fields, on the sound fields
+  spec::validator(spec::Schema::scenario)
+      .collect(s, problems);  // the schema: types, ranges, unknown and missing fields
+  Checks ck(s, problems);     // then the rules across fields, on the sound fields
   check_names(ck);
   check_geometry(ck);
   check_size_and_steps(ck);

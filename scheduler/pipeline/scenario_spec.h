@@ -29,14 +29,14 @@ nlohmann::json load_scenario(const std::filesystem::path& path);
 
 /// Everything the engine needs, from a validated scenario.
 struct ScenarioParams {
-  SystemConfig bed_config;    ///< preparation: bed.dt_s, settle gravity
-  SystemConfig drop_config;   ///< drop: dt_s, gravity_m_s2
+  SystemConfig bed_config;   ///< preparation: bed.dt_s, settle gravity
+  SystemConfig drop_config;  ///< drop: dt_s, gravity_m_s2
   BedSpec bed;
   ProjectileSpec projectile;  ///< with its random offsets drawn from projectile.seed
   DropStop stop;
   double gravity_m_s2 = 9.81;
   double sample_rate_hz = 1e4;
-  double snapshot_interval_s = 0;  ///< /output/snapshot_interval_s: grain snapshots, 0 = none
+  double snapshot_interval_s = 0;         ///< /output/snapshot_interval_s: grain snapshots, 0 = none
   results::MetricOptions metric_options;  ///< fill height and grain diameter set from the bed
 };
 

@@ -25,7 +25,8 @@ class ScopedStopSignals {
   ScopedStopSignals& operator=(const ScopedStopSignals&) = delete;
 
  private:
-  struct sigaction old_int_ {}, old_term_ {};
+  struct sigaction old_int_ {
+  }, old_term_{};
 };
 
 }  // namespace gravsweep::pipeline

@@ -132,8 +132,8 @@ void migrate_paths(Database& db) {
   struct Column {
     const char *table, *column;
   };
-  for (const Column c : {Column{"jobs", "output_path"}, Column{"attempts", "output_path"},
-                         Column{"results", "trace_path"}}) {
+  for (const Column c :
+       {Column{"jobs", "output_path"}, Column{"attempts", "output_path"}, Column{"results", "trace_path"}}) {
     std::vector<std::pair<std::int64_t, std::string>> rows;
     {
       Statement st(db, fmt::format("SELECT rowid, {1} FROM {0} WHERE {1} IS NOT NULL", c.table, c.column));
@@ -172,9 +172,10 @@ Database open_campaign(const fs::path& db_path, OpenMode mode, const fs::path& f
                                      : "";
   const auto refuse_tables = [&](int tables) {
     if ((tables == 0 && (mode != OpenMode::create || files > 0)) || (tables > 0 && tables < 4))
-      throw ConfigError(fmt::format("'{}' is not a gravsweep campaign: {} of the job queue's 4 tables (queue_meta, "
-                                    "jobs, attempts, results) found{}{}",
-                                    name, tables, beside, keep));
+      throw ConfigError(
+          fmt::format("'{}' is not a gravsweep campaign: {} of the job queue's 4 tables (queue_meta, "
+                      "jobs, attempts, results) found{}{}",
+                      name, tables, beside, keep));
   };
   if (server) {
     Database db(name, 30000, mode == OpenMode::read);
@@ -188,8 +189,8 @@ Database open_campaign(const fs::path& db_path, OpenMode mode, const fs::path& f
                                     files > 0 ? keep : " (run `gravsweep submit` first)"));
   } else if (fs::file_size(db_path, ec) == 0) {
     if (mode != OpenMode::create || files > 0)
-      throw ConfigError(fmt::format("'{}' is not a gravsweep campaign: the file is empty (0 bytes){}{}", name, beside,
-                                    keep));
+      throw ConfigError(
+          fmt::format("'{}' is not a gravsweep campaign: the file is empty (0 bytes){}{}", name, beside, keep));
   } else {
     refuse_tables(queue_tables(name));
   }

@@ -54,10 +54,10 @@ std::size_t count_files(const std::filesystem::path& dir);
 
 /// What the database refers to, read in one read transaction.
 struct Referenced {
-  std::set<std::string> done;                ///< files_rel of done jobs' outputs
-  std::set<std::string> live;                ///< files_rel of running attempts' planned outputs
-  std::vector<std::string> live_prefixes;    ///< "<job>.a<k>." of running attempts (tmp files)
-  double taken_at_s = 0;                     ///< wall clock just before the snapshot began
+  std::set<std::string> done;              ///< files_rel of done jobs' outputs
+  std::set<std::string> live;              ///< files_rel of running attempts' planned outputs
+  std::vector<std::string> live_prefixes;  ///< "<job>.a<k>." of running attempts (tmp files)
+  double taken_at_s = 0;                   ///< wall clock just before the snapshot began
   [[nodiscard]] bool refers_to(const std::string& rel) const;
 };
 Referenced referenced_files(db::Database& db);
@@ -67,9 +67,9 @@ Referenced referenced_files(db::Database& db);
 void check_files_belong(db::Database& db, const CampaignPaths& paths);
 
 struct OrphanReport {
-  std::vector<std::string> moved;      ///< files_rel of files moved to quarantine (or found: dry run)
-  std::vector<std::string> restored;   ///< moved, then found referenced, and put back
-  std::size_t purged = 0;              ///< quarantined files (of earlier resumes) removed
+  std::vector<std::string> moved;     ///< files_rel of files moved to quarantine (or found: dry run)
+  std::vector<std::string> restored;  ///< moved, then found referenced, and put back
+  std::size_t purged = 0;             ///< quarantined files (of earlier resumes) removed
 };
 
 /// Moves files no done job and no live attempt refers to, and older than the snapshot by

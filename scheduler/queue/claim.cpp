@@ -20,8 +20,9 @@ namespace detail {
 
 void cascade_dead(Database& db, const std::string& job_id, double now) {
   std::vector<std::string> stack{job_id};
-  Statement st(db, "UPDATE jobs SET state='dead', last_error=?1, finished_at=?2, blocked_by=?3 WHERE state='waiting' "
-                   "AND job_id IN (SELECT job_id FROM job_deps WHERE dep_id=?3) RETURNING job_id");
+  Statement st(db,
+               "UPDATE jobs SET state='dead', last_error=?1, finished_at=?2, blocked_by=?3 WHERE state='waiting' "
+               "AND job_id IN (SELECT job_id FROM job_deps WHERE dep_id=?3) RETURNING job_id");
   while (!stack.empty()) {
     const std::string id = stack.back();
     stack.pop_back();
@@ -99,8 +100,10 @@ WorkerIdentity make_identity(const std::string& code_version, int threads) {
   const char* array_job = std::getenv("SLURM_ARRAY_JOB_ID");
   const char* array_task = std::getenv("SLURM_ARRAY_TASK_ID");
   const char* job = std::getenv("SLURM_JOB_ID");
-  if (array_job && array_task) w.owner += fmt::format(":slurm={}_{}", array_job, array_task);
-  else if (job) w.owner += fmt::format(":slurm={}", job);
+  if (array_job && array_task)
+    w.owner += fmt::format(":slurm={}_{}", array_job, array_task);
+  else if (job)
+    w.owner += fmt::format(":slurm={}", job);
   return w;
 }
 
@@ -117,7 +120,8 @@ std::optional<Claim> claim(Database& db, const WorkerIdentity& who, const Campai
   const std::string returning = std::string(" LIMIT 1") + dialect_of(db).lock_picked_rows() +
                                 ") RETURNING job_id, kind, sweep_id, scenario_json, params_json, attempts, lease_token";
   const std::string q_queued = std::string(kSet) + "state='queued' ORDER BY priority DESC, seq" + returning;
-  const std::string q_failed = std::string(kSet) + "state='failed' AND not_before<=:now ORDER BY not_before" + returning;
+  const std::string q_failed =
+      std::string(kSet) + "state='failed' AND not_before<=:now ORDER BY not_before" + returning;
   std::optional<Claim> c;
   for (const std::string* q : {&q_queued, &q_failed}) {
     Statement st(db, *q);
@@ -157,7 +161,12 @@ std::optional<Claim> claim(Database& db, const WorkerIdentity& who, const Campai
                  "INSERT INTO attempts(job_id, attempt, lease_token, kind, worker, host, pid, threads, code_version, "
                  "started_at, outcome, output_path) VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, 'running', ?) "
                  "RETURNING attempt_id");
-    st.bind(1, c->job_id).bind(2, c->attempt).bind(3, c->token).bind(4, kind_name(c->kind)).bind(5, who.owner).bind(6, who.host);
+    st.bind(1, c->job_id)
+        .bind(2, c->attempt)
+        .bind(3, c->token)
+        .bind(4, kind_name(c->kind))
+        .bind(5, who.owner)
+        .bind(6, who.host);
     st.bind(7, who.pid).bind(8, who.threads).bind(9, who.code_version).bind(10, now).bind(11, c->output_rel);
     st.step();
     c->attempt_row = st.get_int(0);
@@ -187,8 +196,7 @@ bool work_remains(Database& db) {
 
 int threads_for_claim(Database& db, const Claim& c, int threads, int pool_threads) {
   if (c.kind != JobKind::bed || pool_threads <= threads) return threads;
-  Statement st(db,
-               "SELECT EXISTS(SELECT 1 FROM jobs WHERE job_id<>? AND state IN ('queued','running','failed'))");
+  Statement st(db, "SELECT EXISTS(SELECT 1 FROM jobs WHERE job_id<>? AND state IN ('queued','running','failed'))");
   st.bind(1, c.job_id);
   st.step();
   return st.get_int(0) != 0 ? threads : pool_threads;

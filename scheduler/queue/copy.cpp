@@ -34,10 +34,17 @@ std::int64_t copy_rows(Database& src, Database& dst, const std::string& table, c
     write->reset();
     for (int i = 0; i < read.columns(); ++i) {
       switch (read.column_type(i)) {
-        case db::ColumnType::null: write->bind_null(i + 1); break;
-        case db::ColumnType::integer: write->bind(i + 1, read.get_int(i)); break;
-        case db::ColumnType::real: write->bind(i + 1, read.get_double(i)); break;
-        default: write->bind(i + 1, read.get_text(i));
+        case db::ColumnType::null:
+          write->bind_null(i + 1);
+          break;
+        case db::ColumnType::integer:
+          write->bind(i + 1, read.get_int(i));
+          break;
+        case db::ColumnType::real:
+          write->bind(i + 1, read.get_double(i));
+          break;
+        default:
+          write->bind(i + 1, read.get_text(i));
       }
     }
     write->run();
@@ -72,9 +79,10 @@ CopyReport copy_campaign(Database& src, const CampaignPaths& src_paths, Database
     Statement st(src, "SELECT count(*) FROM jobs WHERE state='running'");
     st.step();
     if (st.get_int(0) > 0)
-      throw ConfigError(fmt::format("'{}': {} job(s) are running; stop the workers (or let them finish) before copying "
-                                    "the campaign: a copied lease would run the job twice",
-                                    src.path(), st.get_int(0)));
+      throw ConfigError(
+          fmt::format("'{}': {} job(s) are running; stop the workers (or let them finish) before copying "
+                      "the campaign: a copied lease would run the job twice",
+                      src.path(), st.get_int(0)));
   }
   ensure_schema(dst);
   Transaction tx(dst);
@@ -82,8 +90,8 @@ CopyReport copy_campaign(Database& src, const CampaignPaths& src_paths, Database
     Statement st(dst, "SELECT count(*) FROM jobs");
     st.step();
     if (st.get_int(0) > 0)
-      throw ConfigError(fmt::format("'{}' already holds a campaign ({} jobs); the destination must be new",
-                                    dst.path(), st.get_int(0)));
+      throw ConfigError(fmt::format("'{}' already holds a campaign ({} jobs); the destination must be new", dst.path(),
+                                    st.get_int(0)));
   }
   Transaction snapshot(src, Transaction::Mode::deferred);  // one consistent read of the source
   copy_rows(src, dst, "sweeps", "sweep_id");

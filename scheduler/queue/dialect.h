@@ -30,7 +30,8 @@ class Dialect {
   [[nodiscard]] virtual double now_s(db::Database& db) const = 0;
   /// How many of `names` (comma-separated, quoted SQL strings) exist as tables.
   [[nodiscard]] virtual int tables_present(db::Database& db, const std::string& quoted_names) const = 0;
-  [[nodiscard]] virtual bool has_column(db::Database& db, const std::string& table, const std::string& column) const = 0;
+  [[nodiscard]] virtual bool has_column(db::Database& db, const std::string& table,
+                                        const std::string& column) const = 0;
   /// The column type for a results column of queue type `type` (INTEGER, REAL, TEXT or ANY).
   [[nodiscard]] virtual std::string column_type(const std::string& type) const = 0;
   /// ALTER TABLE adding `column` (quoted) of `sql_type`; a concurrent add of the same column by

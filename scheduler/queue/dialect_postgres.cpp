@@ -20,15 +20,17 @@ class PostgresDialect final : public Dialect {
     return st.get_double(0);
   }
   [[nodiscard]] int tables_present(db::Database& db, const std::string& quoted_names) const override {
-    db::Statement st(db, fmt::format("SELECT count(*) FROM information_schema.tables WHERE table_schema=current_schema() "
-                                     "AND table_name IN ({})",
-                                     quoted_names));
+    db::Statement st(db,
+                     fmt::format("SELECT count(*) FROM information_schema.tables WHERE table_schema=current_schema() "
+                                 "AND table_name IN ({})",
+                                 quoted_names));
     st.step();
     return static_cast<int>(st.get_int(0));
   }
   [[nodiscard]] bool has_column(db::Database& db, const std::string& table, const std::string& column) const override {
-    db::Statement st(db, "SELECT count(*) FROM information_schema.columns WHERE table_schema=current_schema() AND "
-                         "table_name=? AND column_name=?");
+    db::Statement st(db,
+                     "SELECT count(*) FROM information_schema.columns WHERE table_schema=current_schema() AND "
+                     "table_name=? AND column_name=?");
     st.bind(1, table).bind(2, column);
     st.step();
     return st.get_int(0) > 0;
@@ -47,9 +49,10 @@ class PostgresDialect final : public Dialect {
   }
   [[nodiscard]] const char* insertion_order() const override { return "finished_at, job_id"; }
   void after_copy(db::Database& db) const override {
-    db.exec("SELECT setval(pg_get_serial_sequence('jobs', 'seq'), coalesce((SELECT max(seq) FROM jobs), 0) + 1, false); "
-            "SELECT setval(pg_get_serial_sequence('attempts', 'attempt_id'), "
-            "coalesce((SELECT max(attempt_id) FROM attempts), 0) + 1, false)");
+    db.exec(
+        "SELECT setval(pg_get_serial_sequence('jobs', 'seq'), coalesce((SELECT max(seq) FROM jobs), 0) + 1, false); "
+        "SELECT setval(pg_get_serial_sequence('attempts', 'attempt_id'), "
+        "coalesce((SELECT max(attempt_id) FROM attempts), 0) + 1, false)");
   }
 };
 

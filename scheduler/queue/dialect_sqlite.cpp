@@ -16,8 +16,8 @@ class SqliteDialect final : public Dialect {
   [[nodiscard]] const char* lock_picked_rows() const override { return ""; }
   [[nodiscard]] double now_s(db::Database&) const override { return queue::now_s(); }
   [[nodiscard]] int tables_present(db::Database& db, const std::string& quoted_names) const override {
-    db::Statement st(db, fmt::format("SELECT count(*) FROM sqlite_master WHERE type='table' AND name IN ({})",
-                                     quoted_names));
+    db::Statement st(
+        db, fmt::format("SELECT count(*) FROM sqlite_master WHERE type='table' AND name IN ({})", quoted_names));
     st.step();
     return static_cast<int>(st.get_int(0));
   }
@@ -51,9 +51,10 @@ class SqliteDialect final : public Dialect {
     sql.replace(at, from.size(), fmt::format("\"{}\" REAL", column));
     sql.replace(0, head, fmt::format("CREATE TABLE {}_widened", table));
     db.exec(sql);
-    db.exec(fmt::format("INSERT INTO {0}_widened SELECT * FROM {0} ORDER BY rowid; DROP TABLE {0}; "
-                        "ALTER TABLE {0}_widened RENAME TO {0}",
-                        table));
+    db.exec(
+        fmt::format("INSERT INTO {0}_widened SELECT * FROM {0} ORDER BY rowid; DROP TABLE {0}; "
+                    "ALTER TABLE {0}_widened RENAME TO {0}",
+                    table));
   }
   [[nodiscard]] const char* insertion_order() const override { return "rowid"; }
   void after_copy(db::Database&) const override {}  // rowid keys continue after the largest

@@ -115,8 +115,9 @@ std::vector<Condition> parse_where(const std::string& expr) {
 namespace {
 
 bool holds(const json& v, const Condition& c) {
-  if (c.op == "~") return v.is_string() ? v.get<std::string>().find(c.value.get<std::string>()) != std::string::npos
-                                        : v.dump().find(c.value.get<std::string>()) != std::string::npos;
+  if (c.op == "~")
+    return v.is_string() ? v.get<std::string>().find(c.value.get<std::string>()) != std::string::npos
+                         : v.dump().find(c.value.get<std::string>()) != std::string::npos;
   auto cmp = [&](auto a, auto b) {
     if (c.op == "<") return a < b;
     if (c.op == "<=") return a <= b;
@@ -194,19 +195,30 @@ ResultsTable query_results(db::Database& db, const ResultsQuery& q) {
   for (std::size_t i = 0; i < binds.size(); ++i) {
     const json& v = binds[i];
     const int idx = static_cast<int>(i + 1);
-    if (v.is_boolean()) st.bind(idx, static_cast<std::int64_t>(v.get<bool>()));
-    else if (v.is_number_integer()) st.bind(idx, v.get<std::int64_t>());
-    else if (v.is_number()) st.bind(idx, v.get<double>());
-    else st.bind(idx, v.get<std::string>());
+    if (v.is_boolean())
+      st.bind(idx, static_cast<std::int64_t>(v.get<bool>()));
+    else if (v.is_number_integer())
+      st.bind(idx, v.get<std::int64_t>());
+    else if (v.is_number())
+      st.bind(idx, v.get<double>());
+    else
+      st.bind(idx, v.get<std::string>());
   }
   while (st.step()) {
     std::vector<json> row;
     for (int c = 0; c < st.columns(); ++c) {
       switch (st.column_type(c)) {
-        case db::ColumnType::null: row.emplace_back(nullptr); break;
-        case db::ColumnType::integer: row.emplace_back(st.get_int(c)); break;
-        case db::ColumnType::real: row.emplace_back(st.get_double(c)); break;
-        default: row.emplace_back(st.get_text(c));
+        case db::ColumnType::null:
+          row.emplace_back(nullptr);
+          break;
+        case db::ColumnType::integer:
+          row.emplace_back(st.get_int(c));
+          break;
+        case db::ColumnType::real:
+          row.emplace_back(st.get_double(c));
+          break;
+        default:
+          row.emplace_back(st.get_text(c));
       }
     }
     t.rows.push_back(std::move(row));

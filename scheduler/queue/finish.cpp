@@ -41,7 +41,12 @@ bool complete(Database& db, const Claim& c, const Completion& done) {
                  "UPDATE jobs SET state='done', output_path=?1, output_sha256=?2, output_bytes=?3, finished_at=?4, "
                  "progress=1, phase='done', detail=NULL, lease_owner=NULL, lease_expires=NULL, last_error=NULL "
                  "WHERE job_id=?5 AND lease_token=?6 AND state='running'");
-    st.bind(1, done.output_rel).bind(2, done.sha256).bind(3, done.bytes).bind(4, now).bind(5, c.job_id).bind(6, c.token);
+    st.bind(1, done.output_rel)
+        .bind(2, done.sha256)
+        .bind(3, done.bytes)
+        .bind(4, now)
+        .bind(5, c.job_id)
+        .bind(6, c.token);
     st.run();
     if (db.changes() != 1) return false;  // fenced out: another worker holds the job now
   }
@@ -99,7 +104,8 @@ bool bed_mismatch(Database& db, const Claim& c, const std::string& reason) {
   {
     Statement st(db,
                  "UPDATE jobs SET state='waiting', deps_pending=1, last_error=?1, lease_owner=NULL, "
-                 "lease_expires=NULL, phase=NULL, detail=NULL, progress=NULL, attempts=CASE WHEN attempts>0 THEN attempts-1 ELSE 0 END "
+                 "lease_expires=NULL, phase=NULL, detail=NULL, progress=NULL, attempts=CASE WHEN attempts>0 THEN "
+                 "attempts-1 ELSE 0 END "
                  "WHERE job_id=?2 AND lease_token=?3 AND state='running'");
     st.bind(1, reason).bind(2, c.job_id).bind(3, c.token);
     st.run();
@@ -109,7 +115,8 @@ bool bed_mismatch(Database& db, const Claim& c, const std::string& reason) {
   {  // the bed is rebuilt once, by whichever drop noticed first
     Statement st(db,
                  "UPDATE jobs SET state='queued', output_path=NULL, output_sha256=NULL, output_bytes=NULL, "
-                 "finished_at=NULL, last_error=?1, not_before=0, max_attempts=CASE WHEN max_attempts>attempts THEN max_attempts ELSE attempts+1 END "
+                 "finished_at=NULL, last_error=?1, not_before=0, max_attempts=CASE WHEN max_attempts>attempts THEN "
+                 "max_attempts ELSE attempts+1 END "
                  "WHERE job_id=?2 AND state='done' AND output_sha256=?3");
     st.bind(1, reason).bind(2, c.dep_job_id).bind(3, c.dep_sha256);
     st.run();
@@ -130,7 +137,8 @@ bool release(Database& db, const Claim& c, const std::string& why) {
   Transaction tx(db);
   {
     Statement st(db,
-                 "UPDATE jobs SET state='queued', attempts=CASE WHEN attempts>0 THEN attempts-1 ELSE 0 END, lease_owner=NULL, lease_expires=NULL, "
+                 "UPDATE jobs SET state='queued', attempts=CASE WHEN attempts>0 THEN attempts-1 ELSE 0 END, "
+                 "lease_owner=NULL, lease_expires=NULL, "
                  "progress=NULL, phase=NULL, detail=NULL WHERE job_id=? AND lease_token=? AND state='running'");
     st.bind(1, c.job_id).bind(2, c.token);
     st.run();

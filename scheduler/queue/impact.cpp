@@ -15,7 +15,8 @@ void add_impact_runners(RunnerTable& table) {
   table[JobKind::bed] = [](const RunContext& ctx) {
     RunOutput out;
     if (!ctx.bed_cache.empty()) {
-      if (auto cached = pipeline::take_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.claim.scenario, ctx.output_tmp)) {
+      if (auto cached =
+              pipeline::take_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.claim.scenario, ctx.output_tmp)) {
         out.report = *cached;
         return out;
       }
@@ -29,10 +30,9 @@ void add_impact_runners(RunnerTable& table) {
   table[JobKind::drop] = [](const RunContext& ctx) {
     if (ctx.bed_path.empty())
       throw std::runtime_error(fmt::format("drop job {} has no prepared bed", ctx.claim.job_id));
-    auto r = pipeline::run_drop_job(ctx.claim.scenario, ctx.bed_path, ctx.output_tmp, ctx.threads, ctx.progress,
-                                    ctx.stop);
-    if (r.trace_path != ctx.output_tmp && !r.trace_path.empty())
-      std::filesystem::rename(r.trace_path, ctx.output_tmp);
+    auto r =
+        pipeline::run_drop_job(ctx.claim.scenario, ctx.bed_path, ctx.output_tmp, ctx.threads, ctx.progress, ctx.stop);
+    if (r.trace_path != ctx.output_tmp && !r.trace_path.empty()) std::filesystem::rename(r.trace_path, ctx.output_tmp);
     if (!r.snapshot_path.empty()) {
       // Grain snapshots (/output/snapshot_interval_s > 0): <campaign>.files/snapshots/, a folder that
       // `resume` leaves alone (they are for viewing; no job refers to them).

@@ -53,9 +53,9 @@ struct CampaignPaths {
 // ---- submit ---------------------------------------------------------------------------------
 struct SubmitReport {
   std::string sweep;
-  std::size_t planned = 0;       ///< jobs in the expanded spec
-  std::size_t added = 0;         ///< new jobs written
-  std::size_t present = 0;       ///< already in the campaign (same content hash)
+  std::size_t planned = 0;  ///< jobs in the expanded spec
+  std::size_t added = 0;    ///< new jobs written
+  std::size_t present = 0;  ///< already in the campaign (same content hash)
   std::size_t beds_added = 0;
   std::size_t drops_added = 0;
   bool sweep_new = false;
@@ -79,29 +79,29 @@ struct Claim {
   std::string job_id, sweep_id;
   JobKind kind = JobKind::noop;
   nlohmann::json scenario, params;
-  int attempt = 0;                 ///< 1-based attempt number of this claim
-  std::int64_t token = 0;          ///< fencing token
-  std::int64_t attempt_row = 0;    ///< attempts.attempt_id
-  std::string output_rel;          ///< where this attempt's output must end up
-  std::string dep_output_rel;      ///< the bed file (drop jobs)
-  std::string dep_job_id;          ///< the bed job (drop jobs)
-  std::string dep_sha256;          ///< the bed file's recorded checksum (verified before use)
+  int attempt = 0;               ///< 1-based attempt number of this claim
+  std::int64_t token = 0;        ///< fencing token
+  std::int64_t attempt_row = 0;  ///< attempts.attempt_id
+  std::string output_rel;        ///< where this attempt's output must end up
+  std::string dep_output_rel;    ///< the bed file (drop jobs)
+  std::string dep_job_id;        ///< the bed job (drop jobs)
+  std::string dep_sha256;        ///< the bed file's recorded checksum (verified before use)
   double claimed_at = 0;
 };
 
 /// Files of attempts whose lease expired, found by claim()/resume(): the caller deletes them after
 /// the transaction committed.
 struct Reclaimed {
-  std::vector<std::string> output_rels;  ///< planned outputs of lost attempts
-  std::vector<std::string> job_prefixes; ///< "<job>.a<k>" for temp files in tmp/
-  int lost = 0;                          ///< expired leases found
-  int dead = 0;                          ///< of which went dead (budget spent)
+  std::vector<std::string> output_rels;   ///< planned outputs of lost attempts
+  std::vector<std::string> job_prefixes;  ///< "<job>.a<k>" for temp files in tmp/
+  int lost = 0;                           ///< expired leases found
+  int dead = 0;                           ///< of which went dead (budget spent)
 };
 
 /// Claims one runnable job: first an expired lease (its attempt is closed as `lost`), then the
 /// highest-priority queued job, then a failed job whose backoff has passed. nullopt when none.
-std::optional<Claim> claim(db::Database& db, const WorkerIdentity& who, const CampaignPaths& paths,
-                           double lease_s, Reclaimed* reclaimed = nullptr);
+std::optional<Claim> claim(db::Database& db, const WorkerIdentity& who, const CampaignPaths& paths, double lease_s,
+                           Reclaimed* reclaimed = nullptr);
 
 /// Renews the lease and records progress; false when the lease is no longer ours (stop the job).
 bool heartbeat(db::Database& db, const Claim& c, double lease_s, double fraction, const std::string& phase,
@@ -142,7 +142,7 @@ int threads_for_claim(db::Database& db, const Claim& c, int threads, int pool_th
 
 // ---- resume -----------------------------------------------------------------------------------
 struct ResumeOptions {
-  bool retry_dead = false;     ///< also requeue dead jobs with `extra_attempts` more tries
+  bool retry_dead = false;  ///< also requeue dead jobs with `extra_attempts` more tries
   int extra_attempts = 1;
   bool remove_orphans = true;  ///< quarantine campaign files no job or live attempt refers to
   bool dry_run = false;
@@ -184,9 +184,9 @@ struct Status {
   std::vector<RunningJob> running;
   std::vector<KindRuntime> runtimes;
   std::int64_t stale_leases = 0;
-  std::int64_t blocked = 0;       ///< dead because a dependency is dead (jobs.blocked_by)
+  std::int64_t blocked = 0;  ///< dead because a dependency is dead (jobs.blocked_by)
   std::int64_t active_workers = 0;
-  double eta_s = -1;              ///< < 0: unknown (no finished job of some remaining kind)
+  double eta_s = -1;  ///< < 0: unknown (no finished job of some remaining kind)
   std::vector<std::pair<std::string, std::string>> recent_errors;  ///< (job_id, error) of dead jobs
   std::vector<std::pair<std::string, std::string>> beds_rebuilt;   ///< (bed job_id, why) after a checksum mismatch
 };

@@ -17,9 +17,9 @@ using nlohmann::json;
 
 namespace {
 
-const std::vector<std::string> kFixedResultColumns = {"job_id",       "sweep",        "kind",        "bed_job_id",
-                                                      "attempt",      "trace_path",   "trace_sha256", "trace_bytes",
-                                                      "runtime_s",    "finished_at",  "code_version"};
+const std::vector<std::string> kFixedResultColumns = {"job_id",    "sweep",       "kind",         "bed_job_id",
+                                                      "attempt",   "trace_path",  "trace_sha256", "trace_bytes",
+                                                      "runtime_s", "finished_at", "code_version"};
 
 std::string quote_ident(const std::string& name) { return "\"" + name + "\""; }
 
@@ -39,12 +39,18 @@ std::string sql_type_of(const json& v) {
 namespace {
 
 void bind_json_value(Statement& st, int idx, const json& v) {
-  if (v.is_null()) st.bind_null(idx);
-  else if (v.is_boolean()) st.bind(idx, static_cast<std::int64_t>(v.get<bool>() ? 1 : 0));
-  else if (v.is_number_integer() || v.is_number_unsigned()) st.bind(idx, v.get<std::int64_t>());
-  else if (v.is_number()) st.bind(idx, v.get<double>());
-  else if (v.is_string()) st.bind(idx, v.get<std::string>());
-  else st.bind(idx, sweep::canonical_json(v));
+  if (v.is_null())
+    st.bind_null(idx);
+  else if (v.is_boolean())
+    st.bind(idx, static_cast<std::int64_t>(v.get<bool>() ? 1 : 0));
+  else if (v.is_number_integer() || v.is_number_unsigned())
+    st.bind(idx, v.get<std::int64_t>());
+  else if (v.is_number())
+    st.bind(idx, v.get<double>());
+  else if (v.is_string())
+    st.bind(idx, v.get<std::string>());
+  else
+    st.bind(idx, sweep::canonical_json(v));
 }
 
 std::string sanitize_metric(const std::string& key) {
@@ -91,9 +97,10 @@ void widen_result_column(Database& db, const std::string& name, ResultColumn& co
 void add_result_column(Database& db, const std::string& name, const std::string& role, const std::string& type) {
   const Dialect& d = dialect_of(db);
   db.exec(d.add_column_sql("results", quote_ident(name), d.column_type(type)));
-  Statement st(db, "INSERT INTO results_columns(name, role, sql_type, position) "
-                   "VALUES(?, ?, ?, (SELECT coalesce(max(position), 0) + 1 FROM results_columns)) "
-                   "ON CONFLICT(name) DO NOTHING");  // another worker added it first (PostgreSQL)
+  Statement st(db,
+               "INSERT INTO results_columns(name, role, sql_type, position) "
+               "VALUES(?, ?, ?, (SELECT coalesce(max(position), 0) + 1 FROM results_columns)) "
+               "ON CONFLICT(name) DO NOTHING");  // another worker added it first (PostgreSQL)
   st.bind(1, name).bind(2, role).bind(3, type);
   st.run();
 }
@@ -132,8 +139,9 @@ void insert_results_row(Database& db, const Claim& c, const Completion& done, do
     st.bind(1, c.job_id);
     if (st.step()) bed_id = st.get_text(0);
   }
-  std::string names = "job_id, sweep, kind, bed_job_id, attempt, trace_path, trace_sha256, trace_bytes, runtime_s, "
-                      "finished_at, code_version";
+  std::string names =
+      "job_id, sweep, kind, bed_job_id, attempt, trace_path, trace_sha256, trace_bytes, runtime_s, "
+      "finished_at, code_version";
   std::string marks = "?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?";
   for (const auto& [name, v] : values) {
     names += ", " + quote_ident(name);
@@ -141,8 +149,10 @@ void insert_results_row(Database& db, const Claim& c, const Completion& done, do
   }
   Statement st(db, fmt::format("INSERT INTO results({}) VALUES({})", names, marks));
   st.bind(1, c.job_id).bind(2, c.sweep_id).bind(3, kind_name(c.kind));
-  if (bed_id.empty()) st.bind_null(4);
-  else st.bind(4, bed_id);
+  if (bed_id.empty())
+    st.bind_null(4);
+  else
+    st.bind(4, bed_id);
   st.bind(5, c.attempt).bind(6, done.output_rel).bind(7, done.sha256).bind(8, done.bytes);
   st.bind(9, now - c.claimed_at).bind(10, now).bind(11, code_version);
   int i = 12;
@@ -164,8 +174,10 @@ std::vector<std::string> summary_result_columns(Database& db) {
   std::vector<std::string> cols{"job_id"}, metrics;
   Statement st(db, "SELECT name, role FROM results_columns ORDER BY position");
   while (st.step()) {
-    if (st.get_text(1) == "param") cols.push_back(st.get_text(0));
-    else metrics.push_back(st.get_text(0));
+    if (st.get_text(1) == "param")
+      cols.push_back(st.get_text(0));
+    else
+      metrics.push_back(st.get_text(0));
   }
   for (const auto& m : kPaperMetrics)
     if (std::find(metrics.begin(), metrics.end(), m) != metrics.end()) cols.push_back(m);

@@ -42,14 +42,16 @@ ResumeReport resume(Database& db, const CampaignPaths& paths, const ResumeOption
       rep.failed_requeued = db.changes();
     }
     if (o.retry_dead) {
-      Statement a(db,
-                  "UPDATE jobs SET max_attempts=CASE WHEN max_attempts>attempts+?1 THEN max_attempts ELSE attempts+?1 END, "
-                  "last_error=NULL, blocked_by=NULL, finished_at=NULL, "
-                  "deps_pending=(SELECT count(*) FROM job_deps d JOIN jobs j2 ON j2.job_id=d.dep_id "
-                  "WHERE d.job_id=jobs.job_id AND j2.state!='done') WHERE state='dead'");
+      Statement a(
+          db,
+          "UPDATE jobs SET max_attempts=CASE WHEN max_attempts>attempts+?1 THEN max_attempts ELSE attempts+?1 END, "
+          "last_error=NULL, blocked_by=NULL, finished_at=NULL, "
+          "deps_pending=(SELECT count(*) FROM job_deps d JOIN jobs j2 ON j2.job_id=d.dep_id "
+          "WHERE d.job_id=jobs.job_id AND j2.state!='done') WHERE state='dead'");
       a.bind(1, o.extra_attempts);
       a.run();
-      Statement b(db, "UPDATE jobs SET state=CASE WHEN deps_pending>0 THEN 'waiting' ELSE 'queued' END WHERE state='dead'");
+      Statement b(db,
+                  "UPDATE jobs SET state=CASE WHEN deps_pending>0 THEN 'waiting' ELSE 'queued' END WHERE state='dead'");
       b.run();
       rep.dead_requeued = db.changes();
     }

@@ -128,9 +128,7 @@ using db::Transaction;
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-double now_s() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
+double now_s() { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); }
 
 void ensure_schema(Database& db) {
   {
@@ -154,8 +152,9 @@ void add_missing_columns(Database& db) {
   if (dialect_of(db).has_column(db, "jobs", "blocked_by")) return;
   db.exec("ALTER TABLE jobs ADD COLUMN blocked_by TEXT");
   // Campaigns written before the column marked a blocked job only in its message (once, here).
-  db.exec("UPDATE jobs SET blocked_by=substr(last_error, 12, length(last_error)-19) "
-          "WHERE state='dead' AND last_error LIKE 'dependency % is dead'");
+  db.exec(
+      "UPDATE jobs SET blocked_by=substr(last_error, 12, length(last_error)-19) "
+      "WHERE state='dead' AND last_error LIKE 'dependency % is dead'");
   tx.commit();
 }
 
@@ -171,9 +170,10 @@ CampaignPaths::CampaignPaths(const fs::path& db_path, const fs::path& files_root
     return;
   }
   if (db::is_postgres_url(db_path.string()))
-    throw ConfigError(fmt::format("--files: a PostgreSQL campaign ({}) needs its files root given, the folder every "
-                                  "worker node mounts at the same path (e.g. --files /shared/campaign)",
-                                  db_path.string()));
+    throw ConfigError(
+        fmt::format("--files: a PostgreSQL campaign ({}) needs its files root given, the folder every "
+                    "worker node mounts at the same path (e.g. --files /shared/campaign)",
+                    db_path.string()));
   const fs::path abs = fs::absolute(db_path);
   root = abs.parent_path() / (abs.stem().string() + ".files");
 }

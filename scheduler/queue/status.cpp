@@ -40,12 +40,24 @@ Status status(Database& db, std::size_t max_running) {
         const JobState state = parse_state(st.get_text(2));
         const std::int64_t n = st.get_int(3);
         switch (state) {
-          case JobState::waiting: c.waiting += n; break;
-          case JobState::queued: c.queued += n; break;
-          case JobState::running: c.running += n; break;
-          case JobState::failed: c.failed += n; break;
-          case JobState::done: c.done += n; break;
-          case JobState::dead: c.dead += n; break;
+          case JobState::waiting:
+            c.waiting += n;
+            break;
+          case JobState::queued:
+            c.queued += n;
+            break;
+          case JobState::running:
+            c.running += n;
+            break;
+          case JobState::failed:
+            c.failed += n;
+            break;
+          case JobState::done:
+            c.done += n;
+            break;
+          case JobState::dead:
+            c.dead += n;
+            break;
         }
         const bool left = state == JobState::waiting || state == JobState::queued || state == JobState::failed;
         if (q == &own && left) remaining[key] += n;
@@ -60,11 +72,22 @@ Status status(Database& db, std::size_t max_running) {
                  "coalesce(progress,0), coalesce(started_at,0), coalesce(heartbeat_at,0), coalesce(lease_expires,0), "
                  "attempts FROM jobs WHERE state='running' ORDER BY started_at");
     while (st.step()) {
-      RunningJob r{st.get_text(0), st.get_text(1), st.get_text(2), st.get_text(3), st.get_text(4), st.get_double(5),
-                   st.get_double(6), st.get_double(7), st.get_double(8), static_cast<int>(st.get_int(9)), false};
+      RunningJob r{st.get_text(0),
+                   st.get_text(1),
+                   st.get_text(2),
+                   st.get_text(3),
+                   st.get_text(4),
+                   st.get_double(5),
+                   st.get_double(6),
+                   st.get_double(7),
+                   st.get_double(8),
+                   static_cast<int>(st.get_int(9)),
+                   false};
       r.stale = r.lease_expires < now;
-      if (r.stale) ++s.stale_leases;
-      else ++s.active_workers;
+      if (r.stale)
+        ++s.stale_leases;
+      else
+        ++s.active_workers;
       if (s.running.size() < max_running || r.stale) s.running.push_back(std::move(r));
     }
   }
@@ -79,7 +102,8 @@ Status status(Database& db, std::size_t max_running) {
     }
     for (const auto& r : s.running) kinds[r.kind].kind = r.kind;
     Statement cnt(db, "SELECT count(*) FROM attempts WHERE kind=? AND outcome='done'");
-    Statement med(db, "SELECT runtime_s FROM attempts WHERE kind=? AND outcome='done' ORDER BY runtime_s LIMIT 1 OFFSET ?");
+    Statement med(db,
+                  "SELECT runtime_s FROM attempts WHERE kind=? AND outcome='done' ORDER BY runtime_s LIMIT 1 OFFSET ?");
     for (auto& [name, k] : kinds) {
       cnt.reset();
       cnt.bind(1, name);
@@ -141,20 +165,23 @@ Status status(Database& db, std::size_t max_running) {
     bool known = true;
     for (const auto& [key, n] : remaining) {
       double m = 0;
-      if (n > 0 && median_for(key.first, key.second, m)) total += static_cast<double>(n) * m;
-      else if (n > 0) known = false;
+      if (n > 0 && median_for(key.first, key.second, m))
+        total += static_cast<double>(n) * m;
+      else if (n > 0)
+        known = false;
     }
     for (const auto& r : s.running) {
       if (r.stale) continue;
       double m = 0;
-      if (median_for(sweep_of_running[r.job_id], r.kind, m)) total += std::max(0.0, m * (1 - r.progress));
-      else known = false;
+      if (median_for(sweep_of_running[r.job_id], r.kind, m))
+        total += std::max(0.0, m * (1 - r.progress));
+      else
+        known = false;
     }
     if (known) s.eta_s = total / static_cast<double>(std::max<std::int64_t>(1, s.active_workers));
   }
   {
-    Statement st(db,
-                 "SELECT count(*) FROM jobs WHERE state='dead' AND blocked_by IS NOT NULL");
+    Statement st(db, "SELECT count(*) FROM jobs WHERE state='dead' AND blocked_by IS NOT NULL");
     st.step();
     s.blocked = st.get_int(0);
   }

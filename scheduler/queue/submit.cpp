@@ -47,16 +47,18 @@ SubmitReport submit(Database& db, const sweep::SweepSpec& spec, const std::vecto
                 "scenario_json, created_at) VALUES(?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10) "
                 "ON CONFLICT(job_id) DO NOTHING");
   Statement dep(db, "INSERT INTO job_deps(job_id, dep_id) VALUES(?, ?) ON CONFLICT DO NOTHING");
-  Statement pending(db,
-                    "UPDATE jobs SET deps_pending=(SELECT count(*) FROM job_deps d JOIN jobs j ON j.job_id=d.dep_id "
-                    "WHERE d.job_id=?1 AND j.state!='done'), state=CASE WHEN (SELECT count(*) FROM job_deps d JOIN "
-                    "jobs j ON j.job_id=d.dep_id WHERE d.job_id=?1 AND j.state='dead') > 0 THEN 'dead' WHEN "
-                    "(SELECT count(*) FROM job_deps d JOIN jobs j ON j.job_id=d.dep_id WHERE d.job_id=?1 AND "
-                    "j.state!='done') > 0 THEN 'waiting' ELSE 'queued' END, blocked_by=(SELECT d.dep_id FROM job_deps d JOIN "
-                    "jobs j ON j.job_id=d.dep_id WHERE d.job_id=?1 AND j.state='dead' ORDER BY d.dep_id LIMIT 1) "
-                    "WHERE job_id=?1");
+  Statement pending(
+      db,
+      "UPDATE jobs SET deps_pending=(SELECT count(*) FROM job_deps d JOIN jobs j ON j.job_id=d.dep_id "
+      "WHERE d.job_id=?1 AND j.state!='done'), state=CASE WHEN (SELECT count(*) FROM job_deps d JOIN "
+      "jobs j ON j.job_id=d.dep_id WHERE d.job_id=?1 AND j.state='dead') > 0 THEN 'dead' WHEN "
+      "(SELECT count(*) FROM job_deps d JOIN jobs j ON j.job_id=d.dep_id WHERE d.job_id=?1 AND "
+      "j.state!='done') > 0 THEN 'waiting' ELSE 'queued' END, blocked_by=(SELECT d.dep_id FROM job_deps d JOIN "
+      "jobs j ON j.job_id=d.dep_id WHERE d.job_id=?1 AND j.state='dead' ORDER BY d.dep_id LIMIT 1) "
+      "WHERE job_id=?1");
   Statement member(db,
-                   "INSERT INTO sweep_jobs(sweep_id, job_id, shared) VALUES(?1, ?2, (SELECT CASE WHEN sweep_id <> ?1 THEN 1 ELSE 0 END FROM jobs "
+                   "INSERT INTO sweep_jobs(sweep_id, job_id, shared) VALUES(?1, ?2, (SELECT CASE WHEN sweep_id <> ?1 "
+                   "THEN 1 ELSE 0 END FROM jobs "
                    "WHERE job_id=?2)) ON CONFLICT DO NOTHING");
   for (const auto& j : jobs) {
     ins.reset();
@@ -68,8 +70,10 @@ SubmitReport submit(Database& db, const sweep::SweepSpec& spec, const std::vecto
     const bool added = db.changes() == 1;
     if (added) {
       ++rep.added;
-      if (j.kind == JobKind::bed) ++rep.beds_added;
-      else ++rep.drops_added;
+      if (j.kind == JobKind::bed)
+        ++rep.beds_added;
+      else
+        ++rep.drops_added;
       if (!j.deps.empty()) {
         for (const auto& d : j.deps) {
           dep.reset();

@@ -50,7 +50,7 @@ struct JobSignals {
   bool finished = false;
   std::string phase = "started", detail;
   double fraction = 0;
-  std::atomic<bool> stop{false};        // tells the runner to end early
+  std::atomic<bool> stop{false};  // tells the runner to end early
   std::atomic<bool> lease_lost{false};
 };
 
@@ -78,8 +78,8 @@ void heartbeat_loop(const WorkerOptions& o, const Claim& c, JobSignals& sig, dou
         std::fprintf(stderr, "worker %d: heartbeat failed (will retry): %s\n", static_cast<int>(getpid()), e.what());
       }
       lock.lock();
-      next = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                    std::chrono::duration<double>(interval_s));
+      next = std::chrono::steady_clock::now() +
+             std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(interval_s));
       if (sig.lease_lost.load()) return;
     }
     sig.cv.wait_for(lock, std::chrono::milliseconds(50), [&sig] { return sig.finished; });
@@ -137,8 +137,8 @@ Runner noop_runner() {
       }
     }
     if (ctx.claim.attempt <= fail_attempts)
-      throw std::runtime_error(fmt::format("noop job asked to fail on attempt {} (fail_attempts={})",
-                                           ctx.claim.attempt, fail_attempts));
+      throw std::runtime_error(
+          fmt::format("noop job asked to fail on attempt {} (fail_attempts={})", ctx.claim.attempt, fail_attempts));
     std::ofstream(ctx.output_tmp) << json{{"job_id", ctx.claim.job_id}, {"attempt", ctx.claim.attempt}}.dump();
     // (the worker fsyncs the output before renaming it)
     RunOutput out;
@@ -208,19 +208,23 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     bool permanent = false;
     const auto t0 = std::chrono::steady_clock::now();
     if (o.verbose)
-      std::fprintf(stderr, "worker %d: %s job %s attempt %d\n", who.pid, kind_name(c->kind), c->job_id.c_str(), c->attempt);
+      std::fprintf(stderr, "worker %d: %s job %s attempt %d\n", who.pid, kind_name(c->kind), c->job_id.c_str(),
+                   c->attempt);
     if (!c->dep_output_rel.empty() && !c->dep_sha256.empty()) {
       // The bed is verified before the drop uses it: a changed bit changes every drop's results.
       const fs::path bed = paths.abs(c->dep_output_rel);
       const std::string found = fs::exists(bed, ec) ? sweep::sha256_file(bed) : std::string("missing");
       if (found != c->dep_sha256) {
         stop_beat();
-        const std::string why = fmt::format("bed checksum mismatch: '{}' of bed job {} has sha256 {}, recorded {}; the "
-                                            "bed is rebuilt and the drop waits for it",
-                                            bed.string(), c->dep_job_id, found, c->dep_sha256);
+        const std::string why = fmt::format(
+            "bed checksum mismatch: '{}' of bed job {} has sha256 {}, recorded {}; the "
+            "bed is rebuilt and the drop waits for it",
+            bed.string(), c->dep_job_id, found, c->dep_sha256);
         std::fprintf(stderr, "worker %d: job %s: %s\n", who.pid, c->job_id.c_str(), why.c_str());
-        if (bed_mismatch(db, *c, why)) ++rep.failed;
-        else ++rep.fenced_out;
+        if (bed_mismatch(db, *c, why))
+          ++rep.failed;
+        else
+          ++rep.fenced_out;
         continue;
       }
     }
@@ -235,14 +239,18 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     try {
       if (runner == runners.end())
         throw ConfigError(fmt::format("job {}: no runner for kind '{}' in this build", c->job_id, kind_name(c->kind)));
-      RunContext ctx{*c, tmp, c->dep_output_rel.empty() ? fs::path() : paths.abs(c->dep_output_rel), threads,
+      RunContext ctx{*c,
+                     tmp,
+                     c->dep_output_rel.empty() ? fs::path() : paths.abs(c->dep_output_rel),
+                     threads,
                      [&sig](const std::string& phase, double f, const std::string& detail) {
                        std::lock_guard g(sig.m);
                        sig.phase = phase;
                        sig.fraction = f;
                        sig.detail = detail;
                      },
-                     &sig.stop, o.bed_cache};
+                     &sig.stop,
+                     o.bed_cache};
       out = runner->second(ctx);
     } catch (const ConfigError& e) {
       error = e.what();
@@ -279,9 +287,12 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     if (!error.empty()) {
       remove_tmp_of(paths.tmp(), prefix);
       const std::string state = fail(db, *c, error, exit_code, permanent, o.backoff_base_s);
-      if (state == "dead") ++rep.dead;
-      else if (state == "failed") ++rep.failed;
-      else ++rep.fenced_out;
+      if (state == "dead")
+        ++rep.dead;
+      else if (state == "failed")
+        ++rep.failed;
+      else
+        ++rep.fenced_out;
       std::fprintf(stderr, "worker %d: job %s attempt %d failed (%s): %s\n", who.pid, c->job_id.c_str(), c->attempt,
                    state.empty() ? "fenced out" : state.c_str(), error.c_str());
       continue;
@@ -302,8 +313,8 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
       // The file vanished or the disk is full: this attempt fails, the worker goes on.
       remove_tmp_of(paths.tmp(), prefix);
       fs::remove(final_path, ec);
-      const std::string why = fmt::format("job {}: cannot store its output at '{}': {}", c->job_id,
-                                          final_path.string(), e.what());
+      const std::string why =
+          fmt::format("job {}: cannot store its output at '{}': {}", c->job_id, final_path.string(), e.what());
       const std::string state = fail(db, *c, why, 1, false, o.backoff_base_s);
       ++(state == "dead" ? rep.dead : state == "failed" ? rep.failed : rep.fenced_out);
       std::fprintf(stderr, "worker %d: %s\n", who.pid, why.c_str());
@@ -315,8 +326,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     done.report["threads"] = threads;
     if (complete(db, *c, done)) {
       ++rep.done;
-      if (o.verbose)
-        std::fprintf(stderr, "worker %d: job %s done in %.2f s\n", who.pid, c->job_id.c_str(), secs);
+      if (o.verbose) std::fprintf(stderr, "worker %d: job %s done in %.2f s\n", who.pid, c->job_id.c_str(), secs);
     } else {
       fs::remove(final_path, ec);
       ++rep.fenced_out;

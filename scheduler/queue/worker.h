@@ -49,10 +49,10 @@ struct WorkerOptions {
   /// runs alone gets them all (threads_for_claim). At most `threads` when there is one worker.
   int pool_threads = 1;
   double lease_s = 60;
-  double heartbeat_s = 0;       ///< 0: min(lease / 4, 2 s)
-  bool follow = false;          ///< keep waiting for new jobs when none is left
-  double poll_s = 0.5;          ///< idle wait between claims when nothing is runnable
-  long max_jobs = -1;           ///< stop after this many jobs (-1: no limit)
+  double heartbeat_s = 0;  ///< 0: min(lease / 4, 2 s)
+  bool follow = false;     ///< keep waiting for new jobs when none is left
+  double poll_s = 0.5;     ///< idle wait between claims when nothing is runnable
+  long max_jobs = -1;      ///< stop after this many jobs (-1: no limit)
   double backoff_base_s = 2.0;
   std::string code_version = "unknown";
   bool verbose = true;
@@ -63,7 +63,6 @@ struct WorkerReport {
   long done = 0, failed = 0, dead = 0, released = 0, fenced_out = 0, reclaimed = 0;
   bool interrupted = false;
 };
-
 
 WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners);
 

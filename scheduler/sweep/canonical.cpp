@@ -20,23 +20,40 @@ void write_string(std::string& out, const std::string& s) {
   out.push_back('"');
   for (const unsigned char c : s) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
-      case '\b': out += "\\b"; break;
-      case '\f': out += "\\f"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      case '\b':
+        out += "\\b";
+        break;
+      case '\f':
+        out += "\\f";
+        break;
       default:
-        if (c < 0x20) out += fmt::format("\\u{:04x}", c);
-        else out.push_back(static_cast<char>(c));
+        if (c < 0x20)
+          out += fmt::format("\\u{:04x}", c);
+        else
+          out.push_back(static_cast<char>(c));
     }
   }
   out.push_back('"');
 }
 
 void write_double(std::string& out, double v, const std::string& where) {
-  if (!std::isfinite(v)) throw CanonicalError(fmt::format("{}: found {}, expected a finite number", where.empty() ? "/" : where, v));
+  if (!std::isfinite(v))
+    throw CanonicalError(fmt::format("{}: found {}, expected a finite number", where.empty() ? "/" : where, v));
   if (v == 0) {  // also -0
     out.push_back('0');
     return;
@@ -51,12 +68,24 @@ void write_double(std::string& out, double v, const std::string& where) {
 void write(std::string& out, const nlohmann::json& j, const std::string& where) {
   using T = nlohmann::json::value_t;
   switch (j.type()) {
-    case T::null: out += "null"; break;
-    case T::boolean: out += j.get<bool>() ? "true" : "false"; break;
-    case T::number_integer: out += fmt::format("{}", j.get<std::int64_t>()); break;
-    case T::number_unsigned: out += fmt::format("{}", j.get<std::uint64_t>()); break;
-    case T::number_float: write_double(out, j.get<double>(), where); break;
-    case T::string: write_string(out, j.get_ref<const std::string&>()); break;
+    case T::null:
+      out += "null";
+      break;
+    case T::boolean:
+      out += j.get<bool>() ? "true" : "false";
+      break;
+    case T::number_integer:
+      out += fmt::format("{}", j.get<std::int64_t>());
+      break;
+    case T::number_unsigned:
+      out += fmt::format("{}", j.get<std::uint64_t>());
+      break;
+    case T::number_float:
+      write_double(out, j.get<double>(), where);
+      break;
+    case T::string:
+      write_string(out, j.get_ref<const std::string&>());
+      break;
     case T::array: {
       out.push_back('[');
       for (std::size_t i = 0; i < j.size(); ++i) {
@@ -79,7 +108,8 @@ void write(std::string& out, const nlohmann::json& j, const std::string& where) 
       out.push_back('}');
       break;
     }
-    default: throw CanonicalError(fmt::format("{}: unsupported JSON value (binary/discarded)", where));
+    default:
+      throw CanonicalError(fmt::format("{}: unsupported JSON value (binary/discarded)", where));
   }
 }
 
@@ -88,7 +118,8 @@ nlohmann::json normalise(const nlohmann::json& j, const std::string& where) {
   switch (j.type()) {
     case T::number_float: {
       const double v = j.get<double>();
-      if (!std::isfinite(v)) throw CanonicalError(fmt::format("{}: found {}, expected a finite number", where.empty() ? "/" : where, v));
+      if (!std::isfinite(v))
+        throw CanonicalError(fmt::format("{}: found {}, expected a finite number", where.empty() ? "/" : where, v));
       if (v == 0) return 0;
       if (std::abs(v) < kExactIntLimit && std::floor(v) == v) return static_cast<std::int64_t>(v);
       return v;
@@ -104,7 +135,8 @@ nlohmann::json normalise(const nlohmann::json& j, const std::string& where) {
         out[it.key()] = normalise(it.value(), spec::pointer_child(where, it.key()));
       return out;
     }
-    default: return j;
+    default:
+      return j;
   }
 }
 
@@ -136,14 +168,13 @@ double round_decimal(double v, int digits) {
   return std::strtod(s.c_str(), nullptr);
 }
 
-Sha256::Sha256()
-    : h_{0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a, 0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19} {}
+Sha256::Sha256() : h_{0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a, 0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19} {}
 
 void Sha256::block(const unsigned char* p) {
   std::uint32_t w[64];
   for (int i = 0; i < 16; ++i)
-    w[i] = (std::uint32_t(p[4 * i]) << 24) | (std::uint32_t(p[4 * i + 1]) << 16) |
-           (std::uint32_t(p[4 * i + 2]) << 8) | std::uint32_t(p[4 * i + 3]);
+    w[i] = (std::uint32_t(p[4 * i]) << 24) | (std::uint32_t(p[4 * i + 1]) << 16) | (std::uint32_t(p[4 * i + 2]) << 8) |
+           std::uint32_t(p[4 * i + 3]);
   for (int i = 16; i < 64; ++i) {
     const std::uint32_t s0 = rotr(w[i - 15], 7) ^ rotr(w[i - 15], 18) ^ (w[i - 15] >> 3);
     const std::uint32_t s1 = rotr(w[i - 2], 17) ^ rotr(w[i - 2], 19) ^ (w[i - 2] >> 10);
@@ -157,9 +188,23 @@ void Sha256::block(const unsigned char* p) {
     const std::uint32_t S0 = rotr(a, 2) ^ rotr(a, 13) ^ rotr(a, 22);
     const std::uint32_t maj = (a & b) ^ (a & c) ^ (b & c);
     const std::uint32_t t2 = S0 + maj;
-    h = g; g = f; f = e; e = d + t1; d = c; c = b; b = a; a = t1 + t2;
+    h = g;
+    g = f;
+    f = e;
+    e = d + t1;
+    d = c;
+    c = b;
+    b = a;
+    a = t1 + t2;
   }
-  h_[0] += a; h_[1] += b; h_[2] += c; h_[3] += d; h_[4] += e; h_[5] += f; h_[6] += g; h_[7] += h;
+  h_[0] += a;
+  h_[1] += b;
+  h_[2] += c;
+  h_[3] += d;
+  h_[4] += e;
+  h_[5] += f;
+  h_[6] += g;
+  h_[7] += h;
 }
 
 void Sha256::update(const void* data, std::size_t n) {

@@ -29,9 +29,12 @@ std::size_t too_deep_at(const std::string& text, std::size_t max_depth) {
   for (std::size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
     if (in_string) {
-      if (escaped) escaped = false;
-      else if (c == '\\') escaped = true;
-      else if (c == '"') in_string = false;
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        in_string = false;
     } else if (c == '"') {
       in_string = true;
     } else if (c == '[' || c == '{') {
@@ -60,9 +63,9 @@ std::optional<JsonTextError> parse_json_text(const std::string& text, nlohmann::
     const auto a = msg.find('\''), b = msg.rfind('\'');
     const std::string token = a != std::string::npos && b > a ? msg.substr(a + 1, b - a - 1) : std::string();
     const std::size_t at = token.empty() ? std::string::npos : text.find(token);
-    return at_offset(text, at == std::string::npos ? 0 : at,
-                     fmt::format("a number beyond the range of a double{} ({})",
-                                 token.empty() ? "" : " (" + token + ")", msg));
+    return at_offset(
+        text, at == std::string::npos ? 0 : at,
+        fmt::format("a number beyond the range of a double{} ({})", token.empty() ? "" : " (" + token + ")", msg));
   }
   return std::nullopt;
 }

@@ -13,7 +13,7 @@ inline constexpr std::size_t kMaxJsonDepth = 64;  ///< arrays/objects nested dee
 
 struct JsonTextError {
   std::size_t line = 0, column = 0;
-  std::string what;  ///< e.g. "nesting deeper than 64 levels", "number 1e999 out of range"
+  std::string what;                         ///< e.g. "nesting deeper than 64 levels", "number 1e999 out of range"
   [[nodiscard]] std::string where() const;  ///< "line L, column C"
 };
 

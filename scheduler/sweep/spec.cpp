@@ -55,9 +55,8 @@ struct Checker {
 
 /// True when a problem lies at `ptr` or below it.
 bool has_problem_under(const std::vector<SpecProblem>& problems, const std::string& ptr) {
-  return std::any_of(problems.begin(), problems.end(), [&](const SpecProblem& p) {
-    return p.pointer == ptr || p.pointer.rfind(ptr + "/", 0) == 0;
-  });
+  return std::any_of(problems.begin(), problems.end(),
+                     [&](const SpecProblem& p) { return p.pointer == ptr || p.pointer.rfind(ptr + "/", 0) == 0; });
 }
 
 /// Problems of a no-op job's scenario: (pointer, found, expected). sleep_s and fail_attempts are
@@ -65,11 +64,11 @@ bool has_problem_under(const std::vector<SpecProblem>& problems, const std::stri
 std::vector<SpecProblem> noop_problems(const json& s, const std::string& ptr) {
   std::vector<SpecProblem> out;
   if (!s.is_object()) return {{ptr, show(s), "an object (the no-op job's scenario)"}};
-  if (s.contains("sleep_s") && (!s["sleep_s"].is_number() || !(s["sleep_s"].get<double>() >= 0) ||
-                                s["sleep_s"].get<double>() > 86400))
+  if (s.contains("sleep_s") &&
+      (!s["sleep_s"].is_number() || !(s["sleep_s"].get<double>() >= 0) || s["sleep_s"].get<double>() > 86400))
     out.push_back({join(ptr, "sleep_s"), show(s["sleep_s"]), "a number of seconds between 0 and 86400"});
-  if (s.contains("fail_attempts") && (!is_int(s["fail_attempts"]) || s["fail_attempts"].get<double>() < 0 ||
-                                      s["fail_attempts"].get<double>() > 100))
+  if (s.contains("fail_attempts") &&
+      (!is_int(s["fail_attempts"]) || s["fail_attempts"].get<double>() < 0 || s["fail_attempts"].get<double>() > 100))
     out.push_back({join(ptr, "fail_attempts"), show(s["fail_attempts"]), "an integer between 0 and 100"});
   return out;
 }
@@ -77,12 +76,18 @@ std::vector<SpecProblem> noop_problems(const json& s, const std::string& ptr) {
 std::string value_kind(const json& v) {
   if (v.is_number()) return "number";  // numbers are numbers: 10 and 9.81 are both numbers
   switch (v.type()) {
-    case json::value_t::null: return "null";
-    case json::value_t::boolean: return "boolean";
-    case json::value_t::string: return "string";
-    case json::value_t::array: return "array";
-    case json::value_t::object: return "object";
-    default: return "value";
+    case json::value_t::null:
+      return "null";
+    case json::value_t::boolean:
+      return "boolean";
+    case json::value_t::string:
+      return "string";
+    case json::value_t::array:
+      return "array";
+    case json::value_t::object:
+      return "object";
+    default:
+      return "value";
   }
 }
 
@@ -108,9 +113,9 @@ std::optional<std::vector<json>> range_values(const json& r, const std::string& 
   if (r.contains("num")) {
     const long num = r["num"].get<long>();
     for (long i = 0; i < num; ++i)
-      values.emplace_back(num == 1 ? start
-                                   : round_decimal(start + (stop - start) * static_cast<double>(i) /
-                                                               static_cast<double>(num - 1)));
+      values.emplace_back(
+          num == 1 ? start
+                   : round_decimal(start + (stop - start) * static_cast<double>(i) / static_cast<double>(num - 1)));
     return values;
   }
   const double step = r["step"].get<double>();
@@ -141,7 +146,8 @@ std::optional<std::vector<json>> repeat_values(const json& a, const std::string&
     bool ok = true;
     for (const char* k : {"start", "step"})
       if (!is_int(a[k])) {
-        ck.add(join(ptr, k), &a[k], fmt::format("an integer like the base value at {} ({})", pointer, base_value->dump()));
+        ck.add(join(ptr, k), &a[k],
+               fmt::format("an integer like the base value at {} ({})", pointer, base_value->dump()));
         ok = false;
       }
     if (!ok) return std::nullopt;
@@ -175,7 +181,8 @@ std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json
     if (!bad.empty()) {
       ck.add(join(ptr, "pointer"), &a["pointer"],
              fmt::format("a pointer whose tokens make a column name (\"{}\" is not one), or an explicit \"name\" "
-                         "[a-z_][a-z0-9_]*", derived.get<std::string>()));
+                         "[a-z_][a-z0-9_]*",
+                         derived.get<std::string>()));
       ok = false;
     }
     axis.name = derived.get<std::string>();
@@ -202,8 +209,9 @@ std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json
     const json& v = axis.values[i];
     const std::string vp = a.contains("values") ? join(values_ptr, i) : values_ptr;
     if (!base_value->is_null() && value_kind(v) != value_kind(*base_value)) {
-      ck.add(vp, &v, fmt::format("a {} like the base value at {} ({})", value_kind(*base_value), axis.pointer,
-                                 base_value->dump()));
+      ck.add(vp, &v,
+             fmt::format("a {} like the base value at {} ({})", value_kind(*base_value), axis.pointer,
+                         base_value->dump()));
       ok = false;
       continue;
     }
@@ -228,9 +236,11 @@ std::optional<json> read_base(const json& doc, const std::filesystem::path& base
   if (!text) {
     ck.add("/base", &doc["base"], fmt::format("a readable scenario file ('{}' is {})", p.string(), why));
   } else if (const auto err = parse_json_text(*text, base)) {
-    ck.add("/base", &doc["base"], fmt::format("a JSON scenario file ('{}': {} at {})", p.string(), err->what, err->where()));
+    ck.add("/base", &doc["base"],
+           fmt::format("a JSON scenario file ('{}': {} at {})", p.string(), err->what, err->where()));
   } else if (!base.is_object()) {
-    ck.add("/base", &doc["base"], fmt::format("a file holding a JSON object ('{}' holds {})", p.string(), value_kind(base)));
+    ck.add("/base", &doc["base"],
+           fmt::format("a file holding a JSON object ('{}' holds {})", p.string(), value_kind(base)));
   } else {
     return base;
   }
@@ -277,7 +287,8 @@ void read_axes(const json& doc, const json* base, const std::vector<SpecProblem>
     if (ok) add_group(std::move(g), ap);
   }
   if (doc.contains("repeats") && !has_problem_under(schema_problems, "/repeats"))
-    if (auto axis = parse_axis(doc["repeats"], "/repeats", base, ck)) add_group(AxisGroup{{std::move(*axis)}}, "/repeats");
+    if (auto axis = parse_axis(doc["repeats"], "/repeats", base, ck))
+      add_group(AxisGroup{{std::move(*axis)}}, "/repeats");
 }
 
 }  // namespace
@@ -331,8 +342,8 @@ SweepSpec parse_spec(const json& doc_in, const std::string& file, const std::fil
   problems.insert(problems.end(), ck.problems.begin(), ck.problems.end());
   if (!problems.empty()) throw SpecError::sweep_spec(file, problems);
   if (spec.points() > 5'000'000)
-    throw SpecError::sweep_spec(file,
-                                {{"/axes", fmt::format("{} points", spec.points()), "at most 5000000 points per sweep"}});
+    throw SpecError::sweep_spec(
+        file, {{"/axes", fmt::format("{} points", spec.points()), "at most 5000000 points per sweep"}});
   spec.source = doc_in;
   spec.source["base"] = spec.base;
   spec.file = file;
@@ -429,8 +440,8 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
     } catch (const std::exception& e) {
       // One problem per distinct message: a bad base field fails every point the same way.
       const std::string expected = std::string("a valid scenario: ") + e.what();
-      auto same = std::find_if(problems.begin(), problems.end(),
-                               [&](const SpecProblem& p) { return p.expected == expected; });
+      auto same =
+          std::find_if(problems.begin(), problems.end(), [&](const SpecProblem& p) { return p.expected == expected; });
       if (same != problems.end()) {
         ++repeats[static_cast<std::size_t>(same - problems.begin())];
       } else if (problems.size() < 20) {
@@ -460,7 +471,9 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
     drops.push_back(std::move(job));
   }
   for (std::size_t i = 0; i < problems.size(); ++i)
-    if (repeats[i] > 0) problems[i].found += fmt::format(" (and {} more point{} with this problem)", repeats[i], repeats[i] == 1 ? "" : "s");
+    if (repeats[i] > 0)
+      problems[i].found +=
+          fmt::format(" (and {} more point{} with this problem)", repeats[i], repeats[i] == 1 ? "" : "s");
   if (!problems.empty()) throw SpecError::sweep_spec(spec.file.empty() ? spec.name : spec.file, problems);
   for (auto& b : beds) {  // drop the parameters that vary within the bed
     json kept = json::object();

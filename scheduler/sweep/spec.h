@@ -30,8 +30,8 @@ using SpecError = spec::SpecError;
 
 /// One swept scenario field.
 struct Axis {
-  std::string name;      ///< results column name (units in the name, e.g. gravity_m_s2)
-  std::string pointer;   ///< JSON pointer into the scenario
+  std::string name;                    ///< results column name (units in the name, e.g. gravity_m_s2)
+  std::string pointer;                 ///< JSON pointer into the scenario
   std::vector<nlohmann::json> values;  ///< canonical values
 };
 
@@ -48,15 +48,14 @@ struct SweepSpec {
   std::vector<AxisGroup> groups;    ///< product over groups, first group slowest; repeats last
   int max_attempts = 3;
   int priority = 0;
-  nlohmann::json source;            ///< the spec as read (with the base inlined)
-  std::string file;                 ///< where it was read from (for error messages)
+  nlohmann::json source;  ///< the spec as read (with the base inlined)
+  std::string file;       ///< where it was read from (for error messages)
   [[nodiscard]] std::size_t points() const;
 };
 
 /// Parses and validates a spec document. `file` names it in errors; `base_dir` resolves a base
 /// given as a file name. Throws SpecError.
-SweepSpec parse_spec(const nlohmann::json& doc, const std::string& file,
-                     const std::filesystem::path& base_dir);
+SweepSpec parse_spec(const nlohmann::json& doc, const std::string& file, const std::filesystem::path& base_dir);
 /// Reads the file (JSON parse errors are SpecError with line/column) and parses it.
 SweepSpec load_spec(const std::filesystem::path& path);
 

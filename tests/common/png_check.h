@@ -17,7 +17,8 @@ inline PngStats png_stats(const std::filesystem::path& png) {
   PngStats s;
   const std::string cmd =
       "/usr/bin/python3 -c \"import sys, matplotlib.image as m; a = m.imread(sys.argv[1]); "
-      "print(a.shape[1], a.shape[0], float(a[..., :3].std()))\" '" + png.string() + "' 2>/dev/null";
+      "print(a.shape[1], a.shape[0], float(a[..., :3].std()))\" '" +
+      png.string() + "' 2>/dev/null";
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return s;
   s.ok = std::fscanf(p, "%d %d %lf", &s.width, &s.height, &s.pixel_std) == 3;

@@ -133,10 +133,11 @@ class SlurmCluster {
     namespace fs = std::filesystem;
     for (const char* exe : {"munged", "slurmctld", "slurmd", "sbatch", "squeue", "scancel", "sinfo"})
       if (std::system(("command -v " + std::string(exe) + " >/dev/null 2>&1").c_str()) != 0)
-        return std::string(exe) + " not found: install the Debian packages slurmctld slurmd slurm-client munge "
+        return std::string(exe) +
+               " not found: install the Debian packages slurmctld slurmd slurm-client munge "
                "to run the Slurm tests";
-    if (::geteuid() != 0) return "slurmd must run as root to start jobs; these tests run as uid " +
-                                 std::to_string(::geteuid());
+    if (::geteuid() != 0)
+      return "slurmd must run as root to start jobs; these tests run as uid " + std::to_string(::geteuid());
     std::random_device rd;
     dir_ = fs::temp_directory_path() / ("gravsweep-slurm-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
     for (const char* sub : {"spool", "state", "log"}) fs::create_directories(dir_ / sub);

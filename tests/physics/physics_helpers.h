@@ -9,9 +9,7 @@ namespace gravsweep::test {
 
 inline constexpr double kBeadRadius_m = 0.005;
 inline constexpr double kGlassDensity_kg_m3 = 2480.0;
-inline double bead_mass_kg(double r = kBeadRadius_m) {
-  return kGlassDensity_kg_m3 * 4.0 / 3.0 * kPi * r * r * r;
-}
+inline double bead_mass_kg(double r = kBeadRadius_m) { return kGlassDensity_kg_m3 * 4.0 / 3.0 * kPi * r * r * r; }
 
 /// Two materials (0: grain, 1: wall) with the given normal COR for every pair, friction mu.
 inline SystemConfig two_material_config(const std::string& law, double cor, double mu,

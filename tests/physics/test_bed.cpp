@@ -49,10 +49,11 @@ PileResult chrono_pile(double mu_rolling) {
   System s(cfg);
   PileSpec spec;  // 2,000 grains, 1 +/- 0.05 cm, 15 cm base, 2 cm outlet
   const PileResult r = pour_pile(s, spec);
-  std::printf("mu_r %.2f: repose angle %.1f deg over %zu flank bins (apex %.1f cm, %zu grains on the base, "
-              "rms %.1e m/s, %.2f s simulated)\n",
-              mu_rolling, r.angle_deg, r.flank_bins, 100 * r.apex_height_m, r.grains_on_base, r.rms_speed_m_s,
-              r.simulated_time_s);
+  std::printf(
+      "mu_r %.2f: repose angle %.1f deg over %zu flank bins (apex %.1f cm, %zu grains on the base, "
+      "rms %.1e m/s, %.2f s simulated)\n",
+      mu_rolling, r.angle_deg, r.flank_bins, 100 * r.apex_height_m, r.grains_on_base, r.rms_speed_m_s,
+      r.simulated_time_s);
   EXPECT_GT(r.grains_on_base, 1500u);  // a heap, not a spill
   EXPECT_GT(r.flank_bins, 100u);       // the slope is fitted over a whole flank
   EXPECT_LT(r.rms_speed_m_s, 1e-3);    // and measured at rest
@@ -103,8 +104,8 @@ TEST(Bed, GravityRampUnloadsTheBedGently) {
     return rms;
   };
   const double sudden = rms_after(0.0), ramped = rms_after(0.08);
-  std::printf("RMS grain speed 0.1 s after 9.81 -> 0.1 m/s2: %.2e m/s at once, %.2e m/s ramped over 0.08 s\n",
-              sudden, ramped);
+  std::printf("RMS grain speed 0.1 s after 9.81 -> 0.1 m/s2: %.2e m/s at once, %.2e m/s ramped over 0.08 s\n", sudden,
+              ramped);
   EXPECT_LT(3 * ramped, sudden);
 }
 

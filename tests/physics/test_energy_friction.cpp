@@ -99,11 +99,17 @@ double rolling_deceleration(System& s, double v0) {
   }
   // Least-squares slope.
   double mt = 0, mv = 0;
-  for (std::size_t k = 0; k < t.size(); ++k) { mt += t[k]; mv += v[k]; }
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    mt += t[k];
+    mv += v[k];
+  }
   mt /= static_cast<double>(t.size());
   mv /= static_cast<double>(t.size());
   double stv = 0, stt = 0;
-  for (std::size_t k = 0; k < t.size(); ++k) { stv += (t[k] - mt) * (v[k] - mv); stt += (t[k] - mt) * (t[k] - mt); }
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    stv += (t[k] - mt) * (v[k] - mv);
+    stt += (t[k] - mt) * (t[k] - mt);
+  }
   return -stv / stt;
 }
 }  // namespace

@@ -44,8 +44,7 @@ void fill(System& s, bool far_grain) {
   for (int z = 0; z < 2; ++z)
     for (int y = 0; y < 3; ++y)
       for (int x = 0; x < 4; ++x) {
-        const ParticleIndex i = s.particles.add(Vec3(r + x * a, y * a, r + z * a), r, m, 0,
-                                                SizeClass::grain);
+        const ParticleIndex i = s.particles.add(Vec3(r + x * a, y * a, r + z * a), r, m, 0, SizeClass::grain);
         const Vec3 v = Vec3(u(rng), u(rng), 0.0) * 1e-3;
         s.particles.set_velocity(i, v, Vec3(u(rng), u(rng), u(rng)) * 5.0);
       }
@@ -102,7 +101,5 @@ TEST_P(HistoryLayoutTest, RemovingAGrainKeepsEveryOtherHistory) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Laws, HistoryLayoutTest,
-                         ::testing::Values(std::make_tuple("hertz", "sunday"),
-                                           std::make_tuple("hertz", "zhang"),
-                                           std::make_tuple("hooke", "zhang"),
-                                           std::make_tuple("hooke", "none")));
+                         ::testing::Values(std::make_tuple("hertz", "sunday"), std::make_tuple("hertz", "zhang"),
+                                           std::make_tuple("hooke", "zhang"), std::make_tuple("hooke", "none")));

@@ -50,8 +50,8 @@ ImpactResult impact(SystemConfig cfg, double v, bool wall) {
       break;
     }
   }
-  const double v_after = wall ? s.particles.velocity_m_s[0].z()
-                              : s.particles.velocity_m_s[1].z() - s.particles.velocity_m_s[0].z();
+  const double v_after =
+      wall ? s.particles.velocity_m_s[0].z() : s.particles.velocity_m_s[1].z() - s.particles.velocity_m_s[0].z();
   return {v_after / v, static_cast<double>(contact_steps) * s.config().dt_s, peak};
 }
 
@@ -69,10 +69,9 @@ TEST_P(RestitutionTest, EqualsInput) {
   EXPECT_NEAR(r.restitution, e, tol) << law << " e=" << e << " v=" << v << (wall ? " wall" : " pair");
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Laws, RestitutionTest,
-    ::testing::Combine(::testing::Values("hertz", "hooke"), ::testing::Values(0.25, 0.5, 0.9, 1.0),
-                       ::testing::Values(0.01, 1.2), ::testing::Values(false, true)));
+INSTANTIATE_TEST_SUITE_P(Laws, RestitutionTest,
+                         ::testing::Combine(::testing::Values("hertz", "hooke"), ::testing::Values(0.25, 0.5, 0.9, 1.0),
+                                            ::testing::Values(0.01, 1.2), ::testing::Values(false, true)));
 
 // Clamping F_n >= 0 changes the COR to 0.9021 for 0.9 (dem-physics.md 4.2).
 TEST(Restitution, ClampedHertzGives0902) {

@@ -15,7 +15,8 @@ struct TempDir {
   std::filesystem::path path;
   TempDir() {
     std::random_device rd;
-    path = std::filesystem::temp_directory_path() / ("gravsweep_results_" + std::to_string(rd()) + std::to_string(rd()));
+    path =
+        std::filesystem::temp_directory_path() / ("gravsweep_results_" + std::to_string(rd()) + std::to_string(rd()));
     std::filesystem::create_directories(path);
   }
   ~TempDir() {
@@ -53,8 +54,8 @@ inline std::string dev_campaign() {
 }  // namespace gravsweep::testing
 
 /// The dev campaign lives outside the repository (../shared); skip, saying so, where it is absent.
-#define GRAVSWEEP_REQUIRE_DEV_CAMPAIGN()                                                      \
-  do {                                                                                        \
-    if (!std::filesystem::exists(gravsweep::testing::dev_campaign() + "/trials.csv"))          \
-      GTEST_SKIP() << "no dev campaign at " << gravsweep::testing::dev_campaign();             \
+#define GRAVSWEEP_REQUIRE_DEV_CAMPAIGN()                                              \
+  do {                                                                                \
+    if (!std::filesystem::exists(gravsweep::testing::dev_campaign() + "/trials.csv")) \
+      GTEST_SKIP() << "no dev campaign at " << gravsweep::testing::dev_campaign();    \
   } while (0)

@@ -65,63 +65,79 @@ std::vector<Case> corpus() {
   using V = std::vector<std::string>;
   const fs::path none;
   return {
-      {"missing required column", [](V& t, V&, const fs::path&) {
-         t[0] = "trial_id,trace_file,impact_velocity_m_s,fill_height_m,projectile_mass_kg,projectile_diameter_m,"
-                "grain_diameter_m,bulk_density_kg_m3,sample_rate_hz";
-       }, "trials.csv:1", "missing required column 'gravity_m_s2'"},
-      {"unparseable number", [](V& t, V&, const fs::path&) { t[1] = "A,traces/A.csv,abc,0.8,0.1,1.0,0.1,0.01,1450,1400"; },
-       "trials.csv:2:3", "expected a finite number"},
-      {"NaN in trials.csv", [](V& t, V&, const fs::path&) { t[1] = "A,traces/A.csv,nan,0.8,0.1,1.0,0.1,0.01,1450,1400"; },
-       "trials.csv:2:3", "finite number"},
+      {"missing required column",
+       [](V& t, V&, const fs::path&) {
+         t[0] =
+             "trial_id,trace_file,impact_velocity_m_s,fill_height_m,projectile_mass_kg,projectile_diameter_m,"
+             "grain_diameter_m,bulk_density_kg_m3,sample_rate_hz";
+       },
+       "trials.csv:1", "missing required column 'gravity_m_s2'"},
+      {"unparseable number",
+       [](V& t, V&, const fs::path&) { t[1] = "A,traces/A.csv,abc,0.8,0.1,1.0,0.1,0.01,1450,1400"; }, "trials.csv:2:3",
+       "expected a finite number"},
+      {"NaN in trials.csv",
+       [](V& t, V&, const fs::path&) { t[1] = "A,traces/A.csv,nan,0.8,0.1,1.0,0.1,0.01,1450,1400"; }, "trials.csv:2:3",
+       "finite number"},
       {"negative mass", [](V& t, V&, const fs::path&) { t[1] = "A,traces/A.csv,9.81,0.8,0.1,-1,0.1,0.01,1450,1400"; },
        "trials.csv:2:6", "> 0"},
-      {"duplicate trial id", [](V& t, V&, const fs::path&) { t[2] = "A,traces/A.csv,9.81,0.8,0.1,1.0,0.1,0.01,1450,1400"; },
-       "trials.csv:3:1", "appears twice"},
+      {"duplicate trial id",
+       [](V& t, V&, const fs::path&) { t[2] = "A,traces/A.csv,9.81,0.8,0.1,1.0,0.1,0.01,1450,1400"; }, "trials.csv:3:1",
+       "appears twice"},
       {"empty trial id", [](V& t, V&, const fs::path&) { t[1] = ",traces/A.csv,9.81,0.8,0.1,1.0,0.1,0.01,1450,1400"; },
        "trials.csv:2:1", "empty"},
-      {"trace path with ..", [](V& t, V&, const fs::path&) {
-         t[1] = "A,../../../../../etc/passwd,9.81,0.8,0.1,1.0,0.1,0.01,1450,1400";
-       }, "trials.csv:2:2", "outside"},
-      {"absolute trace path", [](V& t, V&, const fs::path&) { t[1] = "A,/etc/passwd,9.81,0.8,0.1,1.0,0.1,0.01,1450,1400"; },
-       "trials.csv:2:2", "absolute"},
-      {"symlink leading outside", [](V&, V&, const fs::path& dir) {
+      {"trace path with ..",
+       [](V& t, V&, const fs::path&) { t[1] = "A,../../../../../etc/passwd,9.81,0.8,0.1,1.0,0.1,0.01,1450,1400"; },
+       "trials.csv:2:2", "outside"},
+      {"absolute trace path",
+       [](V& t, V&, const fs::path&) { t[1] = "A,/etc/passwd,9.81,0.8,0.1,1.0,0.1,0.01,1450,1400"; }, "trials.csv:2:2",
+       "absolute"},
+      {"symlink leading outside",
+       [](V&, V&, const fs::path& dir) {
          fs::remove(dir / "traces/A.csv");
          fs::create_symlink("/etc/passwd", dir / "traces/A.csv");
-       }, "trials.csv:2:2", "outside"},
-      {"missing trace file", [](V&, V&, const fs::path& dir) { fs::remove(dir / "traces/A.csv"); },
-       "trials.csv line 2", "cannot open"},
-      {"trace without accel column", [](V&, V& tr, const fs::path&) { tr[0] = "t_s,acc"; },
-       "traces/A.csv:1", "missing column 'accel_m_s2'"},
+       },
+       "trials.csv:2:2", "outside"},
+      {"missing trace file", [](V&, V&, const fs::path& dir) { fs::remove(dir / "traces/A.csv"); }, "trials.csv line 2",
+       "cannot open"},
+      {"trace without accel column", [](V&, V& tr, const fs::path&) { tr[0] = "t_s,acc"; }, "traces/A.csv:1",
+       "missing column 'accel_m_s2'"},
       {"text in a trace", [](V&, V& tr, const fs::path&) { tr[4] = tr[4].substr(0, tr[4].find(',')) + ",abc"; },
        "traces/A.csv:5:2", "finite number"},
-      {"time not increasing", [](V&, V& tr, const fs::path&) { std::swap(tr[10], tr[11]); },
-       "traces/A.csv:12:1", "time must increase"},
+      {"time not increasing", [](V&, V& tr, const fs::path&) { std::swap(tr[10], tr[11]); }, "traces/A.csv:12:1",
+       "time must increase"},
       {"NaN in a trace", [](V&, V& tr, const fs::path&) { tr[30] = tr[30].substr(0, tr[30].find(',')) + ",nan"; },
        "traces/A.csv:31:2", "finite number"},
-      {"1e308 overflow in a trace", [](V&, V& tr, const fs::path&) {
-         tr[30] = tr[30].substr(0, tr[30].find(',')) + ",1e999";
-       }, "traces/A.csv:31:2", "finite number"},
-      {"declared rate contradicts the timestamps", [](V& t, V&, const fs::path&) {
-         t[1] = "A,traces/A.csv,9.81,0.8,0.1,1.0,0.1,0.01,1450,14000";
-       }, "trials.csv:2:10", "declared 14000 Hz"},
-      {"gap inside the collision", [](V&, V& tr, const fs::path&) {
-         tr.erase(tr.begin() + 40, tr.begin() + 60);
-       }, "traces/A.csv:41:1", "gap"},
-      {"unterminated quote", [](V& t, V&, const fs::path&) { t[1] = "A,\"traces/A.csv,9.81,0.8,0.1,1.0,0.1,0.01,1450,1400"; },
+      {"1e308 overflow in a trace",
+       [](V&, V& tr, const fs::path&) { tr[30] = tr[30].substr(0, tr[30].find(',')) + ",1e999"; }, "traces/A.csv:31:2",
+       "finite number"},
+      {"declared rate contradicts the timestamps",
+       [](V& t, V&, const fs::path&) { t[1] = "A,traces/A.csv,9.81,0.8,0.1,1.0,0.1,0.01,1450,14000"; },
+       "trials.csv:2:10", "declared 14000 Hz"},
+      {"gap inside the collision", [](V&, V& tr, const fs::path&) { tr.erase(tr.begin() + 40, tr.begin() + 60); },
+       "traces/A.csv:41:1", "gap"},
+      {"unterminated quote",
+       [](V& t, V&, const fs::path&) { t[1] = "A,\"traces/A.csv,9.81,0.8,0.1,1.0,0.1,0.01,1450,1400"; },
        "trials.csv:2:2", "unterminated"},
       {"trace too short", [](V&, V& tr, const fs::path&) { tr.resize(6); }, "traces/A.csv:6", "only 5 samples"},
-      {"never makes contact", [](V&, V& tr, const fs::path&) {
+      {"never makes contact",
+       [](V&, V& tr, const fs::path&) {
          for (std::size_t i = 1; i < tr.size(); ++i) tr[i] = tr[i].substr(0, tr[i].find(',')) + ",-9.81";
-       }, "trials.csv line 2", "never makes contact"},
+       },
+       "trials.csv line 2", "never makes contact"},
       // Issue 10 item 12: each unmeasurable record gets its own reason, at the line it is about.
       {"1e308 in a trace", [](V&, V& tr, const fs::path&) { tr[30] = tr[30].substr(0, tr[30].find(',')) + ",1e308"; },
        "traces/A.csv:31:2", "beyond any accelerometer's range"},
-      {"no free fall (starts at rest)", [](V&, V& tr, const fs::path&) {
+      {"no free fall (starts at rest)",
+       [](V&, V& tr, const fs::path&) {
          for (std::size_t i = 1; i < 30; ++i) tr[i] = tr[i].substr(0, tr[i].find(',')) + ",0";
-       }, "traces/A.csv:2: ", "does not start in free fall"},
-      {"never makes contact (a small bump)", [](V&, V& tr, const fs::path&) {
-         for (std::size_t i = 1; i < tr.size(); ++i) tr[i] = tr[i].substr(0, tr[i].find(',')) + (i == 40 ? ",-6" : ",-9.81");
-       }, "traces/A.csv:41: ", "never makes contact"},
+       },
+       "traces/A.csv:2: ", "does not start in free fall"},
+      {"never makes contact (a small bump)",
+       [](V&, V& tr, const fs::path&) {
+         for (std::size_t i = 1; i < tr.size(); ++i)
+           tr[i] = tr[i].substr(0, tr[i].find(',')) + (i == 40 ? ",-6" : ",-9.81");
+       },
+       "traces/A.csv:41: ", "never makes contact"},
       {"record ends inside the collision", [](V&, V& tr, const fs::path&) { tr.resize(50); },
        "traces/A.csv:50: ", "shorter than the collision"},
       {"a line with a column missing", [](V&, V& tr, const fs::path&) { tr[7] = tr[7].substr(0, tr[7].find(',')); },
@@ -146,8 +162,10 @@ TEST(BadCampaigns, EachIsRefusedWithExitCode2TheFileAndLineAndNothingWritten) {
     write_lines(dir / "traces/B.csv", trace);
     c.edit(trials, trace, dir);
     if (fs::is_regular_file(fs::symlink_status(dir / "traces/A.csv"))) write_lines(dir / "traces/A.csv", trace);
-    if (trials.empty()) std::ofstream(dir / "trials.csv", std::ios::trunc);
-    else write_lines(dir / "trials.csv", trials);
+    if (trials.empty())
+      std::ofstream(dir / "trials.csv", std::ios::trunc);
+    else
+      write_lines(dir / "trials.csv", trials);
     const fs::path db = d.path / "out.db";
     const Cmd r = run("measurements import '" + dir.string() + "' --db '" + db.string() + "'");
     EXPECT_EQ(r.code, 2) << r.out;
@@ -165,7 +183,8 @@ TEST(BadCampaigns, KeepGoingStoresTheGoodTrialsAndExitsIncomplete) {
   trace[4] = "0.002,abc";
   write_lines(dir / "traces/B.csv", trace);
   write_lines(dir / "trials.csv", good_trials());
-  const Cmd r = run("measurements import '" + dir.string() + "' --db '" + (d.path / "x.db").string() + "' --keep-going");
+  const Cmd r =
+      run("measurements import '" + dir.string() + "' --db '" + (d.path / "x.db").string() + "' --keep-going");
   EXPECT_EQ(r.code, 4) << r.out;
   EXPECT_NE(r.out.find("traces/B.csv:5:2"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("1 trials stored"), std::string::npos) << r.out;

@@ -116,7 +116,8 @@ TEST_F(CampaignCli, GroupByGivesTheMeansStdAndCountsComputedByHand) {
   std::map<std::pair<double, double>, std::vector<double>> apeak;
   for (const auto& r : json::parse(all.out))
     if (r["apeak_m_s2"].is_number())
-      apeak[{r["gravity_m_s2"].get<double>(), r["impact_speed_m_s"].get<double>()}].push_back(r["apeak_m_s2"].get<double>());
+      apeak[{r["gravity_m_s2"].get<double>(), r["impact_speed_m_s"].get<double>()}].push_back(
+          r["apeak_m_s2"].get<double>());
   ASSERT_EQ(apeak.size(), 4u);
   const Cmd g = run("results --db '" + db() + "' --group-by gravity_m_s2,impact_speed_m_s --format json", false);
   ASSERT_EQ(g.code, 0) << g.out;

@@ -54,7 +54,8 @@ TEST(Cli, ModelFitPrintsBeforeAndAfterAsCsvAndJson) {
   GRAVSWEEP_REQUIRE_DEV_CAMPAIGN();
   const std::string dev = gravsweep::testing::dev_campaign();
   TempDir d;
-  const auto csv = run("model fit '" + dev + "' --model base+depth_friction --format csv --plot '" + d.str() + "/fall.png'");
+  const auto csv =
+      run("model fit '" + dev + "' --model base+depth_friction --format csv --plot '" + d.str() + "/fall.png'");
   ASSERT_EQ(csv.code, 0);
   EXPECT_NE(csv.out.find("model,trace_rms_m_s2,trace_rel_pct,zstop_rms_mm"), std::string::npos) << csv.out;
   EXPECT_NE(csv.out.find("base+depth_friction,"), std::string::npos);
@@ -96,11 +97,12 @@ TEST(Cli, HelpTeachesWithExamples) {
 TEST(Cli, ReportWritesFiguresAndSummary) {
   TempDir d;
   const std::string c = d.str() + "/c", out = d.str() + "/report";
-  ASSERT_EQ(run("synth --out '" + c + "' --model base+immersion_drag --speeds 0.2,0.5,0.8,1.1 --repeats 2 --seed 4").code, 0);
+  ASSERT_EQ(
+      run("synth --out '" + c + "' --model base+immersion_drag --speeds 0.2,0.5,0.8,1.1 --repeats 2 --seed 4").code, 0);
   const auto r = run("report '" + c + "' --out '" + out + "'", true);
   ASSERT_EQ(r.code, 0) << r.out;
-  for (const char* f : {"fig9_metrics_vs_vc.png", "residual_vs_depth_speed.png", "fig10_zstop_vs_H.png",
-                        "ranking.png", "error_falls.png", "summary.md", "errors.csv", "ranking.csv"}) {
+  for (const char* f : {"fig9_metrics_vs_vc.png", "residual_vs_depth_speed.png", "fig10_zstop_vs_H.png", "ranking.png",
+                        "error_falls.png", "summary.md", "errors.csv", "ranking.csv"}) {
     ASSERT_TRUE(fs::exists(fs::path(out) / f)) << f;
     EXPECT_GT(fs::file_size(fs::path(out) / f), std::string(f).ends_with(".png") ? 10000u : 200u) << f;
   }
@@ -128,7 +130,8 @@ TEST(Cli, ReportWritesFiguresAndSummary) {
   EXPECT_NE(h.find("<figcaption><b>fig10_zstop_vs_H.png</b>: Fig. 10"), std::string::npos);
   // In a real browser (deploy/check-report.sh: headless chromium, a screenshot that is not blank).
   const std::string shot = d.str() + "/shot.png";
-  const int rc = std::system(("'" GRAVSWEEP_SOURCE_DIR "/deploy/check-report.sh' '" + out + "' '" + shot + "' >/dev/null 2>&1").c_str());
+  const int rc = std::system(
+      ("'" GRAVSWEEP_SOURCE_DIR "/deploy/check-report.sh' '" + out + "' '" + shot + "' >/dev/null 2>&1").c_str());
   if (WIFEXITED(rc) && WEXITSTATUS(rc) == 77) GTEST_SKIP() << "chromium not installed: the browser check is skipped";
   ASSERT_EQ(WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, 0) << "deploy/check-report.sh failed";
   const auto st = gravsweep::test::png_stats(shot);
@@ -166,7 +169,8 @@ TEST(Cli, SynthRestTailFixedRangeSensorAndTruth) {
   };
   for (const bool fixed : {false, true}) {
     const std::string c = d.str() + (fixed ? "/fixed" : "/scaled");
-    const std::string args = "synth --out '" + c + "' --gravity 0.1 --speeds 0.5 --repeats 1 --sensor-noise 0.02 --rest-tail 0.05";
+    const std::string args =
+        "synth --out '" + c + "' --gravity 0.1 --speeds 0.5 --repeats 1 --sensor-noise 0.02 --rest-tail 0.05";
     ASSERT_EQ(run(args + (fixed ? " --fixed-range-sensor" : "")).code, 0);
     std::ifstream truth(c + "/truth.csv");
     std::string header, row;
@@ -182,7 +186,9 @@ TEST(Cli, SynthRestTailFixedRangeSensorAndTruth) {
     double t_last_s = 0;
     const double sd = tail(c + "/traces/S001.csv", 60, t_last_s);
     EXPECT_NEAR(t_last_s, t_contact_s + tstop_s + 0.05, 2.0 / 1400);
-    if (fixed) EXPECT_NEAR(sd, 0.02 * 9.81, 0.3 * 0.02 * 9.81) << "fixed range";
-    else EXPECT_NEAR(sd, 0.02 * 0.1, 0.3 * 0.02 * 0.1) << "scaled with g";
+    if (fixed)
+      EXPECT_NEAR(sd, 0.02 * 9.81, 0.3 * 0.02 * 9.81) << "fixed range";
+    else
+      EXPECT_NEAR(sd, 0.02 * 0.1, 0.3 * 0.02 * 0.1) << "scaled with g";
   }
 }

@@ -38,7 +38,8 @@ TEST(GeneratedTerms, FormsHaveOneCanonicalNameAndParseInModelSpecs) {
   EXPECT_EQ(canonical_generated_name("depth_friction"), "");
   EXPECT_TRUE(find_term("(1-exp(-z/0.02))").generated);
   EXPECT_FALSE(find_term("depth_friction").generated);
-  EXPECT_EQ(generated_words("z^1*(1-exp(-z/0.02))"), "depth to the power 1 times a rise with depth saturating over 20 mm");
+  EXPECT_EQ(generated_words("z^1*(1-exp(-z/0.02))"),
+            "depth to the power 1 times a rise with depth saturating over 20 mm");
   // In a model spec: '*' inside a form is not a synth scale; ':shared' and '*2' still apply.
   const auto s = parse_model("base+z^1*v^1:shared*2+(1-exp(-z/0.01))");
   ASSERT_EQ(s.terms.size(), 3u);
@@ -52,7 +53,8 @@ TEST(GeneratedTerms, FormsHaveOneCanonicalNameAndParseInModelSpecs) {
     find_term("z^-1");
     FAIL();
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("'z^-1': a power in [0, 10] expected, found -1"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'z^-1': a power in [0, 10] expected, found -1"), std::string::npos)
+        << e.what();
   }
   EXPECT_THROW(find_term("exp(-z/0)"), std::invalid_argument);
   try {

@@ -87,16 +87,16 @@ void expect_accurate(const std::string& model, const SynthOptions& so, int seeds
   int lost = 0;
   const auto by_g = errors_over_seeds(model, so, seeds, lost);
   EXPECT_EQ(lost, 0) << model;
-  std::cout << "model " << model << ", rest tail " << so.rest_tail_s << " s, noise " << so.sensor_noise_g
-            << " g, " << seeds << " seeds; lost " << lost << "\n"
+  std::cout << "model " << model << ", rest tail " << so.rest_tail_s << " s, noise " << so.sensor_noise_g << " g, "
+            << seeds << " seeds; lost " << lost << "\n"
             << "  g_m_s2  trials  tstop_median_%  tstop_p90_%  zstop_median_%  zstop_p90_%  start_p90_ms\n";
   for (auto it = by_g.rbegin(); it != by_g.rend(); ++it) {
     const auto& e = it->second;
     const double t50 = 100 * quantile(e.tstop_rel, 0.5), t90 = 100 * quantile(e.tstop_rel, 0.9);
     const double z50 = 100 * quantile(e.zstop_rel, 0.5), z90 = 100 * quantile(e.zstop_rel, 0.9);
     const double s90 = quantile(e.start_ms, 0.9);
-    std::cout << "  " << it->first << "  " << e.tstop_rel.size() << "  " << t50 << "  " << t90 << "  " << z50
-              << "  " << z90 << "  " << s90 << "\n";
+    std::cout << "  " << it->first << "  " << e.tstop_rel.size() << "  " << t50 << "  " << t90 << "  " << z50 << "  "
+              << z90 << "  " << s90 << "\n";
     EXPECT_LT(t90, 10.0) << model << " at g = " << it->first;
     EXPECT_LT(z90, 5.0) << model << " at g = " << it->first;
     // The start within a millisecond of the contact (1.4 samples); a contact ramping in over 2-4 ms

@@ -137,7 +137,8 @@ TEST(Discovery, DevCampaignBaselineFailsWithDepthAndDepthFrictionWins) {
   // Where it fails: of the state axes the residual varies most with depth, growing with it (the
   // model misses a resistance that grows with depth), consistently across trials.
   const auto& z = axis(d.residual_before, "depth_m");
-  for (const char* other : {"speed_m_s", "time_since_contact_s"}) EXPECT_GT(z.eta2, axis(d.residual_before, other).eta2);
+  for (const char* other : {"speed_m_s", "time_since_contact_s"})
+    EXPECT_GT(z.eta2, axis(d.residual_before, other).eta2);
   EXPECT_GT(z.bin_mean_r_over_g.back(), z.bin_mean_r_over_g.front() + 0.5);
   EXPECT_GT(z.trials_positive, 2 * z.trials_negative);
   EXPECT_LT(z.slope_sign_trials_p, 1e-4);
@@ -190,13 +191,11 @@ TEST_P(HiddenTerm, IsRankedFirstOnASyntheticCampaign) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(FourHiddenTermsThreeSeeds, HiddenTerm,
-                         ::testing::Combine(::testing::Values("depth_friction", "immersion_drag",
-                                                              "bottom_stiffening", "viscous_drag"),
-                                            ::testing::Values(11u, 12u, 13u)),
-                         [](const auto& info) {
-                           return std::get<0>(info.param) + "_seed" + std::to_string(std::get<1>(info.param));
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    FourHiddenTermsThreeSeeds, HiddenTerm,
+    ::testing::Combine(::testing::Values("depth_friction", "immersion_drag", "bottom_stiffening", "viscous_drag"),
+                       ::testing::Values(11u, 12u, 13u)),
+    [](const auto& info) { return std::get<0>(info.param) + "_seed" + std::to_string(std::get<1>(info.param)); });
 
 TEST(Discovery, NothingHiddenNothingReportedIn19Of20Seeds) {
   int reported = 0;
@@ -219,7 +218,8 @@ TEST(Discovery, NothingHiddenNothingReportedIn19Of20Seeds) {
 TEST(Terms, SchemaListsExactlyTheRegisteredTerms) {
   std::ifstream in(std::string(GRAVSWEEP_SOURCE_DIR) + "/schemas/model.schema.json");
   const auto j = nlohmann::json::parse(in);
-  const auto names = j["properties"]["terms"]["items"]["properties"]["name"]["oneOf"][0]["enum"].get<std::vector<std::string>>();
+  const auto names =
+      j["properties"]["terms"]["items"]["properties"]["name"]["oneOf"][0]["enum"].get<std::vector<std::string>>();
   std::vector<std::string> reg;
   for (const auto& t : term_registry()) reg.push_back(t.name);
   EXPECT_EQ(names, reg);
@@ -273,8 +273,10 @@ void expect_every_error_falls(const Campaign& c, const std::string& term, const 
             << b.apeak_rel_pct << " -> " << a.apeak_rel_pct << " % (rms " << b.apeak_rms_m_s2 << " -> "
             << a.apeak_rms_m_s2 << ")\n";
   auto falls = [&](const char* name, double after, double before) {
-    if (within_5pct.count(name)) EXPECT_LT(after, 1.05 * before) << name;
-    else EXPECT_LT(after, before) << name;
+    if (within_5pct.count(name))
+      EXPECT_LT(after, 1.05 * before) << name;
+    else
+      EXPECT_LT(after, before) << name;
   };
   falls("trace_rms", a.trace_rms_m_s2, b.trace_rms_m_s2);
   falls("zstop_rms", a.zstop_rms_mm, b.zstop_rms_mm);
@@ -311,13 +313,13 @@ TEST_P(HiddenTermErrors, EveryHeldOutErrorFallsWhenItIsAdded) {
   const Campaign c = load_campaign(d.str());
   ASSERT_EQ(c.trials.size(), 36u);
   // Viscous drag matters at low gravity only; the trace RMS in m/s2 is the 1 g trials'.
-  expect_every_error_falls(c, term, "synth", term == "viscous_drag" ? std::set<std::string>{"trace_rms"}
-                                                                     : std::set<std::string>{});
+  expect_every_error_falls(c, term, "synth",
+                           term == "viscous_drag" ? std::set<std::string>{"trace_rms"} : std::set<std::string>{});
 }
 
 INSTANTIATE_TEST_SUITE_P(EachNamedTerm, HiddenTermErrors,
-                         ::testing::Values("depth_friction", "gravity_depth_friction", "viscous_drag",
-                                           "immersion_drag", "bottom_stiffening"));
+                         ::testing::Values("depth_friction", "gravity_depth_friction", "viscous_drag", "immersion_drag",
+                                           "bottom_stiffening"));
 
 // Cohesion (a constant force shared by all levels) is absorbed by the base's f0 per gravity level
 // (its term says so): adding it cannot change any held-out error, which is why none can fall.
@@ -327,8 +329,10 @@ TEST(HeldOut, HiddenCohesionIsAbsorbedByThePerLevelFrictionSoNoErrorMoves) {
   const Campaign c = load_campaign(d.str());
   const auto b = summarize(c, cross_validate(parse_model("base"), c, 6, 1));
   const auto a = summarize(c, cross_validate(parse_model("base+cohesion"), c, 6, 1));
-  for (const auto& [after, before] : {std::pair{a.trace_rel_pct, b.trace_rel_pct}, {a.zstop_rel_pct, b.zstop_rel_pct},
-                                      {a.tstop_rel_pct, b.tstop_rel_pct}, {a.apeak_rel_pct, b.apeak_rel_pct}})
+  for (const auto& [after, before] : {std::pair{a.trace_rel_pct, b.trace_rel_pct},
+                                      {a.zstop_rel_pct, b.zstop_rel_pct},
+                                      {a.tstop_rel_pct, b.tstop_rel_pct},
+                                      {a.apeak_rel_pct, b.apeak_rel_pct}})
     EXPECT_NEAR(after, before, 0.01 * before);
 }
 
@@ -336,8 +340,7 @@ TEST(HeldOut, HiddenCohesionIsAbsorbedByThePerLevelFrictionSoNoErrorMoves) {
 // search beyond the named library adds nothing to them (the verdict stays "missing effect"). 72
 // trials each (3 levels x 8 speeds x 3 repeats; with 48 the second term is sometimes not significant).
 TEST(Discovery, TwoHiddenTermsAreBothFoundInTwoRounds) {
-  for (const auto& [first, second, fills] :
-       std::vector<std::tuple<std::string, std::string, std::vector<double>>>{
+  for (const auto& [first, second, fills] : std::vector<std::tuple<std::string, std::string, std::vector<double>>>{
            {"depth_friction", "viscous_drag", {0.21}}, {"bottom_stiffening", "viscous_drag", {0.05, 0.06, 0.08}}}) {
     for (unsigned seed = 1; seed <= 3; ++seed) {
       TempDir d;

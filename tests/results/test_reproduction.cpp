@@ -90,8 +90,8 @@ TEST(Reproduction, ChronoLowGTable3RowAsStated) {
 // 14 when exported): 1/d1 42.2 +/- 0.46 1/m inside the paper's 39 +/- 5, alpha 0.330 +/- 0.011 (the
 // paper's 0.28 +/- 0.02), still below 1 g's; f0 0.94 +/- 0.21 N inside the paper's 0.2 +/- 2.
 TEST(Reproduction, ChronoLowGTable3WithTheRepeats) {
-  const std::string all = "'" + dataset("chrono_1g") + "' '" + dataset("chrono_0.1g") + "' '" +
-                          dataset("chrono_0.1g_repeats") + "'";
+  const std::string all =
+      "'" + dataset("chrono_1g") + "' '" + dataset("chrono_0.1g") + "' '" + dataset("chrono_0.1g_repeats") + "'";
   const auto low = table3_row(all, 0.1), one = table3_row(all, 9.81);
   ASSERT_EQ(low.count("inv_d1_1_m"), 1u);
   EXPECT_GE(low.at("trials"), 14);
@@ -190,8 +190,10 @@ TEST(Reproduction, FillHeightTrendsAsStated) {
   for (const auto& r : rows) {
     const double fill = std::stod(r.at("fill_height_m"));
     const bool rebound = r.at("rebound") == "1" || r.at("rebound") == "true";
-    if (fill <= 0.04 + 1e-9) shallow_rebounds += rebound;
-    else EXPECT_FALSE(rebound) << "fill " << fill;
+    if (fill <= 0.04 + 1e-9)
+      shallow_rebounds += rebound;
+    else
+      EXPECT_FALSE(rebound) << "fill " << fill;
     if (fill >= 0.1 - 1e-9) plateau.push_back(std::stod(r.at("zstop_m")));
   }
   EXPECT_GE(shallow_rebounds, 3);

@@ -15,8 +15,7 @@ using gravsweep::testing::Poncelet;
 
 namespace {
 
-Trace sample(const Poncelet& p, double fs, double t_contact, double noise_g, double bias_g,
-             unsigned seed) {
+Trace sample(const Poncelet& p, double fs, double t_contact, double noise_g, double bias_g, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> n01(0.0, 1.0);
   Trace tr;
@@ -36,8 +35,8 @@ void expect_recovered(const Poncelet& p, double fs, double noise_g, double bias_
   o.gravity_m_s2 = p.g;
   o.impact_velocity_m_s = p.v0;
   const Metrics m = compute_metrics(tr, o);
-  SCOPED_TRACE(::testing::Message() << "fs=" << fs << " g=" << p.g << " v0=" << p.v0
-                                    << " noise=" << noise_g << " seed=" << seed);
+  SCOPED_TRACE(::testing::Message() << "fs=" << fs << " g=" << p.g << " v0=" << p.v0 << " noise=" << noise_g
+                                    << " seed=" << seed);
   EXPECT_NEAR(m.zstop_m, p.zstop(), 0.02 * p.zstop());
   EXPECT_NEAR(m.tstop_s, p.tstop(), 0.02 * p.tstop());
   EXPECT_NEAR(m.apeak_m_s2, p.apeak(), 0.02 * p.apeak());
@@ -100,7 +99,7 @@ TEST(Metrics, PonceletAt1400HzAnd10kHzWithNoiseWithin2Percent) {
 }
 
 TEST(Metrics, PaperTable3ExperimentRowAt1g) {
-  Poncelet p;  // f0 = 25 N, 1/d1 = 25 1/m, m = 1 kg (Table 3, Exp. 10 mm)
+  Poncelet p;                           // f0 = 25 N, 1/d1 = 25 1/m, m = 1 kg (Table 3, Exp. 10 mm)
   for (double v0 : {0.7, 0.85, 1.0}) {  // 0.4-0.6 m/s (24-34 ms) give apeak within 3 %
     p.v0 = v0;
     EXPECT_NO_FATAL_FAILURE(expect_recovered(p, 1400, 0.015, -0.01, 7)) << "v0 " << v0;
@@ -270,7 +269,7 @@ TEST(Metrics, ADemRecordWithAShortFreeFallStartsAtTheEnginesFirstContact) {
   Trace tr = dem_record(p, fs, t_contact);
   MetricOptions o;
   o.gravity_m_s2 = p.g;
-  tr.contact_start_s = std::floor(t_contact * fs) / fs;         // last sample before contact
+  tr.contact_start_s = std::floor(t_contact * fs) / fs;  // last sample before contact
   const Metrics m = compute_metrics(tr, o);
   EXPECT_NEAR(m.t_start_s, t_contact, 1.0 / fs);
   EXPECT_NEAR(m.vc_m_s, p.v0, p.g / fs);

@@ -36,7 +36,7 @@ TEST(TraceSteps, FilterIsTheButterworthOrSaysWhyNot) {
 }
 
 TEST(TraceSteps, EdgeWidthAndHoldFollowTheRates) {
-  EXPECT_EQ(edge_width(1400, 500), 4u);   // 1 + ceil(2.8)
+  EXPECT_EQ(edge_width(1400, 500), 4u);  // 1 + ceil(2.8)
   EXPECT_EQ(edge_width(10000, 500), 21u);
   EXPECT_EQ(end_hold_samples(1400), 3u);  // 2 ms is 2.8 samples: at least 3
   EXPECT_EQ(end_hold_samples(10000), 20u);
@@ -105,8 +105,8 @@ TEST(TraceSteps, FilteredStartIsTheOnsetOfARampAndTheMiddleOfAStep) {
   }
   MetricOptions o;
   const double rise_s = filter_step_rise_s(fs, o);
-  EXPECT_GT(rise_s, 0.8 / fs);   // the filter slows a jump down ...
-  EXPECT_LT(rise_s, 2.0 / fs);   // ... to about a millisecond at 500 Hz
+  EXPECT_GT(rise_s, 0.8 / fs);  // the filter slows a jump down ...
+  EXPECT_LT(rise_s, 2.0 / fs);  // ... to about a millisecond at 500 Hz
   const std::size_t w = edge_width(fs, o.cutoff_hz);
   const auto fstep = butterworth_lowpass(step, fs, o.cutoff_hz, o.filter_order);
   const auto framp = butterworth_lowpass(ramp, fs, o.cutoff_hz, o.filter_order);
@@ -165,7 +165,7 @@ TEST(TraceSteps, RestIsTheLastThreeQuartersAfterTheEdge) {
 }
 
 TEST(TraceSteps, BiasFromFreeFallAndRestWeightedBySamples) {
-  std::vector<double> af(100, 0.2);                     // rest reads the bias 0.2
+  std::vector<double> af(100, 0.2);                        // rest reads the bias 0.2
   for (std::size_t i = 0; i < 20; ++i) af[i] = -kG + 0.5;  // free fall reads -g + 0.5
   const BiasEstimate b = bias_from_segments(af, kG, 20, 60);
   EXPECT_TRUE(b.any);

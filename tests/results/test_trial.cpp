@@ -85,8 +85,7 @@ void write_dem_trace(const fs::path& p, const Poncelet& k, double fs_hz, const s
   write_trace(p, d);
 }
 
-std::string row(const std::string& id, const std::string& trace, double g = 9.81, double v0 = 0.8,
-                double rate = 1400) {
+std::string row(const std::string& id, const std::string& trace, double g = 9.81, double v0 = 0.8, double rate = 1400) {
   std::ostringstream s;
   s << id << "," << trace << "," << g << "," << v0 << ",0.1,1.0,0.1,0.01,1450," << rate;
   return s.str();
@@ -155,7 +154,9 @@ TEST(TrialRecord, OneGravityLevelRule) {
 }
 
 TEST(Csv, Rfc4180QuotingAndAByteOrderMark) {
-  std::istringstream in("\xEF\xBB\xBF" "a,b,c\r\n\"9.81\",\"x, y\",\"say \"\"hi\"\"\"\r\n\r\n 1 ,\"two\nlines\",3\n");
+  std::istringstream in(
+      "\xEF\xBB\xBF"
+      "a,b,c\r\n\"9.81\",\"x, y\",\"say \"\"hi\"\"\"\r\n\r\n 1 ,\"two\nlines\",3\n");
   CsvReader r(in);
   std::vector<std::string> f;
   int line = 0;
@@ -216,15 +217,16 @@ TEST(LabCampaign, TracePathsOutsideTheCampaignFolderAreRefusedWithTheRow) {
   fs::create_symlink(d.path / "outside/X.csv", camp / "traces/link.csv");
   fs::create_directory_symlink(d.path / "outside", camp / "traces/dirlink");
   write_text(camp / "trials.csv", std::string(kHeader) + "\n" + row("T1", "../outside/X.csv") + "\n" +
-                                      row("T2", "traces/../../outside/X.csv") + "\n" + row("T3", "/etc/passwd") +
-                                      "\n" + row("T4", "traces/link.csv") + "\n" + row("T5", "traces/dirlink/X.csv") +
-                                      "\n" + row("T6", "traces/ok.csv") + "\n");
+                                      row("T2", "traces/../../outside/X.csv") + "\n" + row("T3", "/etc/passwd") + "\n" +
+                                      row("T4", "traces/link.csv") + "\n" + row("T5", "traces/dirlink/X.csv") + "\n" +
+                                      row("T6", "traces/ok.csv") + "\n");
   const Campaign c = load_campaign(camp.string());
   ASSERT_EQ(c.trials.size(), 1u) << issues_of(c);
   EXPECT_EQ(c.trials[0].info.trial_id, "T6");
   for (int line = 2; line <= 6; ++line)
     EXPECT_TRUE(has_issue(c, "trials.csv:" + std::to_string(line) + ":2", "inside the campaign folder"))
-        << "line " << line << "\n" << issues_of(c);
+        << "line " << line << "\n"
+        << issues_of(c);
 }
 
 TEST(LabCampaign, DeclaredSampleRateIsCheckedAgainstTheTimestamps) {
@@ -271,7 +273,8 @@ TEST(OneEntry, ADemTrialAndALabTrialWithTheSameKinematicsGiveTheSameMetrics) {
   TempDir d;
   Poncelet k;
   write_lab_trace(d.path / "lab/traces/A.csv", k, 10000, 0.0, false);
-  write_text(d.path / "lab/trials.csv", std::string(kHeader) + "\n" + row("A", "traces/A.csv", 9.81, 0.8, 10000) + "\n");
+  write_text(d.path / "lab/trials.csv",
+             std::string(kHeader) + "\n" + row("A", "traces/A.csv", 9.81, 0.8, 10000) + "\n");
   const Campaign lab = load_campaign((d.path / "lab").string());
   write_dem_trace(d.path / "dem/trace.h5", k, 10000, R"({"output": {"filter_cutoff_hz": 500}})");
   const Campaign dem = load_dem_campaign("dem", {{"D", "", d.path / "dem/trace.h5"}});

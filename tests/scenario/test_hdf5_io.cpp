@@ -163,8 +163,7 @@ TEST(Hdf5Io, ReadableWithH5py) {
   results::write_bed(dir.path / "bed.h5", sample_bed());
   results::write_trace(dir.path / "trace.h5", sample_trace());
   const std::string cmd = std::string(py) + " -c \"import h5py, json; b = h5py.File('" +
-                          (dir.path / "bed.h5").string() + "'); t = h5py.File('" +
-                          (dir.path / "trace.h5").string() +
+                          (dir.path / "bed.h5").string() + "'); t = h5py.File('" + (dir.path / "trace.h5").string() +
                           "'); print(b['grains/position_m'].shape, b['grains/position_m'].attrs['units'], "
                           "json.loads(b.attrs['report'])['grains_kept'], t['trace/depth_m'].attrs['units'], "
                           "t['trace'].attrs['sample_rate_hz'], json.loads(t.attrs['metrics'])['zstop_m'])\"";

@@ -157,11 +157,12 @@ TEST_F(ImpactPipeline, DropsOfOtherSpeedsShareTheBedButNotOtherGravity) {
 TEST_F(ImpactPipeline, StopFlagInterruptsWithoutLeavingFiles) {
   std::atomic<bool> stop{false};
   int calls = 0;
-  EXPECT_THROW(run_drop_job(test::tiny_scenario(), bed_->bed_path, dir_->path / "stopped.h5", 1,
-                            [&](const std::string&, double, const std::string&) {
-                              if (++calls == 2) stop = true;
-                            },
-                            &stop),
+  EXPECT_THROW(run_drop_job(
+                   test::tiny_scenario(), bed_->bed_path, dir_->path / "stopped.h5", 1,
+                   [&](const std::string&, double, const std::string&) {
+                     if (++calls == 2) stop = true;
+                   },
+                   &stop),
                pipeline::Interrupted);
   EXPECT_FALSE(std::filesystem::exists(dir_->path / "stopped.h5"));
   for (const auto& e : std::filesystem::directory_iterator(dir_->path))
@@ -247,7 +248,6 @@ TEST(RunVerb, HelpTeachesWithAnExample) {
   EXPECT_NE(r.out.find("Example"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("--bed"), std::string::npos) << r.out;
 }
-
 
 // `gravsweep pile` on a small heap (600 grains, 8 cm base; measured 7 and 17 degrees): a CSV row
 // per mu_r with the angle, steeper with rolling friction, and a bad option refused with exit code 2.

@@ -157,10 +157,10 @@ TEST(ScenarioSpec, CrossFieldRulesAreRefusedAtTheRightField) {
 
 TEST(ScenarioSpec, EveryProblemIsListedNotOnlyTheFirst) {
   json s = minimal();
-  s["projectile"]["mass_kg"] = "heavy";             // schema: a number
-  s["grains"] = {{"diameter_spread_m", 0.02}};       // rule: below half the grain diameter
-  s["output"] = {{"sample_rate_hz", 1e7}};           // rule: at most 1/dt_s
-  s["dt_s"] = "small";                               // schema: a number (the rate check then skips)
+  s["projectile"]["mass_kg"] = "heavy";         // schema: a number
+  s["grains"] = {{"diameter_spread_m", 0.02}};  // rule: below half the grain diameter
+  s["output"] = {{"sample_rate_hz", 1e7}};      // rule: at most 1/dt_s
+  s["dt_s"] = "small";                          // schema: a number (the rate check then skips)
   try {
     validate_scenario(s, "spec.json");
     FAIL() << "accepted";

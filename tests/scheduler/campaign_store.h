@@ -14,9 +14,9 @@ enum class Store { sqlite, postgres };
 inline std::string store_name(Store s) { return s == Store::sqlite ? "sqlite" : "postgres"; }
 
 struct CampaignStore {
-  std::string location;          ///< --db: the SQLite file, or the PostgreSQL URL
-  std::filesystem::path files;   ///< --files: empty for SQLite (beside the file)
-  std::string skip;              ///< non-empty: why this backend cannot run here (for GTEST_SKIP)
+  std::string location;         ///< --db: the SQLite file, or the PostgreSQL URL
+  std::filesystem::path files;  ///< --files: empty for SQLite (beside the file)
+  std::string skip;             ///< non-empty: why this backend cannot run here (for GTEST_SKIP)
 
   CampaignStore(Store s, const std::filesystem::path& dir, const std::string& stem = "c") {
     if (s == Store::sqlite) {

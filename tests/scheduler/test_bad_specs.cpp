@@ -32,10 +32,10 @@ json impact_doc() {
 
 struct Case {
   std::string name;
-  std::string text;      ///< the spec file's content
-  std::string where;     ///< the pointer or line the message must name
-  std::string also;      ///< another piece the message must hold ("" = none)
-  bool impact = false;   ///< needs the impact pipeline
+  std::string text;     ///< the spec file's content
+  std::string where;    ///< the pointer or line the message must name
+  std::string also;     ///< another piece the message must hold ("" = none)
+  bool impact = false;  ///< needs the impact pipeline
 };
 
 std::string with(json doc, const std::string& pointer, const json& value) {
@@ -53,10 +53,10 @@ std::vector<Case> corpus() {
   std::vector<Case> c;
   const json n = noop_doc(), im = impact_doc();
   c.push_back({"syntax error", "{\n  \"sweep\": \"x\",\n  \"base\": {\n}", "line 4", "JSON"});
-  c.push_back({"number out of range", "{\"sweep\": \"x\", \"job\": \"noop\",\n \"base\": {\"g\": 1e999}}", "line 2",
-               "1e999"});
-  c.push_back({"nested 100000 deep", "{\"sweep\": \"x\", \"base\": " + std::string(100000, '[') +
-                                          std::string(100000, ']') + "}",
+  c.push_back(
+      {"number out of range", "{\"sweep\": \"x\", \"job\": \"noop\",\n \"base\": {\"g\": 1e999}}", "line 2", "1e999"});
+  c.push_back({"nested 100000 deep",
+               "{\"sweep\": \"x\", \"base\": " + std::string(100000, '[') + std::string(100000, ']') + "}",
                "line 1, column", "deeper than 64"});
   c.push_back({"not an object", "[1, 2]", "(array)", "an object"});
   c.push_back({"base is a folder", with(n, "/base", "/tmp"), "/base", "a folder"});
@@ -112,8 +112,7 @@ std::vector<Case> corpus() {
   wide["base"]["container"]["diameter_m"] = 20;
   c.push_back({"a 20 m x 20 m fill", with(wide, "/base/container/fill_height_m", 20), "/base/container/fill_height_m",
                "this machine's memory", true});
-  c.push_back({"unknown scenario field", with(im, "/base/projectile/speed", 1.0), "/base/projectile/speed", "",
-               true});
+  c.push_back({"unknown scenario field", with(im, "/base/projectile/speed", 1.0), "/base/projectile/speed", "", true});
   return c;
 }
 

@@ -23,8 +23,8 @@ std::string one_drop_spec() {
   json spec;
   spec["sweep"] = "cache";
   spec["base"] = json::parse(tiny_base());
-  spec["axes"] = json::array({{{"name", "impact_speed_m_s"}, {"pointer", "/projectile/impact_speed_m_s"},
-                               {"values", {0.5}}}});
+  spec["axes"] =
+      json::array({{{"name", "impact_speed_m_s"}, {"pointer", "/projectile/impact_speed_m_s"}, {"values", {0.5}}}});
   return spec.dump(2);
 }
 
@@ -40,9 +40,8 @@ Campaign run_campaign(const fs::path& dir, const std::string& name, const fs::pa
   const std::string db_file = name + ".db";
   EXPECT_EQ(run_cli({"submit", "spec.json", "--db", db_file}, dir).code, 0);
   Campaign c;
-  c.work = run_cli({"work", "--db", db_file, "--threads", "1", "--quiet", "--backoff", "0", "--bed-cache",
-                    cache.string()},
-                   dir);
+  c.work = run_cli(
+      {"work", "--db", db_file, "--threads", "1", "--quiet", "--backoff", "0", "--bed-cache", cache.string()}, dir);
   db::Database db((dir / db_file).string());
   c.bed_id = sql_text(db, "SELECT job_id FROM jobs WHERE kind='bed'");
   c.bed_report = sql_text(db, "SELECT coalesce(report_json,'') FROM attempts WHERE kind='bed' AND outcome='done'");

@@ -98,7 +98,7 @@ TEST(BedInput, RunBedRefusesEveryFlippedBitOfTheParticleDataAndTakesTheIntactBed
     int byte, bit;
   };
   const std::vector<Flip> flips = {
-      {"/grains/position_m", 0, 0, 0},           // x of the first grain, lowest mantissa bit
+      {"/grains/position_m", 0, 0, 0},                // x of the first grain, lowest mantissa bit
       {"/grains/position_m", 3 * (n / 2) + 2, 3, 5},  // z of a middle grain, a middle mantissa bit
       {"/grains/velocity_m_s", 3 * n - 1, 7, 7},      // the last value, its sign bit
       {"/grains/omega_rad_s", 3 * 7 + 1, 6, 4},       // an exponent bit
@@ -153,23 +153,30 @@ TEST(BedInput, ACorruptBedFileExitsTwoNamingItInRunAndBench) {
     const char* why;                            ///< a word of the reason
   };
   const std::vector<Corrupt> cases = {
-      {"cut short", [&](const fs::path& f) { write_bytes(f, {bytes.begin(), bytes.begin() + bytes.size() / 2}); },
+      {"cut short",
+       [&](const fs::path& f) {
+         write_bytes(f, {bytes.begin(), bytes.begin() + bytes.size() / 2});
+       },
        "not a readable gravsweep bed"},
-      {"random bytes", [&](const fs::path& f) {
+      {"random bytes",
+       [&](const fs::path& f) {
          std::vector<char> junk(bytes.size());
          std::mt19937 rng(11);
          for (auto& c : junk) c = static_cast<char>(rng());
          write_bytes(f, junk);
-       }, "not an HDF5 file"},
+       },
+       "not an HDF5 file"},
       {"a trace, not a bed", [&](const fs::path& f) { fs::copy_file(p.dir.path / "first" / "trace.h5", f); },
        "not a gravsweep bed"},
-      {"HDF5 bed missing /grains/mass_kg", [&](const fs::path& f) {
+      {"HDF5 bed missing /grains/mass_kg",
+       [&](const fs::path& f) {
          fs::copy_file(p.bed, f);
          const hid_t h = H5Fopen(f.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
          ASSERT_GE(h, 0);
          EXPECT_GE(H5Ldelete(h, "/grains/mass_kg", H5P_DEFAULT), 0);
          H5Fclose(h);
-       }, "mass_kg"},
+       },
+       "mass_kg"},
       {"a folder", [&](const fs::path& f) { fs::create_directories(f); }, "not a regular file"},
   };
   for (std::size_t i = 0; i < cases.size(); ++i) {

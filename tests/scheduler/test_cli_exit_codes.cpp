@@ -120,7 +120,9 @@ TEST(ExitCodes, RunInterruptedBySigtermExits130AndSaysSo) {
 
 TEST(ExitCodes, WorkWithADeadJobExits4FromOneWorkerAndFromTheSupervisor) {
   TempDir d;
-  const json spec = {{"sweep", "dead"}, {"job", "noop"}, {"max_attempts", 1},
+  const json spec = {{"sweep", "dead"},
+                     {"job", "noop"},
+                     {"max_attempts", 1},
                      {"base", {{"g", 1.0}, {"sleep_s", 0.0}, {"fail_attempts", 99}}},
                      {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {1.0, 2.0}}}}}};
   write_text(d.path / "spec.json", spec.dump(2));

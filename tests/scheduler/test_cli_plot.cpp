@@ -19,10 +19,12 @@ namespace {
 
 /// Two values per gravity level, so that the mean +/- std of the repeats is drawn.
 std::string spec() {
-  json doc = {{"sweep", "plot"}, {"job", "noop"},
+  json doc = {{"sweep", "plot"},
+              {"job", "noop"},
               {"base", {{"g", 1.5}, {"value", 1.0}}},
-              {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {0.1, 1.62, 9.81}}},
-                        {{"name", "v"}, {"pointer", "/value"}, {"values", {1.0, 3.0}}}}}};
+              {"axes",
+               {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {0.1, 1.62, 9.81}}},
+                {{"name", "v"}, {"pointer", "/value"}, {"values", {1.0, 3.0}}}}}};
   return doc.dump();
 }
 
@@ -40,8 +42,8 @@ TEST(CliPlot, ResultsColumnAgainstColumnWritesAPng) {
   write_text(d.path / "spec.json", spec());
   ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
   ASSERT_EQ(run_cli({"work", "--db", "c.db", "--workers", "2", "--quiet"}, d.path).code, 0);
-  const auto r = run_cli({"plot", "results", "--db", "c.db", "--x", "gravity_m_s2", "--y", "noop_value",
-                          "--group", "v", "--title", "test", "--out", "figs/f.png"},
+  const auto r = run_cli({"plot", "results", "--db", "c.db", "--x", "gravity_m_s2", "--y", "noop_value", "--group", "v",
+                          "--title", "test", "--out", "figs/f.png"},
                          d.path);
   ASSERT_EQ(r.code, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("6 runs plotted"), std::string::npos) << r.out;
@@ -57,11 +59,12 @@ TEST(CliPlot, BadInputIsRefusedWithExitCode2) {
   write_text(d.path / "spec.json", spec());
   ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
   ASSERT_EQ(run_cli({"work", "--db", "c.db", "--quiet"}, d.path).code, 0);
-  auto r = run_cli({"plot", "results", "--db", "c.db", "--x", "gravity_m_s2", "--y", "no_such_column", "--out", "f.png"},
-                   d.path);
+  auto r = run_cli(
+      {"plot", "results", "--db", "c.db", "--x", "gravity_m_s2", "--y", "no_such_column", "--out", "f.png"}, d.path);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("no_such_column"), std::string::npos) << r.err;
-  r = run_cli({"plot", "results", "--db", "c.db", "--x", "gravity_m_s2", "--y", "noop_value", "--out", "f.pdf"}, d.path);
+  r = run_cli({"plot", "results", "--db", "c.db", "--x", "gravity_m_s2", "--y", "noop_value", "--out", "f.pdf"},
+              d.path);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find(".png"), std::string::npos) << r.err;
   r = run_cli({"plot", "results", "--db", "missing.db", "--x", "a", "--y", "b", "--out", "f.png"}, d.path);
@@ -94,8 +97,8 @@ void expect_figure(const std::filesystem::path& png, std::uintmax_t min_bytes) {
 /// Runs tests/scheduler/check_xdmf.py on an XDMF index; returns its exit status, `out` its output
 /// ("ok <grids> <items> <times>" when every dataset the index names exists with its shape).
 int check_xdmf(const std::filesystem::path& xdmf, std::string& out) {
-  const std::string cmd = "/usr/bin/python3 '" GRAVSWEEP_SOURCE_DIR "/tests/scheduler/check_xdmf.py' '" +
-                          xdmf.string() + "' 2>&1";
+  const std::string cmd =
+      "/usr/bin/python3 '" GRAVSWEEP_SOURCE_DIR "/tests/scheduler/check_xdmf.py' '" + xdmf.string() + "' 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   if (p == nullptr) return -1;
   char buf[512] = {0};
@@ -226,7 +229,7 @@ TEST(CliPlot, RunWritesSnapshotsThatTheXdmfIndexDescribes) {
   ASSERT_EQ(check_xdmf(xdmf, out), 0) << out;
   int grids = 0, items = 0, times = 0;
   ASSERT_EQ(std::sscanf(out.c_str(), "ok %d %d %d", &grids, &items, &times), 3) << out;
-  EXPECT_GE(times, 3) << out;  // release, every 5 ms, the end
+  EXPECT_GE(times, 3) << out;          // release, every 5 ms, the end
   EXPECT_EQ(grids, 2 * times) << out;  // grains and projectile per snapshot
   EXPECT_EQ(items, 5 * grids) << out;  // position, radius, velocity, omega, contacts
   // A corrupted index (a dataset renamed) is caught: the check can fail.
@@ -249,7 +252,8 @@ TEST(CliPlot, CampaignDropsWriteSnapshotsWhenTheScenarioAsks) {
     spec["sweep"] = interval_s > 0 ? "snap" : "nosnap";
     spec["base"] = json::parse(tiny_base());
     spec["base"]["output"]["snapshot_interval_s"] = interval_s;
-    spec["axes"] = json::array({{{"name", "impact_speed_m_s"}, {"pointer", "/projectile/impact_speed_m_s"},
+    spec["axes"] = json::array({{{"name", "impact_speed_m_s"},
+                                 {"pointer", "/projectile/impact_speed_m_s"},
                                  {"values", {interval_s > 0 ? 0.5 : 0.6}}}});
     write_text(d.path / "spec.json", spec.dump(2));
     ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);

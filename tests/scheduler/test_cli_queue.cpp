@@ -16,8 +16,11 @@ using nlohmann::json;
 
 namespace {
 
-std::string noop_spec(const std::vector<double>& gs, double sleep_s = 0.0, int fail_attempts = 0, int max_attempts = 3) {
-  json doc = {{"sweep", "cli"}, {"job", "noop"}, {"max_attempts", max_attempts},
+std::string noop_spec(const std::vector<double>& gs, double sleep_s = 0.0, int fail_attempts = 0,
+                      int max_attempts = 3) {
+  json doc = {{"sweep", "cli"},
+              {"job", "noop"},
+              {"max_attempts", max_attempts},
               {"base", {{"g", 1.5}, {"sleep_s", sleep_s}, {"fail_attempts", fail_attempts}}},
               {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", gs}}}}};
   return doc.dump(2);
@@ -77,7 +80,8 @@ TEST(CliQueue, WorkersRunEverythingRetryAndReportDeadJobs) {
   // Every result's file exists with its recorded checksum size.
   db::Statement st(db, "SELECT trace_path, trace_bytes FROM results");
   while (st.step())
-    EXPECT_EQ(std::filesystem::file_size(campaign_file(d.path, "c", st.get_text(0))), static_cast<std::uintmax_t>(st.get_int(1)));
+    EXPECT_EQ(std::filesystem::file_size(campaign_file(d.path, "c", st.get_text(0))),
+              static_cast<std::uintmax_t>(st.get_int(1)));
   // A job that always fails goes dead after max_attempts; work exits 4.
   write_text(d.path / "dead.json", noop_spec({7.0}, 0.0, 99, 2));
   ASSERT_EQ(run_cli({"submit", "dead.json", "--db", "c.db"}, d.path).code, 0);
@@ -182,7 +186,8 @@ TEST(CliQueue, SubmitWhereTakesPartOfASweepWithOnlyTheBedsItNeeds) {
   EXPECT_NE(r.out.find("4 jobs planned (1 bed, 3 drop): 4 new"), std::string::npos) << r.out;
   {
     db::Database db((d.path / "c.db").string());
-    EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE kind='drop' AND params_json LIKE '%\"projectile_seed\":2%'"), 3);
+    EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE kind='drop' AND params_json LIKE '%\"projectile_seed\":2%'"),
+              3);
   }
   // The whole sweep later adds the rest and keeps what is there.
   r = run_cli({"submit", example, "--db", "c.db"}, d.path);
@@ -200,9 +205,9 @@ TEST(CliQueue, FollowingWorkersPickUpLateSubmissionsAndTheSupervisorForwardsSigt
   TempDir d;
   write_text(d.path / "a.json", noop_spec({1.0}, 0.05));
   ASSERT_EQ(run_cli({"submit", "a.json", "--db", "c.db"}, d.path).code, 0);
-  const pid_t sup = start_cli({"work", "--db", (d.path / "c.db").string(), "--workers", "2", "--follow", "--poll",
-                               "0.05", "--quiet"},
-                              d.path / "w.log");
+  const pid_t sup =
+      start_cli({"work", "--db", (d.path / "c.db").string(), "--workers", "2", "--follow", "--poll", "0.05", "--quiet"},
+                d.path / "w.log");
   db::Database db((d.path / "c.db").string());
   auto wait_done = [&](std::int64_t n) {
     const auto t0 = std::chrono::steady_clock::now();

@@ -96,7 +96,8 @@ void crash_campaign(Store store_kind, const json& doc, std::int64_t total, std::
   sup_args.insert(sup_args.end(), {"--workers", "2", "--quiet"});
   // Slot 0: a plain worker; then the supervisor of two workers, or two more plain workers.
   std::vector<pid_t> workers{start_cli(work_args, d.path / "w0.log")};
-  if (with_supervisor) workers.push_back(start_cli(sup_args, d.path / "sup.log"));
+  if (with_supervisor)
+    workers.push_back(start_cli(sup_args, d.path / "sup.log"));
   else
     for (int i = 1; i < 3; ++i) workers.push_back(start_cli(work_args, d.path / fmt::format("w{}.log", i)));
 
@@ -148,16 +149,18 @@ void crash_campaign(Store store_kind, const json& doc, std::int64_t total, std::
   EXPECT_EQ(storm.orphans, 0) << "workers outlived their SIGKILLed supervisor";
   for (pid_t w : workers) EXPECT_EQ(wait_child(w, 200), 0);
   ::testing::Test::RecordProperty("sigkills", kills);
-  std::printf("crash campaign: %lld jobs, %d SIGKILLs mid-job (%d of a worker, %d of a supervisor, %d "
-              "worker(s) outlived it), all workers finished\n",
-              static_cast<long long>(total), kills, storm.worker_kills, storm.supervisor_kills, storm.orphans);
+  std::printf(
+      "crash campaign: %lld jobs, %d SIGKILLs mid-job (%d of a worker, %d of a supervisor, %d "
+      "worker(s) outlived it), all workers finished\n",
+      static_cast<long long>(total), kills, storm.worker_kills, storm.supervisor_kills, storm.orphans);
 
   // Every job done exactly once.
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs"), total);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), total);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='done'"), total);
-  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM (SELECT job_id FROM attempts WHERE outcome='done' GROUP BY job_id "
-                        "HAVING count(*) > 1) AS twice"),
+  EXPECT_EQ(sql_int(db,
+                    "SELECT count(*) FROM (SELECT job_id FROM attempts WHERE outcome='done' GROUP BY job_id "
+                    "HAVING count(*) > 1) AS twice"),
             0);
   // Each kill of a worker left one lost attempt, reclaimed by a surviving worker (more only if a
   // starved heartbeat let a lease lapse, then fenced out); the workers of a killed supervisor got
@@ -217,19 +220,22 @@ TEST_P(CrashCampaign, SigkilledWorkersAndSupervisorsLoseNothingAndDuplicateNothi
                  {"range", {{"start", 0.4}, {"stop", 1.0}, {"step", 0.1}}}}}},
               {"repeats", {{"name", "projectile_seed"}, {"pointer", "/projectile/seed"}, {"count", 2}, {"start", 1}}}};
   // 4 beds (gravity x bed seed) and 56 drops (7 speeds x 2 projectile seeds per bed).
-  EXPECT_NO_FATAL_FAILURE(crash_campaign(GetParam(), doc, 60, 56,
-                                         {"gravity_m_s2", "bed_seed", "impact_speed_m_s", "projectile_seed", "bed_job_id"},
-                                         4, 6, /*with_supervisor=*/true));
+  EXPECT_NO_FATAL_FAILURE(crash_campaign(
+      GetParam(), doc, 60, 56, {"gravity_m_s2", "bed_seed", "impact_speed_m_s", "projectile_seed", "bed_job_id"}, 4, 6,
+      /*with_supervisor=*/true));
 }
 
 TEST_P(CrashCampaign, NoopJobsSurviveSigkillToo) {
   // The queue alone (no engine): 30 half-second jobs.
-  json doc = {{"sweep", "crash_noop"},
-              {"job", "noop"},
-              {"max_attempts", 6},
-              {"base", {{"g", 1.5}, {"sleep_s", 0.5}}},
-              {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 0.1}, {"stop", 3.0}, {"step", 0.1}}}}}}};
-  EXPECT_NO_FATAL_FAILURE(crash_campaign(GetParam(), doc, 30, 30, {"gravity_m_s2", "noop_value"}, 4, 4, /*with_supervisor=*/true));
+  json doc = {
+      {"sweep", "crash_noop"},
+      {"job", "noop"},
+      {"max_attempts", 6},
+      {"base", {{"g", 1.5}, {"sleep_s", 0.5}}},
+      {"axes",
+       {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 0.1}, {"stop", 3.0}, {"step", 0.1}}}}}}};
+  EXPECT_NO_FATAL_FAILURE(
+      crash_campaign(GetParam(), doc, 30, 30, {"gravity_m_s2", "noop_value"}, 4, 4, /*with_supervisor=*/true));
 }
 
 TEST_P(CrashCampaign, SigkilledSupervisorTakesItsWorkersDownAndLosesNothing) {
@@ -238,11 +244,13 @@ TEST_P(CrashCampaign, SigkilledSupervisorTakesItsWorkersDownAndLosesNothing) {
   TempDir d;
   const CampaignStore store(GetParam(), d.path);
   if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
-  json doc = {{"sweep", "sup"},
-              {"job", "noop"},
-              {"max_attempts", 6},
-              {"base", {{"g", 1.0}, {"sleep_s", 0.3}}},
-              {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 0.1}, {"stop", 4.0}, {"step", 0.1}}}}}}};
+  json doc = {
+      {"sweep", "sup"},
+      {"job", "noop"},
+      {"max_attempts", 6},
+      {"base", {{"g", 1.0}, {"sleep_s", 0.3}}},
+      {"axes",
+       {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 0.1}, {"stop", 4.0}, {"step", 0.1}}}}}}};
   write_text(d.path / "spec.json", doc.dump());
   ASSERT_EQ(run_cli(cat({"submit", "spec.json"}, store.args()), d.path).code, 0);
   const std::string db_path = store.location;
@@ -275,7 +283,8 @@ TEST_P(CrashCampaign, SigkilledSupervisorTakesItsWorkersDownAndLosesNothing) {
   }
   std::printf("supervisor SIGKILLed 3 times: %d worker(s) outlived it by 5 s\n", orphans_left);
   EXPECT_EQ(orphans_left, 0) << "workers outlived their supervisor";
-  const auto r = run_cli(cat({"work", "--workers", "2", "--quiet", "--lease", "2", "--poll", "0.1"}, store.args()), d.path);
+  const auto r =
+      run_cli(cat({"work", "--workers", "2", "--quiet", "--lease", "2", "--poll", "0.1"}, store.args()), d.path);
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), 40);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='done'"), 40);

@@ -15,7 +15,8 @@ using namespace gravsweep;
 TEST(DbLayer, ParametersAreTranslatedOutsideLiteralsAndCasts) {
   std::map<std::string, int> names;
   int count = 0;
-  EXPECT_EQ(db::translate_parameters("SELECT ?, ?, x FROM t WHERE a=?", names, count), "SELECT $1, $2, x FROM t WHERE a=$3");
+  EXPECT_EQ(db::translate_parameters("SELECT ?, ?, x FROM t WHERE a=?", names, count),
+            "SELECT $1, $2, x FROM t WHERE a=$3");
   EXPECT_EQ(count, 3);
   names.clear();
   EXPECT_EQ(db::translate_parameters("UPDATE t SET a=?2, b=?1 WHERE c=?2", names, count),

@@ -46,8 +46,9 @@ TEST(WhereParser, RowsOutsideADatabaseMatchAsTheResultsTableDoes) {
     row_matches(row, {"speed_m_s>1"});
     FAIL();
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("found column 'speed_m_s', expected one of: gravity_m_s2, rebound, seed, sweep"),
-              std::string::npos)
+    EXPECT_NE(
+        std::string(e.what()).find("found column 'speed_m_s', expected one of: gravity_m_s2, rebound, seed, sweep"),
+        std::string::npos)
         << e.what();
   }
 }
@@ -56,9 +57,12 @@ TEST(ResultsQuery, FiltersAreBoundAndColumnsChecked) {
   test::TempDir dir;
   db::Database db((dir.path / "c.db").string());
   ensure_schema(db);
-  nlohmann::json doc = {{"sweep", "s"}, {"job", "noop"}, {"base", {{"g", 1.5}, {"tag", "a"}}},
-                        {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {0.5, 1.62, 9.81}}},
-                                  {{"name", "tag"}, {"pointer", "/tag"}, {"values", {"a", "b'); DROP TABLE jobs; --"}}}}}};
+  nlohmann::json doc = {{"sweep", "s"},
+                        {"job", "noop"},
+                        {"base", {{"g", 1.5}, {"tag", "a"}}},
+                        {"axes",
+                         {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {0.5, 1.62, 9.81}}},
+                          {{"name", "tag"}, {"pointer", "/tag"}, {"values", {"a", "b'); DROP TABLE jobs; --"}}}}}};
   const auto spec = sweep::parse_spec(doc, "t", ".");
   submit(db, spec, sweep::expand(spec, {}));
   const auto me = make_identity("t", 1);
@@ -74,7 +78,8 @@ TEST(ResultsQuery, FiltersAreBoundAndColumnsChecked) {
   ASSERT_EQ(t.rows.size(), 2u);
   EXPECT_EQ(t.rows[0][0], 0.5);
   EXPECT_EQ(t.rows[0][1], 5.0);
-  t = query_results(db, {{"tag = \"b'); DROP TABLE jobs; --\"", "gravity_m_s2 >= 1"}, {"gravity_m_s2"}, "", "gravity_m_s2", -1});
+  t = query_results(
+      db, {{"tag = \"b'); DROP TABLE jobs; --\"", "gravity_m_s2 >= 1"}, {"gravity_m_s2"}, "", "gravity_m_s2", -1});
   ASSERT_EQ(t.rows.size(), 2u);
   EXPECT_EQ(t.rows[0][0], 1.62);
   EXPECT_EQ(test::sql_int(db, "SELECT count(*) FROM jobs"), 6) << "the text was a value, not SQL";

@@ -64,7 +64,9 @@ TEST(PostgresCampaign, AServerCampaignNeedsItsFilesRoot) {
   TempDir d;
   const CampaignStore store(Store::postgres, d.path);
   if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
-  json doc = {{"sweep", "s"}, {"job", "noop"}, {"base", {{"i", 0}}},
+  json doc = {{"sweep", "s"},
+              {"job", "noop"},
+              {"base", {{"i", 0}}},
               {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"values", {1, 2}}}}}};
   write_text(d.path / "spec.json", doc.dump());
   const auto r = run_cli({"submit", "spec.json", "--db", store.location}, d.path);
@@ -146,7 +148,9 @@ TEST(PostgresCampaign, SlurmSubmitDryRunPrintsOneArrayOfPilotWorkers) {
   TempDir d;
   const CampaignStore store(Store::postgres, d.path);
   if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
-  json doc = {{"sweep", "s"}, {"job", "noop"}, {"base", {{"i", 0}}},
+  json doc = {{"sweep", "s"},
+              {"job", "noop"},
+              {"base", {{"i", 0}}},
               {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"values", {1, 2}}}}}};
   write_text(d.path / "spec.json", doc.dump());
   ASSERT_EQ(run_cli({"submit", "spec.json", "--db", store.location, "--files", store.files.string()}, d.path).code, 0);

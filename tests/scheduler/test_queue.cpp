@@ -24,7 +24,10 @@ namespace {
 sweep::SweepSpec noop_spec(const std::string& name, std::vector<double> gs, int max_attempts = 3,
                            json base = json::object()) {
   if (base.empty()) base = {{"g", 1.5}, {"sleep_s", 0.0}};
-  json doc = {{"sweep", name}, {"job", "noop"}, {"base", base}, {"max_attempts", max_attempts},
+  json doc = {{"sweep", name},
+              {"job", "noop"},
+              {"base", base},
+              {"max_attempts", max_attempts},
               {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", gs}}}}};
   return sweep::parse_spec(doc, "test", ".");
 }
@@ -234,7 +237,8 @@ TEST_P(QueueTest, PermanentErrorGoesDeadAtOnceAndKillsDependents) {
   o.retry_dead = true;
   resume(db, paths, o);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='waiting'"), 6);
-  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='queued' AND kind='bed'"), 2);  // the revived bed and the one never claimed
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='queued' AND kind='bed'"),
+            2);  // the revived bed and the one never claimed
 }
 
 TEST_P(QueueTest, ReleaseDoesNotSpendTheBudget) {
@@ -347,7 +351,9 @@ TEST_P(QueueTest, EtaOfASweepWithNothingFinishedComesFromItsRunningJobsProgress)
 }
 
 TEST_P(QueueTest, StatusIsFastOnAHundredThousandJobs) {
-  json doc = {{"sweep", "big"}, {"job", "noop"}, {"base", {{"i", 0}}},
+  json doc = {{"sweep", "big"},
+              {"job", "noop"},
+              {"base", {{"i", 0}}},
               {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"range", {{"start", 0}, {"stop", 99999}, {"step", 1}}}}}}};
   const auto spec = sweep::parse_spec(doc, "test", ".");
   const auto r = submit_spec(spec);

@@ -72,8 +72,7 @@ TEST(ResumeSafety, ResumeLoopBesideEightWorkersLosesNoFinishedOutput) {
   write_text(d.path / "spec.json", noop_sweep(kJobs, 0.0));
   ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "r.db"}, d.path).code, 0);
   const std::string db_path = (d.path / "r.db").string();
-  const pid_t work = start_cli({"work", "--db", db_path, "--workers", "8", "--lease", "5", "--threads", "1",
-                                "--quiet"},
+  const pid_t work = start_cli({"work", "--db", db_path, "--workers", "8", "--lease", "5", "--threads", "1", "--quiet"},
                                d.path / "work.log");
   int resumes = 0, resume_failures = 0;
   std::string resume_err;
@@ -95,11 +94,13 @@ TEST(ResumeSafety, ResumeLoopBesideEightWorkersLosesNoFinishedOutput) {
   db::Database db(db_path);
   std::string first;
   const int lost = lost_outputs(db, d.path, "r", &first);
-  const auto no_output = sql_int(db, "SELECT count(*) FROM attempts WHERE error LIKE '%wrote no output%' OR "
-                                     "error LIKE '%cannot rename%' OR error LIKE '%filesystem error%'");
-  std::printf("resume loop: %d resumes beside 8 workers on %d jobs: %d done files lost, %lld attempts lost their "
-              "file\n",
-              resumes, kJobs, lost, static_cast<long long>(no_output));
+  const auto no_output = sql_int(db,
+                                 "SELECT count(*) FROM attempts WHERE error LIKE '%wrote no output%' OR "
+                                 "error LIKE '%cannot rename%' OR error LIKE '%filesystem error%'");
+  std::printf(
+      "resume loop: %d resumes beside 8 workers on %d jobs: %d done files lost, %lld attempts lost their "
+      "file\n",
+      resumes, kJobs, lost, static_cast<long long>(no_output));
   ::testing::Test::RecordProperty("resumes", resumes);
   EXPECT_GE(resumes, 3) << "the loop must overlap the workers";
   EXPECT_EQ(resume_failures, 0) << resume_err;
@@ -218,9 +219,10 @@ TEST(ResumeSafety, VersionOneCampaignIsMigratedAndItsRenamedCopyKeepsItsFiles) {
   {
     // As gravsweep wrote campaigns before schema version 2: paths relative to the database's folder.
     db::Database db((d.path / "c.db").string());
-    db.exec("UPDATE jobs SET output_path='c.files/' || output_path; UPDATE attempts SET output_path='c.files/' || "
-            "output_path; UPDATE results SET trace_path='c.files/' || trace_path; UPDATE queue_meta SET value='1' "
-            "WHERE key='schema_version'");
+    db.exec(
+        "UPDATE jobs SET output_path='c.files/' || output_path; UPDATE attempts SET output_path='c.files/' || "
+        "output_path; UPDATE results SET trace_path='c.files/' || trace_path; UPDATE queue_meta SET value='1' "
+        "WHERE key='schema_version'");
     db.exec("VACUUM INTO '" + (d.path / "c2.db").string() + "'");
   }
   fs::copy(d.path / "c.files", d.path / "c2.files", fs::copy_options::recursive);
@@ -239,9 +241,10 @@ TEST(ResumeSafety, VersionOneCampaignIsMigratedAndItsRenamedCopyKeepsItsFiles) {
 
 TEST(BedChecksum, AFlippedBitInAFinishedBedFailsTheDropAndRebuildsTheBed) {
   TempDir d;
-  json doc = {{"sweep", "flip"},
-              {"base", json::parse(tiny_base())},
-              {"axes", {{{"name", "impact_speed_m_s"}, {"pointer", "/projectile/impact_speed_m_s"}, {"values", {0.4, 0.6}}}}}};
+  json doc = {
+      {"sweep", "flip"},
+      {"base", json::parse(tiny_base())},
+      {"axes", {{{"name", "impact_speed_m_s"}, {"pointer", "/projectile/impact_speed_m_s"}, {"values", {0.4, 0.6}}}}}};
   write_text(d.path / "spec.json", doc.dump());
   ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
   auto r = run_cli({"work", "--db", "c.db", "--max-jobs", "1", "--quiet"}, d.path);  // the bed (priority)

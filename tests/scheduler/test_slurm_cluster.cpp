@@ -107,7 +107,8 @@ TEST_F(ClusterFixture, ATinyImpactCampaignCompletesThroughSlurmWithATaskScancell
   const std::string mid_job =
       "SELECT substr(a.worker, strpos(a.worker, ':slurm=') + 7) || ' ' || a.job_id FROM attempts a JOIN jobs j ON "
       "j.job_id=a.job_id WHERE a.outcome='running' AND j.state='running' AND j.progress > 0.1 AND j.progress < 0.5 "
-      "AND a.worker LIKE '%:slurm=" + array + "%' ORDER BY j.progress LIMIT 1";
+      "AND a.worker LIKE '%:slurm=" +
+      array + "%' ORDER BY j.progress LIMIT 1";
   std::string found;
   for (const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(240);
        found.empty() && std::chrono::steady_clock::now() < end;)
@@ -125,8 +126,8 @@ TEST_F(ClusterFixture, ATinyImpactCampaignCompletesThroughSlurmWithATaskScancell
   // The other task finishes the campaign; the cancelled one gave its lease back on SIGTERM.
   EXPECT_TRUE(slurm->wait_idle(300)) << "tasks still queued or running: " << slurm->client("squeue");
   EXPECT_NO_FATAL_FAILURE(expect_complete_and_exact(db, 10, 8));
-  EXPECT_EQ(sql_text(db, "SELECT outcome FROM attempts WHERE job_id='" + victim_job + "' AND worker LIKE '%:slurm=" +
-                             victim + "'"),
+  EXPECT_EQ(sql_text(db, "SELECT outcome FROM attempts WHERE job_id='" + victim_job +
+                             "' AND worker LIKE '%:slurm=" + victim + "'"),
             "released")
       << "the scancelled worker's attempt";
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='lost'"), 0) << "no lease had to expire";
@@ -139,10 +140,11 @@ TEST_F(ClusterFixture, ATinyImpactCampaignCompletesThroughSlurmWithATaskScancell
 }
 
 TEST_F(ClusterFixture, SlurmCancelStopsEveryWorkerAndTheyGiveTheirLeasesBack) {
-  json doc = {{"sweep", "slurm_cancel"},
-              {"job", "noop"},
-              {"base", {{"g", 1.0}, {"sleep_s", 1.0}}},
-              {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 1}, {"stop", 20}, {"step", 1}}}}}}};
+  json doc = {
+      {"sweep", "slurm_cancel"},
+      {"job", "noop"},
+      {"base", {{"g", 1.0}, {"sleep_s", 1.0}}},
+      {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 1}, {"stop", 20}, {"step", 1}}}}}}};
   const std::string array = submit_with_workers(doc, 2);
   ASSERT_FALSE(array.empty());
   db::Database db(store.location);
@@ -172,15 +174,16 @@ TEST_F(ClusterFixture, SlurmCancelStopsEveryWorkerAndTheyGiveTheirLeasesBack) {
 TEST_F(ClusterFixture, ATaskKilledAtItsTimeLimitLosesNothing) {
   // One pilot worker with a 1 minute limit on 8 jobs of 15 s: Slurm stops it mid-job (SIGTERM,
   // then SIGKILL after KillWait); its job goes back to the queue and a later worker finishes it.
-  json doc = {{"sweep", "slurm_time"},
-              {"job", "noop"},
-              {"base", {{"g", 1.0}, {"sleep_s", 15.0}}},
-              {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 1}, {"stop", 8}, {"step", 1}}}}}}};
+  json doc = {
+      {"sweep", "slurm_time"},
+      {"job", "noop"},
+      {"base", {{"g", 1.0}, {"sleep_s", 15.0}}},
+      {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"range", {{"start", 1}, {"stop", 8}, {"step", 1}}}}}}};
   write_text(dir.path / "spec.json", doc.dump());
   ASSERT_EQ(run_cli(with_store({"submit", "spec.json"}), dir.path).code, 0);
-  auto r = run_cli(with_store({"slurm", "submit", "--workers", "1", "--threads", "1", "--time", "00:01:00", "--lease",
-                               "5"}),
-                   dir.path);
+  auto r =
+      run_cli(with_store({"slurm", "submit", "--workers", "1", "--threads", "1", "--time", "00:01:00", "--lease", "5"}),
+              dir.path);
   ASSERT_EQ(r.code, 0) << r.err;
   const auto at = r.out.find("job array ");
   ASSERT_NE(at, std::string::npos) << r.out;

@@ -9,7 +9,8 @@
 using namespace gravsweep;
 
 TEST(StopRequest, ARealSignalSetsTheOneFlagAndTheScopeRestoresThePreviousHandlers) {
-  struct sigaction ignore {}, before {}, after {};
+  struct sigaction ignore {
+  }, before{}, after{};
   ignore.sa_handler = SIG_IGN;
   sigemptyset(&ignore.sa_mask);
   sigaction(SIGTERM, &ignore, &before);

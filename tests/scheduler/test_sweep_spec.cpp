@@ -43,15 +43,16 @@ bool has_problem(const std::vector<SpecProblem>& ps, const std::string& ptr, con
 }  // namespace
 
 TEST(SweepSpec, ProductOfListsRangesZipsAndRepeats) {
-  const json doc = {{"sweep", "s"},
-                    {"base", kBase},
-                    {"axes",
-                     {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {9.81, 1.62}}},
-                      {{"name", "speed_m_s"}, {"pointer", "/speed_m_s"}, {"range", {{"start", 0.1}, {"stop", 0.3}, {"step", 0.1}}}},
-                      {{"zip",
-                        {{{"name", "fill_m"}, {"pointer", "/fill_m"}, {"values", {0.1, 0.21}}},
-                         {{"name", "dt_s"}, {"pointer", "/dt_s"}, {"values", {1e-5, 2e-5}}}}}}}},
-                    {"repeats", {{"pointer", "/seed"}, {"count", 3}, {"start", 1}}}};
+  const json doc = {
+      {"sweep", "s"},
+      {"base", kBase},
+      {"axes",
+       {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {9.81, 1.62}}},
+        {{"name", "speed_m_s"}, {"pointer", "/speed_m_s"}, {"range", {{"start", 0.1}, {"stop", 0.3}, {"step", 0.1}}}},
+        {{"zip",
+          {{{"name", "fill_m"}, {"pointer", "/fill_m"}, {"values", {0.1, 0.21}}},
+           {{"name", "dt_s"}, {"pointer", "/dt_s"}, {"values", {1e-5, 2e-5}}}}}}}},
+      {"repeats", {{"pointer", "/seed"}, {"count", 3}, {"start", 1}}}};
   const SweepSpec spec = parse(doc);
   EXPECT_EQ(spec.points(), 2u * 3u * 2u * 3u);
   // The range is 0.1, 0.2, 0.3 exactly as literals, not 0.30000000000000004.
@@ -95,7 +96,7 @@ TEST(SweepSpec, ExpansionIsDeterministicAndExtensionKeepsIds) {
   for (const auto& j : a) old_ids.insert(j.job_id);
   std::size_t fresh = 0;
   for (const auto& j : c) fresh += old_ids.count(j.job_id) == 0;
-  EXPECT_EQ(fresh, 2u);  // one new drop and its bed
+  EXPECT_EQ(fresh, 2u);                               // one new drop and its bed
   EXPECT_EQ(parse(doc).groups[0].axes[0].name, "g");  // name derived from the pointer
 }
 
@@ -134,13 +135,12 @@ TEST(SweepSpec, MalformedSpecNamesPointerValueAndExpectedType) {
 }
 
 TEST(SweepSpec, ZipLengthsAndDuplicatesAreRefused) {
-  const json doc = {{"sweep", "s"},
-                    {"base", kBase},
-                    {"axes",
-                     {{{"zip",
-                        {{{"pointer", "/fill_m"}, {"values", {0.1, 0.2}}},
-                         {{"pointer", "/dt_s"}, {"values", {1e-5}}}}}},
-                      {{"pointer", "/g"}, {"values", {1.0, 1}}}}}};
+  const json doc = {
+      {"sweep", "s"},
+      {"base", kBase},
+      {"axes",
+       {{{"zip", {{{"pointer", "/fill_m"}, {"values", {0.1, 0.2}}}, {{"pointer", "/dt_s"}, {"values", {1e-5}}}}}},
+        {{"pointer", "/g"}, {"values", {1.0, 1}}}}}};
   const auto ps = problems_of(doc);
   EXPECT_TRUE(has_problem(ps, "/axes/0/zip/1", "1 values", "2 values"));
   EXPECT_TRUE(has_problem(ps, "/axes/1/values/1", "1", "differ"));  // 1.0 and 1 are the same value

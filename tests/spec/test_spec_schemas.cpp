@@ -77,7 +77,7 @@ TEST(SpecSchemas, SweepSpecProblemsComeFromTheSchemaAtTheirPointers) {
     "max_attempts": 101, "priority": 1.5})");
   const auto ps = sweep_problems(doc);
   EXPECT_TRUE(has(ps, "/axes/0/range/step", "a positive number"));
-  EXPECT_TRUE(has(ps, "/axes/1/name", "none of"));            // a fixed results column
+  EXPECT_TRUE(has(ps, "/axes/1/name", "none of"));                       // a fixed results column
   EXPECT_TRUE(has(ps, "/axes/2/values/1", "repeats an earlier value"));  // 1 and 1.0
   EXPECT_TRUE(has(ps, "/axes/3/zip", "at least two axes"));
   EXPECT_TRUE(has(ps, "/repeats/count", "between 1 and 1000000"));

@@ -46,8 +46,8 @@ TEST(Failure, OverlapWithAWallNamesTheWall) {
     }
     System s(cfg);
     s.walls.push_back(Wall::plane("floor", Vec3(0, 0, 0), Vec3(0, 0, 1), 1));
-    s.particles.add(Vec3(0.1, 0, 0.01), 0.005, 1.3e-3, 0, SizeClass::grain);     // clear of the floor
-    s.particles.add(Vec3(0, 0, 0.002), 0.005, 1.3e-3, 0, SizeClass::grain);      // 60 % into it
+    s.particles.add(Vec3(0.1, 0, 0.01), 0.005, 1.3e-3, 0, SizeClass::grain);  // clear of the floor
+    s.particles.add(Vec3(0, 0, 0.002), 0.005, 1.3e-3, 0, SizeClass::grain);   // 60 % into it
     try {
       s.step();
       ADD_FAILURE() << law << ": expected NumericalFailure";

@@ -30,8 +30,7 @@ double rel(const Vec3& a, const Vec3& b, double floor) {
 
 template <class Rolling>
 void compare(bool rolling) {
-  PairCoefficients pc = compose_pair(chrono_table1_config().materials[0],
-                                     chrono_table1_config().materials[0], nullptr);
+  PairCoefficients pc = compose_pair(chrono_table1_config().materials[0], chrono_table1_config().materials[0], nullptr);
   pc.mu_rolling = 0.09;
   pc.mu_twisting = 0.05;
   HertzChrono::prepare(pc);
@@ -79,8 +78,10 @@ void compare(bool rolling) {
       g.wall = false;
       batch.add(b, 0, 1, d, d.squaredNorm(), r1, r2, m_eff, v1, v2, w1, w2, pc, h);
     }
-    if (rolling) batch.compute<true>(opt, dt);
-    else batch.compute<false>(opt, dt);
+    if (rolling)
+      batch.compute<true>(opt, dt);
+    else
+      batch.compute<false>(opt, dt);
     for (int b = 0; b < HertzBatch::kSize; ++b) {
       Case& cs = cases[b];
       fresh += !cs.h.active;
@@ -105,7 +106,8 @@ void compare(bool rolling) {
       const Vec3 tang = out.force_on_2 - out.force_on_2.dot(cs.g.n) * cs.g.n;
       slipping += tang.norm() >= pc.mu_static * std::abs(out.normal_force_N) * (1 - 1e-9);
       gated += cs.h.duration_s <= cs.h.gate_s;
-      rolling_on += cs.h.duration_s > cs.h.gate_s && (out.torque_1 - cs.g.r1_m * cs.g.n.cross(-out.force_on_2)).norm() > 0;
+      rolling_on +=
+          cs.h.duration_s > cs.h.gate_s && (out.torque_1 - cs.g.r1_m * cs.g.n.cross(-out.force_on_2)).norm() > 0;
       slow += cs.g.v1.norm() < 1e-5;
     }
   }
@@ -121,13 +123,9 @@ void compare(bool rolling) {
 
 }  // namespace
 
-TEST(HertzBatch, MatchesScalarKernelWithSundayRolling) {
-  EXPECT_NO_FATAL_FAILURE(compare<RollingSunday>(true));
-}
+TEST(HertzBatch, MatchesScalarKernelWithSundayRolling) { EXPECT_NO_FATAL_FAILURE(compare<RollingSunday>(true)); }
 
-TEST(HertzBatch, MatchesScalarKernelWithoutRolling) {
-  EXPECT_NO_FATAL_FAILURE(compare<RollingNone>(false));
-}
+TEST(HertzBatch, MatchesScalarKernelWithoutRolling) { EXPECT_NO_FATAL_FAILURE(compare<RollingNone>(false)); }
 
 TEST(HertzBatch, CoversThePaperModels) {
   EXPECT_TRUE((kHasHertzBatch<HertzChrono, RollingSunday>));

@@ -55,7 +55,8 @@ TEST(VerletList, HistorySurvivesRebuild) {
   const auto before = listed(l);
   std::map<std::pair<std::uint32_t, std::uint32_t>, double> dur;
   for (std::size_t i = 0; i + 1 < l.offset.size(); ++i)
-    for (auto k = l.offset[i]; k < l.offset[i + 1]; ++k) dur[{static_cast<std::uint32_t>(i), l.neighbor[k]}] = l.history[k].duration_s;
+    for (auto k = l.offset[i]; k < l.offset[i + 1]; ++k)
+      dur[{static_cast<std::uint32_t>(i), l.neighbor[k]}] = l.history[k].duration_s;
   p.position_m[5] += Vec3(0.01, 0, 0);  // move one grain: some pairs change
   EXPECT_TRUE(l.needs_rebuild(p));
   l.build(p, 0.001, 2);

@@ -14,9 +14,7 @@ TermInfo bottom_stiffening_term() {
   t.signature = "negative residual growing as z -> H_fill; vanishes in deep beds";
   t.params = {"Fb_N"};
   t.per_gravity = true;
-  t.features = [](const TermContext& c, double* out) {
-    out[0] = std::exp(-(c.fill_height_m - c.z_m) / 0.01);
-  };
+  t.features = [](const TermContext& c, double* out) { out[0] = std::exp(-(c.fill_height_m - c.z_m) / 0.01); };
   t.typical = [](double g, double m, double) { return std::vector<double>{8.0 * m * g}; };
   return t;
 }

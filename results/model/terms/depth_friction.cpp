@@ -8,8 +8,9 @@ TermInfo depth_friction_term() {
   TermInfo t;
   t.name = "depth_friction";
   t.meaning = "quasi-static friction growing linearly with depth (hydrostatic-like pressure)";
-  t.references = "Katsuragi & Durian 2007 Nat. Phys. 3:420; Tsimring & Volfson 2005; "
-                 "Brzinski, Mayor & Durian 2013 PRL 111:168002";
+  t.references =
+      "Katsuragi & Durian 2007 Nat. Phys. 3:420; Tsimring & Volfson 2005; "
+      "Brzinski, Mayor & Durian 2013 PRL 111:168002";
   t.signature = "residual ~ -z, independent of v; f0 fitted per trial grows with impact speed";
   t.params = {"k_N_m"};
   t.per_gravity = true;

@@ -21,10 +21,10 @@ const TermInfo& find_term(const std::string& name) {
     known += (known.empty() ? "" : ", ") + t.name;
   }
   if (const TermInfo* g = generated_term(name)) return *g;
-  throw std::invalid_argument(fmt::format(
-      "unknown model term '{}' (known: {}; or a generated form such as z^1*v^1, exp(-z/0.01), "
-      "(1-exp(-z/0.01)), v^2*exp(-z/0.02))",
-      name, known));
+  throw std::invalid_argument(
+      fmt::format("unknown model term '{}' (known: {}; or a generated form such as z^1*v^1, exp(-z/0.01), "
+                  "(1-exp(-z/0.01)), v^2*exp(-z/0.02))",
+                  name, known));
 }
 
 }  // namespace gravsweep::results
