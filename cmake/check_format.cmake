@@ -1,0 +1,31 @@
+# The house style (.clang-format at the root) holds in every C++ source of the tree: run as a script
+# (cmake -DROOT=<dir> -P check_format.cmake) from CTest (Format.SourcesFollowClangFormat). Fails
+# naming each file that clang-format would change, and the command that fixes them all.
+if(NOT DEFINED ROOT)
+  message(FATAL_ERROR "check_format: pass -DROOT=<source dir>")
+endif()
+find_program(CLANG_FORMAT clang-format)
+if(NOT CLANG_FORMAT)
+  message(FATAL_ERROR "check_format: clang-format not found (deploy/debian-packages.txt lists it; run deploy/install-deps.sh)")
+endif()
+set(files "")
+foreach(folder db engine spec results scheduler tests)
+  file(GLOB_RECURSE found "${ROOT}/${folder}/*.h" "${ROOT}/${folder}/*.cpp")
+  list(APPEND files ${found})
+endforeach()
+set(bad "")
+set(count 0)
+foreach(f IN LISTS files)
+  math(EXPR count "${count} + 1")
+  execute_process(COMMAND ${CLANG_FORMAT} --dry-run --Werror --style=file ${f}
+                  RESULT_VARIABLE rc OUTPUT_QUIET ERROR_QUIET)
+  if(NOT rc EQUAL 0)
+    file(RELATIVE_PATH rel "${ROOT}" "${f}")
+    string(APPEND bad "\n  ${rel}")
+  endif()
+endforeach()
+if(bad)
+  message(FATAL_ERROR "format: these files differ from .clang-format:${bad}\n"
+          "fix: git ls-files '*.h' '*.cpp' | xargs clang-format -i")
+endif()
+message(STATUS "format: ${count} files follow .clang-format")
