@@ -20,6 +20,35 @@ double grain_kinetic_energy_J(const System& sys) {
   return e;
 }
 
+std::size_t remove_spilled_grains(System& sys, ParticleIndex& projectile) {
+  const auto& p = sys.particles;
+  std::vector<bool> spilled;
+  std::size_t n = 0, before_projectile = 0;
+  for (const Wall& w : sys.walls) {
+    if (w.kind != WallKind::cylinder || !std::isfinite(w.height_m)) continue;
+    const Vec3 axis = w.normal.normalized();
+    const double top_m = w.height_m;  // along the axis, from point_m
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (p.size_class[i] != SizeClass::grain || p.inv_mass_1_kg[i] == 0) continue;
+      const Vec3 rel = p.position_m[i] - w.point_m;
+      const double along_m = rel.dot(axis);
+      const Vec3 radial = rel - along_m * axis;
+      const double r = p.radius_m[i];
+      // Wholly above the rim, beyond the wall's radius less its own, moving outward.
+      if (along_m - r <= top_m || radial.norm() <= w.radius_m - r || p.velocity_m_s[i].dot(radial) <= 0) continue;
+      if (spilled.empty()) spilled.assign(p.size(), false);
+      if (spilled[i]) continue;
+      spilled[i] = true;
+      ++n;
+      if (i < projectile) ++before_projectile;
+    }
+  }
+  if (n == 0) return 0;
+  sys.remove_particles(spilled);  // keeps the order and the contact histories of the others
+  projectile -= static_cast<ParticleIndex>(before_projectile);
+  return n;
+}
+
 std::optional<FirstTouch> first_touch_bottom(const System& sys, double x_m, double y_m, double radius_m) {
   const auto& p = sys.particles;
   std::optional<FirstTouch> best;
@@ -85,7 +114,7 @@ DropResult drop_projectile(System& sys, double surface_height_m, const Projectil
     SystemConfig& cfg = sys.mutable_config();
     if (cfg.domain) cfg.domain->hi_m.z() = std::max(cfg.domain->hi_m.z(), centre.z() + 2 * R);
   }
-  const ParticleIndex ip = sys.particles.add(centre, R, ps.mass_kg, ps.material, SizeClass::projectile);
+  ParticleIndex ip = sys.particles.add(centre, R, ps.mass_kg, ps.material, SizeClass::projectile);
   sys.particles.set_velocity(ip, Vec3(0, 0, -v0));
   sys.invalidate();
   sys.initialize();
@@ -133,6 +162,8 @@ DropResult drop_projectile(System& sys, double surface_height_m, const Projectil
   for (long long k = 1; k <= max_samples; ++k) {
     const double vz_before = sys.particles.velocity_m_s[ip].z();
     sys.advance(steps_per_sample);
+    res.grains_spilled += remove_spilled_grains(sys, ip);
+    res.projectile = ip;
     const double vz_after = sys.particles.velocity_m_s[ip].z();
     const DropSample s = sample((vz_after - vz_before) / sample_dt);
     k_done = k;

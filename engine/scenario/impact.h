@@ -63,8 +63,19 @@ struct DropResult {
   bool stopped = false;          ///< stop criterion met (false: the time cap ended the run)
   std::optional<double> rest_s;  ///< start of the hold window that met the stop criterion
   long long steps = 0;
-  ParticleIndex projectile = 0;
+  ParticleIndex projectile = 0;  ///< its index at the end (grains removed before it shift it down)
+  /// Grains that went over the container's rim and were removed (remove_spilled_grains): low-gravity
+  /// ejecta; 0 at 1 g in the paper's beds.
+  std::size_t grains_spilled = 0;
 };
+
+/// Removes the grains that went over the rim of a container wall (a cylinder of finite height):
+/// wholly above its top, centred beyond its radius less their own, moving outward. Nothing brings
+/// them back (the paper's Chrono runs have no domain: such grains fly on), so they are taken out
+/// rather than ending a low-gravity drop with "left the container" when they cross the domain's
+/// side. Contact histories of the other particles are kept; `projectile` follows the renumbering.
+/// Returns how many were removed (checked once per output sample by drop_projectile).
+std::size_t remove_spilled_grains(System& sys, ParticleIndex& projectile);
 
 /// The grain a sphere of radius_m falling straight down along (x_m, y_m) touches first, and the
 /// engine z of the sphere's bottom at that moment; nothing when no grain lies under it.

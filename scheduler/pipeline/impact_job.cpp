@@ -299,6 +299,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   m["final_depth_m"] = td.depth_m.empty() ? 0.0 : td.depth_m.back();
   m["first_contact_s"] = dr.first_contact_s ? json(*dr.first_contact_s) : json(nullptr);
   m["stopped"] = dr.stopped;
+  m["grains_spilled_over_rim"] = dr.grains_spilled;  // low-gravity ejecta removed (impact.h)
   // Sect. 2.2's stop criterion (speed < stop.speed_m_s after contact): when the projectile came to
   // rest, and how long after the collision start (a DEM-side duration next to the paper's tstop).
   m["rest_time_s"] = dr.rest_s ? json(*dr.rest_s) : json(nullptr);

@@ -132,6 +132,36 @@ TEST(Drop, StartGapIsMeasuredFromTheGrainUnderTheFootprint) {
   EXPECT_NEAR(res.samples[k - 1].velocity_down_m_s, 0.3, 2e-3);
 }
 
+// Issue #11 (part 2, 0.1 m/s2 at 1.2 m/s): an ejected grain flew over the 0.3 m wall and the drop
+// died with "left the container" when it crossed the domain's side. A grain over the rim, moving
+// out, is removed instead; the projectile's index follows; grains still inside are kept.
+TEST(Drop, AGrainThatGoesOverTheRimIsRemovedNotAFailure) {
+  EmptyContainer c(0.1);  // container radius 0.1 m, wall 0.3 m high
+  const double r = 0.005;
+  const double m = sphere_mass_kg(2480, 2 * r);
+  // Over the rim, moving out: it crosses the domain's side (x = 0.1 m) within a few ms.
+  const ParticleIndex out = c.sys.particles.add(Vec3(0.097, 0, 0.32), r, m, kGrainMaterial, SizeClass::grain);
+  c.sys.particles.set_velocity(out, Vec3(0.8, 0, 0.5));
+  // Above the rim but moving inward, and one inside on the floor: both stay.
+  const ParticleIndex in = c.sys.particles.add(Vec3(0.097, 0.0, 0.33), r, m, kGrainMaterial, SizeClass::grain);
+  c.sys.particles.set_velocity(in, Vec3(-0.5, 0, 0.2));
+  c.sys.particles.add(Vec3(-0.08, 0.0, r), r, m, kGrainMaterial, SizeClass::grain);  // out of the footprint
+  ProjectileSpec p;
+  p.impact_speed_m_s = 0.2;
+  p.start_gap_m = 0.01;
+  DropStop stop;
+  stop.max_time_s = 0.3;
+  DropResult res;
+  ASSERT_NO_THROW(res = drop_projectile(c.sys, 0.05, p, stop, 1e4));
+  EXPECT_EQ(res.grains_spilled, 1u);
+  EXPECT_EQ(c.sys.particles.size(), 3u);  // two grains and the projectile
+  EXPECT_EQ(res.projectile, 2u);          // was 3: the removed grain came before it
+  EXPECT_EQ(c.sys.particles.size_class[res.projectile], SizeClass::projectile);
+  EXPECT_NEAR(c.sys.particles.radius_m[res.projectile], 0.05, 1e-15);
+  // The samples after the removal still follow the projectile (free fall at -g until contact).
+  EXPECT_NEAR(res.samples[50].accel_up_m_s2, -0.1, 1e-9);
+}
+
 TEST(Drop, AReleaseThatOverlapsAGrainIsRefused) {
   EmptyContainer c(9.81);
   const double r = 0.005;
