@@ -14,28 +14,6 @@ using nlohmann::json;
 
 namespace {
 
-std::string type_name(const json& v) {
-  switch (v.type()) {
-    case json::value_t::null:
-      return "null";
-    case json::value_t::boolean:
-      return "boolean";
-    case json::value_t::number_integer:
-    case json::value_t::number_unsigned:
-      return "integer";
-    case json::value_t::number_float:
-      return "number";
-    case json::value_t::string:
-      return "string";
-    case json::value_t::array:
-      return "array";
-    case json::value_t::object:
-      return "object";
-    default:
-      return "value";
-  }
-}
-
 std::string joined(const std::vector<std::string>& items, const char* separator = ", ") {
   std::string out;
   for (const auto& i : items) out += (out.empty() ? "" : separator) + i;
@@ -151,6 +129,28 @@ SpecError SpecError::sweep_spec(std::string file, std::vector<SpecProblem> probl
 SpecError::SpecError(Message message, std::string source, std::vector<SpecProblem> problems)
     : ConfigError(std::move(message.text)), source_(std::move(source)), problems_(std::move(problems)) {
   if (problems_.empty()) throw std::logic_error("SpecError without a problem");
+}
+
+std::string type_name(const json& v) {
+  switch (v.type()) {
+    case json::value_t::null:
+      return "null";
+    case json::value_t::boolean:
+      return "boolean";
+    case json::value_t::number_integer:
+    case json::value_t::number_unsigned:
+      return "integer";
+    case json::value_t::number_float:
+      return "number";
+    case json::value_t::string:
+      return "string";
+    case json::value_t::array:
+      return "array";
+    case json::value_t::object:
+      return "object";
+    default:
+      return "value";
+  }
 }
 
 std::string shown_value(const json& v) {

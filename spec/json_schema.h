@@ -55,6 +55,9 @@ class SpecError : public ConfigError {
   std::vector<SpecProblem> problems_;
 };
 
+/// The JSON type of `v` as messages name it: null, boolean, integer, number, string, array, object.
+std::string type_name(const nlohmann::json& v);
+
 /// `v` as a problem shows it: compact JSON (cut at 80 characters) and its JSON type, `"1.62" (string)`.
 std::string shown_value(const nlohmann::json& v);
 

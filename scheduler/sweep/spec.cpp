@@ -73,23 +73,9 @@ std::vector<SpecProblem> noop_problems(const json& s, const std::string& ptr) {
   return out;
 }
 
-std::string value_kind(const json& v) {
-  if (v.is_number()) return "number";  // numbers are numbers: 10 and 9.81 are both numbers
-  switch (v.type()) {
-    case json::value_t::null:
-      return "null";
-    case json::value_t::boolean:
-      return "boolean";
-    case json::value_t::string:
-      return "string";
-    case json::value_t::array:
-      return "array";
-    case json::value_t::object:
-      return "object";
-    default:
-      return "value";
-  }
-}
+/// The kind a swept value must share with the base field: its JSON type, numbers all alike (10 and
+/// 9.81 are both numbers).
+std::string value_kind(const json& v) { return v.is_number() ? "number" : spec::type_name(v); }
 
 /// The field an axis sets, looked up in the base; nullptr (reported) when it is not there.
 const json* base_field(const json& a, const std::string& ptr, const json* base, Checker& ck) {
