@@ -163,6 +163,22 @@ bool structured(const std::vector<AxisResidual>& axes, std::string& where) {
   return true;
 }
 
+/// The state axis (depth, speed, time since contact) whose within-trial residual slope has the same
+/// sign in the most trials, when the sign test says p < kConsistentTrendP; empty otherwise.
+std::string consistent_trend(const std::vector<AxisResidual>& axes) {
+  const AxisResidual* best = nullptr;
+  for (const auto& a : axes)
+    if ((a.axis == "depth_m" || a.axis == "speed_m_s" || a.axis == "time_since_contact_s") &&
+        a.slope_sign_trials_p < kConsistentTrendP && (!best || a.slope_sign_trials_p < best->slope_sign_trials_p))
+      best = &a;
+  if (!best) return "";
+  const bool up = best->trials_positive >= best->trials_negative;
+  return fmt::format(
+      "along {}: the residual {} with it in {} of {} trials (sign test p = {:.2g}), but weakly (eta^2 = {:.3f})",
+      best->axis, up ? "grows" : "falls", up ? best->trials_positive : best->trials_negative,
+      best->trials_positive + best->trials_negative, best->slope_sign_trials_p, best->eta2);
+}
+
 /// The state axis (depth, speed, time since contact) along which the residual varies most.
 std::string strongest_axis(const std::vector<AxisResidual>& axes) {
   const AxisResidual* best = nullptr;
@@ -227,9 +243,15 @@ std::string improvement_words(const Candidate& cd) {
 std::string verdict_of(const Discovery& d, const std::string& where_named, const std::string& where_generated) {
   std::string v;
   if (d.added.empty()) {
-    if (!d.structure_left)
+    if (!d.structure_left && d.consistent_trend.empty())
       return "no missing effect found: no candidate term improves the held-out trials significantly and the "
              "residuals show no structure";
+    if (!d.structure_left)
+      return "no missing effect found: no candidate term improves the held-out trials significantly" +
+             std::string(d.generated_searched ? ", nor a form of the generated family" : "") +
+             "; the residuals trend consistently " + d.consistent_trend +
+             ": a term that helps some trials hurts others held out (different regimes? rank each gravity level "
+             "or speed range with --where)";
     v = "structure left that no named term explains, " + where_named;
   } else {
     const auto& first = d.rounds.front().front();
@@ -296,10 +318,11 @@ Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds, doub
   d.residual_after = residual_axes(named_fit, c);
   std::string where_named, where_generated;
   d.structure_left = structured(d.residual_after, where_named);
+  d.consistent_trend = consistent_trend(d.residual_after);
   // The residuals of the named winners are tested again by the held-out test itself: a form of the
   // generated family that improves them significantly (Bonferroni over the family) is structure the
   // named terms left, even where the binned axes alone do not show it (issue 13 item 3).
-  if (search_generated && (d.structure_left || !d.added.empty())) {
+  if (search_generated && (d.structure_left || !d.added.empty() || !d.consistent_trend.empty())) {
     const detail::GeneratedSearch g = detail::search_generated(current, c, folds, alpha, min_improvement);
     d.generated_searched = true;
     d.generated_test = g.test;

@@ -94,11 +94,32 @@ TEST(Reproduction, ChronoLowGTable3WithTheRepeats) {
       "'" + dataset("chrono_1g") + "' '" + dataset("chrono_0.1g") + "' '" + dataset("chrono_0.1g_repeats") + "'";
   const auto low = table3_row(all, 0.1), one = table3_row(all, 9.81);
   ASSERT_EQ(low.count("inv_d1_1_m"), 1u);
-  EXPECT_GE(low.at("trials"), 14);
+  EXPECT_EQ(low.at("trials"), 21) << "seven speeds, three repeats (part 2 complete)";
   EXPECT_NEAR(low.at("inv_d1_1_m"), 39, 5) << "inside the paper's 39 +/- 5 1/m";
+  EXPECT_NEAR(low.at("inv_d1_1_m"), 39.2, 2.4) << "ours, REPRODUCTION.md (2 standard errors)";
   EXPECT_NEAR(low.at("f0_N"), 0.2, 2) << "inside the paper's 0.2 +/- 2 N";
-  EXPECT_NEAR(low.at("alpha"), 0.330, 0.022) << "ours, REPRODUCTION.md (2 standard errors)";
+  EXPECT_NEAR(low.at("alpha"), 0.319, 0.017) << "ours, REPRODUCTION.md (2 standard errors)";
   EXPECT_LT(low.at("alpha"), one.at("alpha")) << "the paper: alpha lower at 0.1 m/s2 than at 1 g";
+}
+
+// Beyond the paper, on the whole Chrono campaign (both levels, 42 drops; REPRODUCTION.md): no named
+// term helps held out on both levels at once, and the search beyond the library finds a depth
+// resistance that saturates over a few centimetres, with the depth and duration errors falling.
+TEST(Reproduction, ModelRankOnTheWholeChronoCampaignFindsASaturatingDepthResistance) {
+  const std::string all =
+      "'" + dataset("chrono_1g") + "' '" + dataset("chrono_0.1g") + "' '" + dataset("chrono_0.1g_repeats") + "'";
+  const auto r = gravsweep::testing::run_gravsweep("model rank " + all, true);
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("Verdict: structure left that no named term explains"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("a generated form fits it: c * (1-exp(-z/0.04))"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("zstop 38.3 -> 18.3 %"), std::string::npos) << r.out;
+  // Each level alone: depth friction at 1 g (the test above), nothing named at 0.1 m/s2, where the
+  // residuals still trend consistently with time (said, not hidden as "no structure").
+  const auto low = gravsweep::testing::run_gravsweep(
+      "model rank '" + dataset("chrono_0.1g") + "' '" + dataset("chrono_0.1g_repeats") + "'", true);
+  ASSERT_EQ(low.code, 0) << low.out;
+  EXPECT_NE(low.out.find("Verdict: no missing effect found"), std::string::npos) << low.out;
+  EXPECT_NE(low.out.find("the residuals trend consistently along"), std::string::npos) << low.out;
 }
 
 // Beyond the paper (REPRODUCTION.md): `model rank` on both gravity levels finds paper II's two
