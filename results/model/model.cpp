@@ -16,6 +16,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "spec/json_text.h"
 #include "spec/schemas.h"
 
 namespace gravsweep::results {
@@ -43,13 +44,12 @@ namespace {
 /// looked up: a generated form's numbers must be in range). Throws spec::SpecError naming the file
 /// and the JSON pointer of every problem.
 std::vector<ModelTerm> model_file_terms(const std::string& file) {
-  std::ifstream in(file);
+  std::string why;
+  const auto text = spec::read_text_file(file, why);
+  if (!text) throw spec::SpecError(file, "", why, "a readable model spec file");
   nlohmann::json j;
-  try {
-    in >> j;
-  } catch (const nlohmann::json::parse_error& e) {
-    throw spec::SpecError(file, "", "not valid JSON", e.what());
-  }
+  if (const auto err = spec::parse_json_text(*text, j))
+    throw ConfigError(fmt::format("{}:{}:{}: not valid JSON: {}", file, err->line, err->column, err->what));
   std::vector<spec::SpecProblem> problems;
   spec::validator(spec::Schema::model).collect(j, problems);
   if (!problems.empty()) throw spec::SpecError(file, std::move(problems));

@@ -1,6 +1,6 @@
 #include "scheduler/pipeline/scenario_spec.h"
 
-#include "scheduler/sweep/json_text.h"
+#include "spec/json_text.h"
 
 #include <fmt/format.h>
 
@@ -336,10 +336,10 @@ json validate_scenario(const json& scenario, const std::string& source) {
 
 json load_scenario(const std::filesystem::path& path) {
   std::string why;
-  const auto text = sweep::read_text_file(path, why);
+  const auto text = spec::read_text_file(path, why);
   if (!text) throw ConfigError(fmt::format("{}: cannot read the scenario file ({})", path.string(), why));
   json j;
-  if (const auto err = sweep::parse_json_text(*text, j))
+  if (const auto err = spec::parse_json_text(*text, j))
     throw ConfigError(fmt::format("{}:{}:{}: not valid JSON: {}", path.string(), err->line, err->column, err->what));
   return validate_scenario(j, path.string());
 }

@@ -1,6 +1,6 @@
 #include "scheduler/sweep/spec.h"
 
-#include "scheduler/sweep/json_text.h"
+#include "spec/json_text.h"
 
 #include <fmt/format.h>
 
@@ -217,11 +217,11 @@ std::optional<json> read_base(const json& doc, const std::filesystem::path& base
   if (doc["base"].is_object()) return doc["base"];
   const std::filesystem::path p = base_dir / doc["base"].get<std::string>();
   std::string why;
-  const auto text = read_text_file(p, why);
+  const auto text = spec::read_text_file(p, why);
   json base;
   if (!text) {
     ck.add("/base", &doc["base"], fmt::format("a readable scenario file ('{}' is {})", p.string(), why));
-  } else if (const auto err = parse_json_text(*text, base)) {
+  } else if (const auto err = spec::parse_json_text(*text, base)) {
     ck.add("/base", &doc["base"],
            fmt::format("a JSON scenario file ('{}': {} at {})", p.string(), err->what, err->where()));
   } else if (!base.is_object()) {
@@ -338,10 +338,10 @@ SweepSpec parse_spec(const json& doc_in, const std::string& file, const std::fil
 
 SweepSpec load_spec(const std::filesystem::path& path) {
   std::string why;
-  const auto text = read_text_file(path, why);
+  const auto text = spec::read_text_file(path, why);
   if (!text) throw SpecError::sweep_spec(path.string(), {{"", why, "a JSON sweep spec file"}});
   json doc;
-  if (const auto err = parse_json_text(*text, doc))
+  if (const auto err = spec::parse_json_text(*text, doc))
     throw SpecError::sweep_spec(path.string(), {{"", fmt::format("{} at {}", err->what, err->where()), "valid JSON"}});
   return parse_spec(doc, path.string(), path.parent_path());
 }

@@ -130,3 +130,16 @@ TEST(SpecSchemas, AModelFileIsCheckedByItsSchemaEveryProblemWithItsPointer) {
     EXPECT_EQ(e.pointer(), "/terms/0/name") << e.what();
   }
 }
+
+TEST(SpecSchemas, AModelFileWithBadJsonNamesItsLineAndColumn) {
+  // Model files are read like scenario and sweep specs (spec/json_text.h): file:line:column.
+  test::TempDir d;
+  const fs::path f = d.path / "model.json";
+  std::ofstream(f) << "{\"terms\": [\n  {\"name\": \"base\"},\n  {\"name\": }\n]}\n";
+  try {
+    results::parse_model(f.string());
+    FAIL() << "bad JSON accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find(f.string() + ":3:"), std::string::npos) << e.what();
+  }
+}

@@ -1,4 +1,4 @@
-// Reading JSON text users wrote (sweep specs, scenarios): bounded nesting depth, every error with
+// Reading JSON text users wrote (sweep, scenario and model specs): bounded nesting depth, every error with
 // its line and column, numbers out of double range and unreadable files (a folder) refused.
 #pragma once
 #include <nlohmann/json.hpp>
@@ -7,7 +7,7 @@
 #include <optional>
 #include <string>
 
-namespace gravsweep::sweep {
+namespace gravsweep::spec {
 
 inline constexpr std::size_t kMaxJsonDepth = 64;  ///< arrays/objects nested deeper are refused
 
@@ -24,4 +24,4 @@ std::optional<JsonTextError> parse_json_text(const std::string& text, nlohmann::
 /// Reads a whole file; nullopt (and `why`) when it is missing, a folder or unreadable.
 std::optional<std::string> read_text_file(const std::filesystem::path& path, std::string& why);
 
-}  // namespace gravsweep::sweep
+}  // namespace gravsweep::spec

@@ -1,11 +1,11 @@
-#include "scheduler/sweep/json_text.h"
+#include "spec/json_text.h"
 
 #include <fmt/format.h>
 
 #include <fstream>
 #include <sstream>
 
-namespace gravsweep::sweep {
+namespace gravsweep::spec {
 
 namespace {
 
@@ -90,4 +90,4 @@ std::optional<std::string> read_text_file(const std::filesystem::path& path, std
   return ss.str();
 }
 
-}  // namespace gravsweep::sweep
+}  // namespace gravsweep::spec
