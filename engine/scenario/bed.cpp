@@ -44,7 +44,7 @@ std::size_t place_grains(System& sys, const BedSpec& spec) {
       static_cast<std::size_t>(std::ceil(spec.overfill_factor * spec.packing_fraction * bed_volume / grain_volume));
   std::mt19937_64 rng(spec.seed);
   std::uniform_real_distribution<double> uni(-1.0, 1.0);
-  const double spacing = 1.04 * d_max;
+  const double spacing = spec.placement_spacing_diameters * d_max;
   const double jitter = 0.5 * (spacing - d_max) * 0.9;
   // Triangular lattice in each layer, layers offset; stop when the target count is reached.
   const double row = spacing * std::sqrt(3.0) / 2;
@@ -73,6 +73,21 @@ std::size_t place_grains(System& sys, const BedSpec& spec) {
   }
   sys.invalidate();
   return placed;
+}
+
+double core_packing_fraction(const Particles& p, double core_radius_m, double z_lo_m, double z_hi_m) {
+  double v_m3 = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.size_class[i] != SizeClass::grain) continue;
+    const Vec3& x = p.position_m[i];
+    if (std::hypot(x.x(), x.y()) >= core_radius_m) continue;
+    const double r = p.radius_m[i];
+    // Volume of the sphere between a and b (relative to its centre): pi (r^2 u - u^3 / 3) from a to b.
+    const double a = std::clamp(z_lo_m - x.z(), -r, r), b = std::clamp(z_hi_m - x.z(), -r, r);
+    auto F = [r](double u) { return r * r * u - u * u * u / 3; };
+    v_m3 += kPi * (F(b) - F(a));
+  }
+  return v_m3 / (kPi * core_radius_m * core_radius_m * (z_hi_m - z_lo_m));
 }
 
 void grain_speeds(const System& sys, double& rms_m_s, double& max_m_s) {

@@ -372,13 +372,16 @@ void setup_model(CLI::App& app) {
       "a Wilcoxon signed-rank test over trials (not samples), Bonferroni over candidates. Adds the winner and\n"
       "repeats while a term is significant, then says which effect is missing, 'no missing\n"
       "effect found', 'partly explained by X; structure left along <axis>', or 'structure left\n"
-      "that no named term explains' with where it lies. When structure is left, the same test runs\n"
+      "that no named term explains' with where it lies. When a term was added, structure is left, or\n"
+      "the residual's within-trial slope has the same sign in nearly every trial (sign test p < 1e-6,\n"
+      "however weak: 'the residuals trend consistently along <axis>'), the same test runs\n"
       "over a generated family of forms (z^a |v|^b, exp(-z/l), 1-exp(-z/l) and their products with\n"
       "z, |v|, v^2; each per gravity level or shared) and a significant one is reported by its\n"
       "formula, never by a physical name, with the held-out errors without and with it; fit it\n"
       "like a named term: --model 'base+z^1*v^1'.\n\n"
       "Examples:\n  gravsweep model rank ../shared/data/measurements/depth-friction-dev\n"
-      "  gravsweep model rank campaign.db          # the drops of `gravsweep submit` + `work`");
+      "  gravsweep model rank campaign.db          # the drops of `gravsweep submit` + `work`\n"
+      "  gravsweep model rank data/reproduction/chrono_1g --where 'impact_velocity_m_s<0.5'  # one regime");
   rank->alias("discover");
   rank->add_option("dir", orank->dir, kDirHelp)->required();
   rank->add_option("--where", orank->where, kWhereHelp);

@@ -366,6 +366,8 @@ ScenarioParams scenario_params(const json& s) {
   const json& bj = s.at("bed");
   b.overfill_factor = bj.at("overfill_factor");
   b.packing_fraction = bj.at("packing_fraction");
+  // Optional and without a default, so that the bed keys of beds placed on the default lattice stay.
+  b.placement_spacing_diameters = bj.value("placement_spacing_diameters", kLatticeSpacingDiameters);
   b.seed = bj.at("seed").get<std::uint64_t>();
   b.settle.rms_speed_m_s = bj["/settle/rms_speed_m_s"_json_pointer];
   b.settle.max_speed_m_s = bj["/settle/max_speed_m_s"_json_pointer];
