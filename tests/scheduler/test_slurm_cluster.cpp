@@ -83,13 +83,15 @@ struct ClusterFixture : ::testing::Test {
 }  // namespace
 
 TEST_F(ClusterFixture, ATinyImpactCampaignCompletesThroughSlurmWithATaskScancelledMidJob) {
-  // 2 beds and 8 drops (4 speeds per bed, 4 s simulated: 4-12 s each), 2 pilot workers of 1
-  // thread (this machine's cores). A drop must outlast the heartbeat (progress every 1.25 s with --lease 5), or
-  // no progress between 5 and 70 % is ever written: with 1 s simulated a fast machine finished each
-  // drop in about 1 s and the test saw no task mid-job (2026-12-02).
+  // 2 beds and 8 drops (4 speeds per bed, 6 s simulated: 3-18 s each), 2 pilot workers of 1 thread
+  // (this machine's cores). Progress is written at each heartbeat (1.25 s with --lease 5), so the
+  // value read may be that old: a drop must outlast the heartbeat by far, and the window read (5-40 %)
+  // must end well before the drop does. Seen on 2026-12-02: with 1 s simulated no task was ever seen
+  // mid-job (each drop took about 1 s); with 4 s and a window up to 70 % the job was done before the
+  // scancel landed.
   json base = json::parse(tiny_base());
-  base["stop"]["max_time_s"] = 4.0;
-  // Every drop runs its full second: a drop that came to rest early jumped from 30 % to done
+  base["stop"]["max_time_s"] = 6.0;
+  // Every drop runs its full time: a drop that came to rest early jumped from 30 % to done
   // between the progress reading and the scancel, and the victim's attempt read "done".
   base["stop"]["hold_time_s"] = 10.0;
   json doc = {{"sweep", "slurm_tiny"},
@@ -108,7 +110,7 @@ TEST_F(ClusterFixture, ATinyImpactCampaignCompletesThroughSlurmWithATaskScancell
   // lease names its Slurm task, and status shows it.
   const std::string mid_job =
       "SELECT substr(a.worker, strpos(a.worker, ':slurm=') + 7) || ' ' || a.job_id FROM attempts a JOIN jobs j ON "
-      "j.job_id=a.job_id WHERE a.outcome='running' AND j.state='running' AND j.progress > 0.05 AND j.progress < 0.7 "
+      "j.job_id=a.job_id WHERE a.outcome='running' AND j.state='running' AND j.progress > 0.05 AND j.progress < 0.4 "
       "AND a.worker LIKE '%:slurm=" +
       array + "%' ORDER BY j.progress LIMIT 1";
   std::string found;
