@@ -28,8 +28,15 @@ double rel(const Vec3& a, const Vec3& b, double floor) {
   return (a - b).norm() / std::max({a.norm(), b.norm(), floor});
 }
 
+/// How often each branch of the kernel was taken while the batch and the scalar kernel were compared.
+struct Branches {
+  int slipping = 0, rolling_on = 0, fresh = 0, gated = 0, slow = 0;
+};
+
+/// Compares the batched kernel with the scalar one contact by contact (the comparisons assert);
+/// returns the branches visited, for the test to check that each one was.
 template <class Rolling>
-void compare(bool rolling) {
+Branches compare(bool rolling) {
   PairCoefficients pc = compose_pair(chrono_table1_config().materials[0], chrono_table1_config().materials[0], nullptr);
   pc.mu_rolling = 0.09;
   pc.mu_twisting = 0.05;
@@ -111,21 +118,35 @@ void compare(bool rolling) {
       slow += cs.g.v1.norm() < 1e-5;
     }
   }
-  // Every branch was visited.
-  EXPECT_GT(slipping, 50);
-  EXPECT_GT(fresh, 50);
-  EXPECT_GT(gated, 50);
-  EXPECT_GT(slow, 50);
+  return Branches{slipping, rolling_on, fresh, gated, slow};
+}
+
+/// Every branch was visited often (slip, fresh contact, activation gate, slow contact, rolling).
+void expect_every_branch(const Branches& b, bool rolling) {
+  EXPECT_GT(b.slipping, 50);
+  EXPECT_GT(b.fresh, 50);
+  EXPECT_GT(b.gated, 50);
+  EXPECT_GT(b.slow, 50);
   if (rolling) {
-    EXPECT_GT(rolling_on, 50);
+    EXPECT_GT(b.rolling_on, 50);
   }
 }
 
 }  // namespace
 
-TEST(HertzBatch, MatchesScalarKernelWithSundayRolling) { EXPECT_NO_FATAL_FAILURE(compare<RollingSunday>(true)); }
+TEST(HertzBatch, MatchesScalarKernelWithSundayRolling) {
+  Branches b;
+  EXPECT_NO_FATAL_FAILURE(b = compare<RollingSunday>(true));
+  EXPECT_GT(b.rolling_on, 50);  // the rolling branch is what this case adds
+  expect_every_branch(b, true);
+}
 
-TEST(HertzBatch, MatchesScalarKernelWithoutRolling) { EXPECT_NO_FATAL_FAILURE(compare<RollingNone>(false)); }
+TEST(HertzBatch, MatchesScalarKernelWithoutRolling) {
+  Branches b;
+  EXPECT_NO_FATAL_FAILURE(b = compare<RollingNone>(false));
+  EXPECT_GT(b.slipping, 50);
+  expect_every_branch(b, false);
+}
 
 TEST(HertzBatch, CoversThePaperModels) {
   EXPECT_TRUE((kHasHertzBatch<HertzChrono, RollingSunday>));
