@@ -6,11 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <optional>
 #include <set>
-#include <sstream>
 
 #include "scheduler/sweep/canonical.h"
 #include "spec/json_pointer.h"
@@ -45,8 +43,8 @@ bool is_int(const json& v) {
 /// Collects the problems of the second pass.
 struct Checker {
   std::vector<SpecProblem> problems;
-  void add(const std::string& ptr, const json* found, std::string expected) {
-    problems.push_back({ptr, found ? show(*found) : std::string("nothing (missing)"), std::move(expected)});
+  void add(const std::string& ptr, const json& found, std::string expected) {
+    problems.push_back({ptr, show(found), std::move(expected)});
   }
   void add_text(const std::string& ptr, std::string found, std::string expected) {
     problems.push_back({ptr, std::move(found), std::move(expected)});
@@ -84,10 +82,10 @@ const json* base_field(const json& a, const std::string& ptr, const json* base, 
     const json::json_pointer jp(pointer);
     if (!base) return nullptr;  // the base could not be read (reported at /base)
     if (base->contains(jp)) return &base->at(jp);
-    ck.add(join(ptr, "pointer"), &a["pointer"],
+    ck.add(join(ptr, "pointer"), a["pointer"],
            "a pointer to a field present in the base scenario (to sweep a default, write the field into the base)");
   } catch (const json::exception&) {
-    ck.add(join(ptr, "pointer"), &a["pointer"], "a valid JSON pointer (RFC 6901)");
+    ck.add(join(ptr, "pointer"), a["pointer"], "a valid JSON pointer (RFC 6901)");
   }
   return nullptr;
 }
@@ -106,13 +104,13 @@ std::optional<std::vector<json>> range_values(const json& r, const std::string& 
   }
   const double step = r["step"].get<double>();
   if (stop < start) {
-    ck.add(join(rp, "stop"), &r["stop"], fmt::format("a number >= start ({})", start));
+    ck.add(join(rp, "stop"), r["stop"], fmt::format("a number >= start ({})", start));
     return std::nullopt;
   }
   // Inclusive of stop up to rounding: n = floor((stop - start) / step + 1e-9) + 1.
   const double n = std::floor((stop - start) / step + 1e-9) + 1;
   if (n > 1e6) {
-    ck.add(join(rp, "step"), &r["step"], "a step giving at most 1000000 values");
+    ck.add(join(rp, "step"), r["step"], "a step giving at most 1000000 values");
     return std::nullopt;
   }
   const bool ints = is_int(r["start"]) && is_int(r["stop"]) && is_int(r["step"]) && integer_base;
@@ -132,7 +130,7 @@ std::optional<std::vector<json>> repeat_values(const json& a, const std::string&
     bool ok = true;
     for (const char* k : {"start", "step"})
       if (!is_int(a[k])) {
-        ck.add(join(ptr, k), &a[k],
+        ck.add(join(ptr, k), a[k],
                fmt::format("an integer like the base value at {} ({})", pointer, base_value->dump()));
         ok = false;
       }
@@ -165,7 +163,7 @@ std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json
     std::vector<SpecProblem> bad;
     spec::validator(spec::Schema::sweep).collect_definition(derived, "column", join(ptr, "pointer"), bad);
     if (!bad.empty()) {
-      ck.add(join(ptr, "pointer"), &a["pointer"],
+      ck.add(join(ptr, "pointer"), a["pointer"],
              fmt::format("a pointer whose tokens make a column name (\"{}\" is not one), or an explicit \"name\" "
                          "[a-z_][a-z0-9_]*",
                          derived.get<std::string>()));
@@ -195,7 +193,7 @@ std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json
     const json& v = axis.values[i];
     const std::string vp = a.contains("values") ? join(values_ptr, i) : values_ptr;
     if (!base_value->is_null() && value_kind(v) != value_kind(*base_value)) {
-      ck.add(vp, &v,
+      ck.add(vp, v,
              fmt::format("a {} like the base value at {} ({})", value_kind(*base_value), axis.pointer,
                          base_value->dump()));
       ok = false;
@@ -203,7 +201,7 @@ std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json
     }
     axis.values[i] = canonicalize(v);
     if (ok && !seen.insert(canonical_json(axis.values[i])).second) {
-      ck.add(vp, &axis.values[i], "values that differ from each other (this one repeats an earlier value)");
+      ck.add(vp, axis.values[i], "values that differ from each other (this one repeats an earlier value)");
       ok = false;
     }
   }
@@ -220,12 +218,12 @@ std::optional<json> read_base(const json& doc, const std::filesystem::path& base
   const auto text = spec::read_text_file(p, why);
   json base;
   if (!text) {
-    ck.add("/base", &doc["base"], fmt::format("a readable scenario file ('{}' is {})", p.string(), why));
+    ck.add("/base", doc["base"], fmt::format("a readable scenario file ('{}' is {})", p.string(), why));
   } else if (const auto err = spec::parse_json_text(*text, base)) {
-    ck.add("/base", &doc["base"],
+    ck.add("/base", doc["base"],
            fmt::format("a JSON scenario file ('{}': {} at {})", p.string(), err->what, err->where()));
   } else if (!base.is_object()) {
-    ck.add("/base", &doc["base"],
+    ck.add("/base", doc["base"],
            fmt::format("a file holding a JSON object ('{}' holds {})", p.string(), value_kind(base)));
   } else {
     return base;
