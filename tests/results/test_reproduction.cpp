@@ -322,3 +322,34 @@ TEST(Reproduction, ThePkdgravBedIsOrderedWithItsFastGrainsAtTheFloor) {
   EXPECT_EQ(floor_pkd, fast_pkd) << "every fast grain of the pkdgrav bed lies in its bottom two layers";
   EXPECT_EQ(fast_chrono, 0);
 }
+
+// Part 5's second bed (1.5 d placement lattice, REPRODUCTION.md): random packing inside Table 1's
+// range, and its fast grains are lone grains rolling without slipping on the floor (the velocity
+// of the contact point v + w x (-R z) is a small part of v), which only the Zhang rolling torque
+// M_R <= mu_r beta R m g slows (0.37 m/s2 with pkdgrav's mu_r 1.05, beta 0.05): not a defect of the
+// floor contact, and 10 cm below the projectile's deepest point.
+TEST(Reproduction, ThePkdgravBedOnAWiderLatticeIsRandomAndItsFastGrainsRollOnTheFloor) {
+  namespace fs = std::filesystem;
+  const fs::path beds = fs::path(GRAVSWEEP_SOURCE_DIR) / "data/reproduction/beds";
+  const auto bed = gravsweep::results::read_bed(beds / "2ea3209e0f33f5075120.h5");  // part 5, 8,533 grains
+  const double phi = core_packing_fraction(bed);
+  EXPECT_GT(phi, 0.57) << "Table 1's pkdgrav bulk density 1.45-1.48 g/cm3: 0.58-0.60";
+  EXPECT_LT(phi, 0.61);
+  int fast = 0, rolling_on_floor = 0;
+  for (std::size_t i = 0; i < bed.radius_m.size(); ++i) {
+    const double* v = &bed.velocity_m_s[3 * i];
+    const double* w = &bed.omega_rad_s[3 * i];
+    const double R = bed.radius_m[i];
+    const double speed = std::hypot(v[0], v[1], v[2]);
+    if (speed <= 1e-2) continue;
+    ++fast;
+    // Contact point at -R z (z up from the floor at 0): v + w x (-R z) = v - R (w_y, -w_x, 0).
+    const double slip = std::hypot(v[0] - R * w[1], v[1] + R * w[0], v[2]);
+    const bool on_floor = bed.position_m[3 * i + 2] < 1.01 * R;
+    if (on_floor && slip < 0.1 * speed) ++rolling_on_floor;
+  }
+  std::printf("pkdgrav bed on the 1.5 d lattice: core packing fraction %.3f; %d grains > 1 cm/s, %d rolling on the floor\n",
+              phi, fast, rolling_on_floor);
+  EXPECT_GE(fast, 5);
+  EXPECT_EQ(rolling_on_floor, fast);
+}
