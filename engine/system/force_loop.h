@@ -68,14 +68,8 @@ struct TouchingPair {
 /// region); a listed pair that no longer touches has its history erased; two fixed particles are
 /// skipped; an overlap beyond kMaxOverlapFraction is recorded in `worst` (the exact ratio is
 /// computed only then); visit(const TouchingPair&, ContactHistory&) evaluates the rest.
-///
-/// Each row of the list is screened in chunks of kScreenChunk slots without a data-dependent
-/// branch: the touching slots are compacted into a small index array (about half the listed pairs
-/// touch in a settled bed, so a branch on "touching" mispredicts often), then visited in list
-/// order, so forces are summed in the same order as a one-pass loop (bit-identical results).
 template <class Visit>
 void for_each_touching_pair(ForceContext& c, OverlapFailure& worst, Visit&& visit) {
-  constexpr std::uint32_t kScreenChunk = 32;
   const Particles& p = c.p;
   const std::size_t n = p.size();
   const Vec3* X = p.position_m.data();
@@ -85,37 +79,27 @@ void for_each_touching_pair(ForceContext& c, OverlapFailure& worst, Visit&& visi
   const std::uint32_t* off = c.nlist.offset.data();
   const std::uint32_t* nbr = c.nlist.neighbor.data();
   ContactHistory* hist = c.nlist.history.data();
-  std::uint32_t touching[kScreenChunk];
 #pragma omp for schedule(static) nowait
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 xi = X[i];
     const double ri = R[i];
-    for (std::uint32_t start = off[i]; start < off[i + 1]; start += kScreenChunk) {
-      const std::uint32_t end = std::min(off[i + 1], start + kScreenChunk);
-      std::uint32_t count = 0;
-      for (std::uint32_t k = start; k < end; ++k) {
-        const std::uint32_t j = nbr[k];
-        const double rsum = ri + R[j];
-        const bool touch = (X[j] - xi).squaredNorm() < rsum * rsum;
-        touching[count] = k;
-        count += touch;
-        // Contact ended: history erased (a rare, well-predicted branch; no write otherwise).
-        if (!touch & hist[k].active) hist[k].active = false;
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+      const std::uint32_t j = nbr[k];
+      const Vec3 d = X[j] - xi;
+      const double rsum = ri + R[j];
+      const double dist2 = d.squaredNorm();
+      ContactHistory& h = hist[k];
+      if (dist2 >= rsum * rsum) {
+        if (h.active) h.active = false;  // contact ended: history erased (no write otherwise)
+        continue;
       }
-      for (std::uint32_t t = 0; t < count; ++t) {
-        const std::uint32_t k = touching[t];
-        const std::uint32_t j = nbr[k];
-        if (inv_m[i] == 0 && inv_m[j] == 0) continue;  // two fixed particles
-        const Vec3 d = X[j] - xi;
-        const double dist2 = d.squaredNorm();
-        const double rsum = ri + R[j];
-        const double r_min = std::min(ri, R[j]);
-        const double limit = rsum - kMaxOverlapFraction * r_min;
-        if (dist2 < limit * limit) worst.consider((rsum - std::sqrt(dist2)) / r_min, static_cast<long long>(i), j, -1);
-        const double mi = inv_m[i] == 0 ? kInf : M[i], mj = inv_m[j] == 0 ? kInf : M[j];
-        const double m_eff = std::isinf(mi) ? mj : std::isinf(mj) ? mi : mi * mj / (mi + mj);
-        visit(TouchingPair{k, static_cast<std::uint32_t>(i), j, d, dist2, m_eff}, hist[k]);
-      }
+      if (inv_m[i] == 0 && inv_m[j] == 0) continue;  // two fixed particles
+      const double r_min = std::min(ri, R[j]);
+      const double limit = rsum - kMaxOverlapFraction * r_min;
+      if (dist2 < limit * limit) worst.consider((rsum - std::sqrt(dist2)) / r_min, static_cast<long long>(i), j, -1);
+      const double mi = inv_m[i] == 0 ? kInf : M[i], mj = inv_m[j] == 0 ? kInf : M[j];
+      const double m_eff = std::isinf(mi) ? mj : std::isinf(mj) ? mi : mi * mj / (mi + mj);
+      visit(TouchingPair{k, static_cast<std::uint32_t>(i), j, d, dist2, m_eff}, h);
     }
   }
 }
