@@ -104,6 +104,26 @@ TEST(Reproduction, ChronoLowGTable3WithTheRepeats) {
   EXPECT_LT(low.at("alpha"), one.at("alpha")) << "the paper: alpha lower at 0.1 m/s2 than at 1 g";
 }
 
+// pkdgrav set at 1 g (part 5, second bed, 7 drops; REPRODUCTION.md). Paper Table 3: f0 21 +/- 4 N,
+// 1/d1 35 +/- 7 1/m, alpha 0.40 +/- 0.03. Ours: f0 21.2 +/- 1.6, 1/d1 42.7 +/- 2.2 (0.7 above the
+// paper's range: 1.05 combined uncertainties), alpha 0.544 +/- 0.013 (not reproduced: the slow drops stop at half the
+// Chrono set's depth). The first, ordered bed gave a seven-fold 1/d1.
+TEST(Reproduction, PkdgravTable3RowAsStated) {
+  const auto row = table3_row("'" + dataset("pkdgrav_1g") + "'");
+  ASSERT_EQ(row.count("f0_N"), 1u);
+  EXPECT_EQ(row.at("trials"), 7);
+  EXPECT_NEAR(row.at("f0_N"), 21.2, 0.5);
+  EXPECT_NEAR(row.at("inv_d1_1_m"), 42.7, 1.0);
+  EXPECT_NEAR(row.at("alpha"), 0.544, 0.01);
+  EXPECT_NEAR(row.at("f0_N"), 21, 4) << "inside the paper's 21 +/- 4 N";
+  const double combined = std::hypot(7.0, row.at("inv_d1_se_1_m"));
+  EXPECT_GT(std::abs(row.at("inv_d1_1_m") - 35), combined) << "just outside one combined uncertainty, as stated";
+  EXPECT_LT(std::abs(row.at("inv_d1_1_m") - 35), 1.2 * combined) << "and within 1.2 of them";
+  const auto ordered = table3_row("'" + dataset("pkdgrav_1g_ordered_bed") + "'");
+  ASSERT_EQ(ordered.count("inv_d1_1_m"), 1u);
+  EXPECT_GT(ordered.at("inv_d1_1_m"), 5 * row.at("inv_d1_1_m")) << "the ordered bed resisted far more";
+}
+
 // Beyond the paper, on the whole Chrono campaign (both levels, 42 drops; REPRODUCTION.md): no named
 // term helps held out on both levels at once, and the search beyond the library finds a depth
 // resistance that saturates over a few centimetres, with the depth and duration errors falling.
@@ -348,8 +368,9 @@ TEST(Reproduction, ThePkdgravBedOnAWiderLatticeIsRandomAndItsFastGrainsRollOnThe
     const bool on_floor = bed.position_m[3 * i + 2] < 1.01 * R;
     if (on_floor && slip < 0.1 * speed) ++rolling_on_floor;
   }
-  std::printf("pkdgrav bed on the 1.5 d lattice: core packing fraction %.3f; %d grains > 1 cm/s, %d rolling on the floor\n",
-              phi, fast, rolling_on_floor);
+  std::printf(
+      "pkdgrav bed on the 1.5 d lattice: core packing fraction %.3f; %d grains > 1 cm/s, %d rolling on the floor\n",
+      phi, fast, rolling_on_floor);
   EXPECT_GE(fast, 5);
   EXPECT_EQ(rolling_on_floor, fast);
 }

@@ -260,16 +260,38 @@ TEST(PileVerb, PrintsTheAngleForEachRollingFrictionAndRefusesBadOptions) {
   std::getline(lines, header);
   std::getline(lines, row0);
   std::getline(lines, row1);
-  EXPECT_EQ(header.rfind("mu_rolling,mu_static,repose_angle_deg,", 0), 0u) << r.out;
-  EXPECT_EQ(row0.rfind("0,0.16,", 0), 0u) << r.out;
-  EXPECT_EQ(row1.rfind("0.09,0.16,", 0), 0u) << r.out;
-  const double flat = std::stod(row0.substr(std::string("0,0.16,").size()));
-  const double steep = std::stod(row1.substr(std::string("0.09,0.16,").size()));
+  EXPECT_EQ(header.rfind("set,mu_rolling,shape_beta,mu_static,repose_angle_deg,", 0), 0u) << r.out;
+  const std::string flat_key = "chrono,0,-,0.16,", steep_key = "chrono,0.09,-,0.16,";
+  EXPECT_EQ(row0.rfind(flat_key, 0), 0u) << r.out;
+  EXPECT_EQ(row1.rfind(steep_key, 0), 0u) << r.out;
+  const double flat = std::stod(row0.substr(flat_key.size()));
+  const double steep = std::stod(row1.substr(steep_key.size()));
   EXPECT_GT(steep, flat + 4.0) << r.out;
   EXPECT_LT(steep, 45.0) << r.out;
   const Cli bad = gravsweep_cli(dir, "pile --mu-s -1");
   EXPECT_EQ(bad.code, 2) << bad.out << bad.err;
   EXPECT_NE(bad.err.find("--mu-s"), std::string::npos) << bad.err;
+  const Cli bad_set = gravsweep_cli(dir, "pile --set lammps");
+  EXPECT_EQ(bad_set.code, 2) << bad_set.out << bad_set.err;
+  EXPECT_NE(bad_set.err.find("--set"), std::string::npos) << bad_set.err;
+}
+
+// `gravsweep pile --set pkdgrav` takes Table 1's pkdgrav grains (mu_s 1.0, beta as given, 1 cm
+// beads, Hooke + Zhang); the small heap measured 13 degrees (the full 2,000-grain heap 22.2, Table 2:
+// 22.1; REPRODUCTION.md, part 5).
+TEST(PileVerb, ThePkdgravSetPilesWithItsOwnFrictionAndBeta) {
+  test::TempDir dir;
+  const Cli r = gravsweep_cli(dir, "pile --set pkdgrav --grains 600 --base-radius 0.08 --format csv --quiet");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  std::istringstream lines(r.out);
+  std::string header, row;
+  std::getline(lines, header);
+  std::getline(lines, row);
+  const std::string key = "pkdgrav,1.05,0.05,1,";
+  ASSERT_EQ(row.rfind(key, 0), 0u) << r.out;
+  const double angle = std::stod(row.substr(key.size()));
+  EXPECT_GT(angle, 5.0) << r.out;
+  EXPECT_LT(angle, 35.0) << r.out;
 }
 
 }  // namespace
