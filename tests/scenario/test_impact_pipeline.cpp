@@ -203,6 +203,15 @@ TEST(RunVerb, WritesBedTraceAndMetricsThenReusesTheBed) {
   const json m = json::parse(std::ifstream(out / "metrics.json"));
   EXPECT_TRUE(m["zstop_m"].is_number());
   EXPECT_TRUE(m["bed_report"]["grains_kept"].is_number());
+  // The bed line says how settling ended: which criterion the time cap left unmet, and by how much.
+  if (m["bed_report"]["settled"].get<bool>()) {
+    EXPECT_NE(r.out.find("settled to the criteria (rms "), std::string::npos) << r.out;
+  } else {
+    EXPECT_NE(r.out.find("settling stopped by the time cap /bed/settle/max_time_s"), std::string::npos) << r.out;
+    EXPECT_TRUE(r.out.find(" m/s above its ") != std::string::npos ||
+                r.out.find("after the relax they hold (rms ") != std::string::npos)
+        << r.out;
+  }
 
   // Another speed on the same bed: no new bed, the given one is used.
   json faster = test::tiny_scenario();
