@@ -9,9 +9,27 @@ inline constexpr std::uint8_t kGrainMaterial = 0;
 inline constexpr std::uint8_t kWallMaterial = 1;
 inline constexpr std::uint8_t kProjectileMaterial = 2;
 
+/// The three materials of the paper's set-ups from the grain's: the wall and the projectile are
+/// made of it, the wall with its own normal COR and sliding friction, which explicit pair values
+/// for grain-wall and projectile-wall make act (dem-physics.md 1.2).
+inline void set_paper_materials(SystemConfig& c, const Material& grain, double wall_cor_normal, double wall_mu_static) {
+  Material wall = grain;
+  wall.name = "wall";
+  wall.cor_normal = wall_cor_normal;
+  wall.mu_static = wall_mu_static;
+  Material projectile = grain;
+  projectile.name = "projectile";
+  c.materials = {grain, wall, projectile};
+  c.composition = Composition::explicit_pair;
+  PairOverride with_wall;
+  with_wall.cor_normal = wall_cor_normal;
+  with_wall.mu_static = wall_mu_static;
+  c.pair_overrides[{kGrainMaterial, kWallMaterial}] = with_wall;
+  c.pair_overrides[{kWallMaterial, kProjectileMaterial}] = with_wall;
+}
+
 /// Chrono column of Table 1: Hertz, E = 700 MPa, nu = 0.24, COR grain/wall 0.9/0.5, static friction
-/// grain/wall 0.16/0.45, rolling 0.09, twisting 0.01, dt = 1 us, semi-implicit Euler, explicit pair
-/// values for grain-wall (so the wall's 0.5 and 0.45 act; dem-physics.md 1.2).
+/// grain/wall 0.16/0.45, rolling 0.09, twisting 0.01, dt = 1 us, semi-implicit Euler.
 inline SystemConfig chrono_table1_config(double mu_rolling = 0.09) {
   SystemConfig c;
   c.contact_law = "hertz";
@@ -26,19 +44,7 @@ inline SystemConfig chrono_table1_config(double mu_rolling = 0.09) {
   grain.mu_static = 0.16;
   grain.mu_rolling = mu_rolling;
   grain.mu_twisting = 0.01;
-  Material wall = grain;
-  wall.name = "wall";
-  wall.cor_normal = 0.5;
-  wall.mu_static = 0.45;
-  Material projectile = grain;
-  projectile.name = "projectile";
-  c.materials = {grain, wall, projectile};
-  c.composition = Composition::explicit_pair;
-  PairOverride gw;
-  gw.cor_normal = 0.5;
-  gw.mu_static = 0.45;
-  c.pair_overrides[{kGrainMaterial, kWallMaterial}] = gw;
-  c.pair_overrides[{kWallMaterial, kProjectileMaterial}] = gw;
+  set_paper_materials(c, grain, 0.5, 0.45);
   return c;
 }
 
@@ -63,17 +69,7 @@ inline SystemConfig pkdgrav_table1_config(double mu_rolling = 1.05, double shape
   grain.kn_N_m = 7.48e5;
   grain.kt_N_m = 0;  // 2/7 k_N
   grain.shape_beta = shape_beta;
-  Material wall = grain;
-  wall.name = "wall";
-  wall.cor_normal = 0.5;
-  Material projectile = grain;
-  projectile.name = "projectile";
-  c.materials = {grain, wall, projectile};
-  c.composition = Composition::explicit_pair;
-  PairOverride gw;
-  gw.cor_normal = 0.5;
-  c.pair_overrides[{kGrainMaterial, kWallMaterial}] = gw;
-  c.pair_overrides[{kWallMaterial, kProjectileMaterial}] = gw;
+  set_paper_materials(c, grain, 0.5, 1.0);
   return c;
 }
 

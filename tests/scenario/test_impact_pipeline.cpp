@@ -9,6 +9,7 @@
 #include <set>
 #include <string>
 #include <sstream>
+#include <vector>
 #include <sys/wait.h>
 
 #include "engine/core/error.h"
@@ -258,17 +259,23 @@ TEST(RunVerb, HelpTeachesWithAnExample) {
   EXPECT_NE(r.out.find("--bed"), std::string::npos) << r.out;
 }
 
+/// The lines of a verb's output (a CSV table: header first).
+std::vector<std::string> lines_of(const std::string& out) {
+  std::vector<std::string> lines;
+  std::istringstream in(out);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
 // `gravsweep pile` on a small heap (600 grains, 8 cm base; measured 7 and 17 degrees): a CSV row
 // per mu_r with the angle, steeper with rolling friction, and a bad option refused with exit code 2.
 TEST(PileVerb, PrintsTheAngleForEachRollingFrictionAndRefusesBadOptions) {
   test::TempDir dir;
   const Cli r = gravsweep_cli(dir, "pile --mu-r 0,0.09 --grains 600 --base-radius 0.08 --format csv --quiet");
   ASSERT_EQ(r.code, 0) << r.out << r.err;
-  std::istringstream lines(r.out);
-  std::string header, row0, row1;
-  std::getline(lines, header);
-  std::getline(lines, row0);
-  std::getline(lines, row1);
+  const auto lines = lines_of(r.out);
+  ASSERT_GE(lines.size(), 3u) << r.out;
+  const std::string &header = lines[0], &row0 = lines[1], &row1 = lines[2];
   EXPECT_EQ(header.rfind("set,mu_rolling,shape_beta,mu_static,repose_angle_deg,", 0), 0u) << r.out;
   const std::string flat_key = "chrono,0,-,0.16,", steep_key = "chrono,0.09,-,0.16,";
   EXPECT_EQ(row0.rfind(flat_key, 0), 0u) << r.out;
@@ -292,10 +299,9 @@ TEST(PileVerb, ThePkdgravSetPilesWithItsOwnFrictionAndBeta) {
   test::TempDir dir;
   const Cli r = gravsweep_cli(dir, "pile --set pkdgrav --grains 600 --base-radius 0.08 --format csv --quiet");
   ASSERT_EQ(r.code, 0) << r.out << r.err;
-  std::istringstream lines(r.out);
-  std::string header, row;
-  std::getline(lines, header);
-  std::getline(lines, row);
+  const auto lines = lines_of(r.out);
+  ASSERT_GE(lines.size(), 2u) << r.out;
+  const std::string& row = lines[1];
   const std::string key = "pkdgrav,1.05,0.05,1,";
   ASSERT_EQ(row.rfind(key, 0), 0u) << r.out;
   const double angle = std::stod(row.substr(key.size()));
