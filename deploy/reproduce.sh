@@ -35,7 +35,8 @@ case "${1:-}" in
     # the result table of every sweep with finished drops. A campaign that was restarted on a new
     # machine may hold fewer drops of a part than the committed dataset: that dataset is kept.
     count() { [ -f "$1/trials.csv" ] && echo $(( $(wc -l < "$1/trials.csv") - 1 )) || echo 0; }
-    for part in part1_chrono_1g:chrono_1g part2_chrono_lowg:chrono_0.1g part5_pkdgrav_1g:pkdgrav_1g; do
+    for part in part1_chrono_1g:chrono_1g part2_chrono_lowg:chrono_0.1g part5_pkdgrav_1g:pkdgrav_1g \
+      part5b_pkdgrav_stiff_1g:pkdgrav_stiff_1g; do
       sweep="${part%%:*}"; dir="$data/${part##*:}"
       rm -rf "$dir.tmp"
       if ! "$gs" export --db "$db" --sweep "$sweep" --out "$dir.tmp" --rate-hz 2000; then
