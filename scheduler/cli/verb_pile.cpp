@@ -13,6 +13,7 @@
 #include "engine/scenario/pile.h"
 #include "scheduler/cli/progress.h"
 #include "results/report/table.h"
+#include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/format_option.h"
 #include "scheduler/cli/verbs.h"
 
@@ -27,9 +28,9 @@ constexpr double kPkdgravPileDt_s = 4e-6;
 
 struct PileOptions {
   std::string set = "chrono";
-  std::vector<double> mu_rolling;   ///< empty: the set's default list
-  std::optional<double> mu_static;  ///< unset: the set's (Chrono 0.16, pkdgrav 1.0)
-  double shape_beta = 0.05;         ///< pkdgrav only
+  std::vector<double> mu_rolling;    ///< empty: the set's default list
+  std::optional<double> mu_static;   ///< unset: the set's (Chrono 0.16, pkdgrav 1.0)
+  std::optional<double> shape_beta;  ///< pkdgrav only; unset: 0.05 (Table 1)
   std::size_t grains = 2000;
   double base_radius_m = 0.15;
   std::optional<double> dt_s;  ///< unset: the set's
@@ -42,6 +43,10 @@ struct PileOptions {
 void run_pile(const PileOptions& o) {
   ProgressBar bar(!o.quiet);
   const bool pkdgrav = o.set == "pkdgrav";
+  if (o.shape_beta && !pkdgrav)
+    throw UsageError(fmt::format("--beta {:g}: the shape parameter applies to --set pkdgrav only (found --set {})",
+                                 *o.shape_beta, o.set));
+  const double beta = o.shape_beta.value_or(0.05);
   const std::vector<double> mu_rolling = !o.mu_rolling.empty() ? o.mu_rolling
                                          : pkdgrav             ? std::vector<double>{1.05}
                                                                : std::vector<double>{0.0, 0.09};
@@ -49,7 +54,7 @@ void run_pile(const PileOptions& o) {
                     "grains_on_base", "flank_bins", "rms_speed_m_s", "simulated_time_s", "wall_time_s"},
                    results::kRuledText);
   for (double mu_r : mu_rolling) {
-    SystemConfig cfg = pkdgrav ? pkdgrav_table1_config(mu_r, o.shape_beta) : chrono_table1_config(mu_r);
+    SystemConfig cfg = pkdgrav ? pkdgrav_table1_config(mu_r, beta) : chrono_table1_config(mu_r);
     const double mu_s = o.mu_static.value_or(cfg.materials[kGrainMaterial].mu_static);
     cfg.materials[kGrainMaterial].mu_static = mu_s;
     cfg.dt_s = o.dt_s.value_or(pkdgrav ? kPkdgravPileDt_s : kChronoPileDt_s);
@@ -65,9 +70,9 @@ void run_pile(const PileOptions& o) {
         pour_pile(sys, spec, [&](double f, const std::string& d) { bar.update(fmt::format("mu_r={:g}", mu_r), f, d); });
     bar.finish();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    t.add({o.set, fmt::format("{:g}", mu_r), pkdgrav ? fmt::format("{:g}", o.shape_beta) : "-",
-           fmt::format("{:g}", mu_s), fmt::format("{:.1f}", r.angle_deg), fmt::format("{:.4f}", r.apex_height_m),
-           std::to_string(r.grains_on_base), std::to_string(r.flank_bins), fmt::format("{:.1e}", r.rms_speed_m_s),
+    t.add({o.set, fmt::format("{:g}", mu_r), pkdgrav ? fmt::format("{:g}", beta) : "-", fmt::format("{:g}", mu_s),
+           fmt::format("{:.1f}", r.angle_deg), fmt::format("{:.4f}", r.apex_height_m), std::to_string(r.grains_on_base),
+           std::to_string(r.flank_bins), fmt::format("{:.1e}", r.rms_speed_m_s),
            fmt::format("{:.2f}", r.simulated_time_s), fmt::format("{:.1f}", wall)});
   }
   t.print(o.format);
@@ -100,9 +105,10 @@ void setup_pile(CLI::App& app) {
       ->delimiter(',');
   sub->add_option("--mu-s", opt->mu_static, "grain-grain sliding friction (default: Table 1's, 0.16 / 1.0)")
       ->check(CLI::NonNegativeNumber);
-  sub->add_option("--beta", opt->shape_beta, "pkdgrav's rolling shape parameter beta (Table 2: 0.025-0.3)")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
+  sub->add_option("--beta", opt->shape_beta,
+                  "pkdgrav's rolling shape parameter beta, --set pkdgrav only (default 0.05, Table 1; Table 2 "
+                  "tries 0.025-0.3)")
+      ->check(CLI::PositiveNumber);
   sub->add_option("--grains", opt->grains, "grains poured")->check(CLI::Range(100, 1000000))->capture_default_str();
   sub->add_option("--base-radius", opt->base_radius_m, "radius of the rough base, m")
       ->check(CLI::Range(0.03, 10.0))

@@ -30,19 +30,19 @@ std::string settling_outcome(const nlohmann::json& report, const nlohmann::json&
   const nlohmann::json settle = scenario.value("/bed/settle"_json_pointer, nlohmann::json::object());
   const double rms_max = settle.value("rms_speed_m_s", 0.0), fastest_max = settle.value("max_speed_m_s", 0.0);
   if (report.value("settled", false))
-    return fmt::format("settled to the criteria (rms {:.1e} m/s <= {:.0e}, fastest {:.1e} m/s <= {:.0e})", rms, rms_max,
+    return fmt::format("settled to the criteria (rms {:.1e} m/s <= {:g}, fastest {:.1e} m/s <= {:g})", rms, rms_max,
                        fastest, fastest_max);
   std::string unmet;
   auto add = [&](const char* what, double found, double limit) {
     if (found <= limit) return;
-    unmet += fmt::format("{}{} {:.1e} m/s above its {:.0e}", unmet.empty() ? "" : ", ", what, found, limit);
+    unmet += fmt::format("{}{} {:.1e} m/s above its {:g}", unmet.empty() ? "" : ", ", what, found, limit);
   };
   add("rms", rms, rms_max);
   add("fastest grain", fastest, fastest_max);
   if (unmet.empty())  // the pour's settling was capped; the relax after flattening then met the criteria
     return fmt::format(
         "settling stopped by the time cap /bed/settle/max_time_s before the criteria held; after the relax they "
-        "hold (rms {:.1e} m/s <= {:.0e}, fastest {:.1e} m/s <= {:.0e})",
+        "hold (rms {:.1e} m/s <= {:g}, fastest {:.1e} m/s <= {:g})",
         rms, rms_max, fastest, fastest_max);
   return fmt::format("settling stopped by the time cap /bed/settle/max_time_s ({})", unmet);
 }
