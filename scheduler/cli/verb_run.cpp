@@ -25,11 +25,10 @@ namespace {
 /// How the bed's settling ended, against the scenario's criteria (/bed/settle): "settled to the
 /// criteria", or which criterion the time cap left unmet and by how much (the report's speeds are
 /// those at the end of the relax; `settled` needs the criteria met in both phases).
-std::string settling_outcome(const nlohmann::json& report, const nlohmann::json& scenario) {
-  const double rms = report.value("rms_speed_m_s", 0.0), fastest = report.value("max_speed_m_s", 0.0);
-  const nlohmann::json settle = scenario.value("/bed/settle"_json_pointer, nlohmann::json::object());
-  const double rms_max = settle.value("rms_speed_m_s", 0.0), fastest_max = settle.value("max_speed_m_s", 0.0);
-  if (report.value("settled", false))
+std::string settling_outcome(const nlohmann::json& report, const SettleCriteria& criteria) {
+  const double rms = report.at("rms_speed_m_s").get<double>(), fastest = report.at("max_speed_m_s").get<double>();
+  const double rms_max = criteria.rms_speed_m_s, fastest_max = criteria.max_speed_m_s;
+  if (report.at("settled").get<bool>())
     return fmt::format("settled to the criteria (rms {:.1e} m/s <= {:g}, fastest {:.1e} m/s <= {:g})", rms, rms_max,
                        fastest, fastest_max);
   std::string unmet;
@@ -146,7 +145,8 @@ void run_impact(const RunOptions& o) {
           "bed: {} grains kept of {} poured, surface at {:.2f} cm, bulk density {:.0f} kg/m3, {}, prepared in {}\n",
           b.report["grains_kept"].get<long>(), b.report["grains_placed"].get<long>(),
           100 * b.report["surface_height_m"].get<double>(), b.report["bulk_density_kg_m3"].get<double>(),
-          settling_outcome(b.report, scenario), format_duration(b.report["wall_time_s"].get<double>()));
+          settling_outcome(b.report, pipeline::scenario_params(scenario).bed.settle),
+          format_duration(b.report["wall_time_s"].get<double>()));
     } else {
       bed_path = o.bed;
       fmt::print("bed: reusing {}\n", bed_path.string());
