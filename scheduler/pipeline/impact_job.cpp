@@ -40,10 +40,15 @@ json bed_key_of_validated(const json& s) {
   k["container"] = s.at("container");
   k["grains"] = s.at("grains");
   k["gravity_m_s2"] = s.at("gravity_m_s2");
-  k["materials"] = s.at("materials");
+  // The bed's own materials (/bed/materials, when given) are the ones it is prepared with: a bed
+  // prepared with them has the key of a scenario whose /materials are those, so drops that differ
+  // from it only in their materials reuse it (scenario.schema.json, /bed/materials).
+  json bed = s.at("bed");
+  k["materials"] = bed.contains("materials") ? bed.at("materials") : s.at("materials");
+  bed.erase("materials");
   k["contact"] = s.at("contact");
   k["integrator"] = s.at("integrator");
-  k["bed"] = s.at("bed");
+  k["bed"] = bed;
   return k;
 }
 

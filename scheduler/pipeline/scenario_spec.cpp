@@ -76,8 +76,15 @@ std::string join(const std::vector<std::string>& v) {
   return s;
 }
 
-/// The system configuration common to preparation and drop (dt and gravity set by the caller).
-SystemConfig base_config(const json& s) {
+/// The materials a bed is prepared with: /bed/materials when given, else /materials (the drop's).
+const json& bed_materials(const json& s) {
+  const json& b = s.at("bed");
+  return b.contains("materials") ? b.at("materials") : s.at("materials");
+}
+
+/// The system configuration common to preparation and drop (dt and gravity set by the caller),
+/// with the body materials `m` (/materials for the drop, bed_materials() for the preparation).
+SystemConfig base_config(const json& s, const json& m) {
   SystemConfig c;
   const json& ct = s.at("contact");
   c.contact_law = ct.at("law");
@@ -85,7 +92,6 @@ SystemConfig base_config(const json& s) {
   c.integrator = s.at("integrator");
   c.composition = ct.at("composition").get<Composition>();
   c.options.clamp_normal = ct.at("clamp_normal");
-  const json& m = s.at("materials");
   c.materials.assign(3, Material{});
   for (const auto& [index, name] : {std::pair{kGrainMaterial, "grain"}, std::pair{kWallMaterial, "wall"},
                                     std::pair{kProjectileMaterial, "projectile"}}) {
@@ -164,9 +170,8 @@ void engine_checks(const json& s, Checks& ck) {
   const double spread = s["/grains/diameter_spread_m"_json_pointer];
   const double rho = s["/grains/density_kg_m3"_json_pointer];
   const double r_min = 0.5 * (d - spread);
-  const SystemConfig cfg = base_config(s);
-  auto build = [&](double dt) {
-    SystemConfig c = cfg;
+  auto build = [&](double dt, const json& materials) {
+    SystemConfig c = base_config(s, materials);
     c.dt_s = dt;
     System sys(c);
     sys.particles.add(Vec3(0, 0, 1), r_min, sphere_mass_kg(rho, 2 * r_min), kGrainMaterial, SizeClass::grain);
@@ -178,18 +183,24 @@ void engine_checks(const json& s, Checks& ck) {
     add_container_walls(sys, cs, 5.0, kWallMaterial);
     sys.initialize();
   };
-  try {
-    build(1e-12);
-  } catch (const ConfigError& e) {
-    ck.bad("/materials", fmt::format("parameters the engine rejects ({})", e.what()),
-           "materials and contact.pairs valid for the contact law");
-    return;
-  }
-  for (const char* dt_pointer : {"/bed/dt_s", "/dt_s"}) {
+  const bool own_bed_materials = s.at("bed").contains("materials");
+  if (own_bed_materials && !ck.sound("/bed/materials")) return;
+  // Each time step is checked with the materials it is used with: the bed's and the drop's.
+  const std::pair<const char*, const char*> uses[] = {{"/materials", "/dt_s"},
+                                                      {own_bed_materials ? "/bed/materials" : "/materials", "/bed/dt_s"}};
+  for (const auto& [materials_pointer, dt_pointer] : uses) {
+    const json& m = s[json::json_pointer(materials_pointer)];
+    try {
+      build(1e-12, m);
+    } catch (const ConfigError& e) {
+      ck.bad(materials_pointer, fmt::format("parameters the engine rejects ({})", e.what()),
+             "materials and contact.pairs valid for the contact law");
+      return;
+    }
     if (!ck.sound(dt_pointer)) continue;
     const double dt = s[json::json_pointer(dt_pointer)];
     try {
-      build(dt);
+      build(dt, m);
     } catch (const ConfigError& e) {
       ck.bad(dt_pointer, fmt::format("{:g}", dt), fmt::format("a time step the contact law accepts ({})", e.what()));
     }
@@ -350,10 +361,10 @@ ScenarioParams scenario_params(const json& s) {
   const double settle_g = s["/bed/settle_gravity_m_s2"_json_pointer].get<double>() > 0
                               ? s["/bed/settle_gravity_m_s2"_json_pointer].get<double>()
                               : out.gravity_m_s2;
-  out.bed_config = base_config(s);
+  out.bed_config = base_config(s, bed_materials(s));
   out.bed_config.dt_s = s["/bed/dt_s"_json_pointer];
   out.bed_config.gravity_m_s2 = Vec3(0, 0, -settle_g);
-  out.drop_config = base_config(s);
+  out.drop_config = base_config(s, s.at("materials"));
   out.drop_config.dt_s = s.at("dt_s");
   out.drop_config.gravity_m_s2 = Vec3(0, 0, -out.gravity_m_s2);
 

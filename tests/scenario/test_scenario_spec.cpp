@@ -183,6 +183,20 @@ TEST(ScenarioSpec, TimeStepsAboveTheStabilityBoundAreRefused) {
   refused_at(s, "/bed/dt_s");
 }
 
+TEST(ScenarioSpec, TheBedsOwnMaterialsAreCheckedWithTheBedsTimeStep) {
+  json s = minimal();
+  s["bed"]["materials"]["grain"]["cor_normal"] = 1.5;
+  refused_at(s, "/bed/materials/grain/cor_normal");
+  s = minimal();
+  s["bed"]["materials"]["grain"]["young_modulus_Pa"] = 7e10;  // 100x stiffer: bound ~1.5 us
+  refused_at(s, "/bed/dt_s");  // the default 5 us preparation step, checked with the bed's materials
+  s["bed"]["dt_s"] = 1e-6;
+  const json ok = validate_scenario(s);
+  EXPECT_DOUBLE_EQ(ok["/bed/materials/grain/young_modulus_Pa"_json_pointer].get<double>(), 7e10);
+  EXPECT_DOUBLE_EQ(ok["/bed/materials/wall/cor_normal"_json_pointer].get<double>(), 0.5);  // defaults fill in
+  EXPECT_FALSE(validate_scenario(minimal())["bed"].contains("materials"));  // absent stays absent: bed keys stay
+}
+
 TEST(ScenarioSpec, TheCompiledSchemaIsTheRepositorysSchema) {
   std::ifstream in(std::string(GRAVSWEEP_SOURCE_DIR) + "/schemas/scenario.schema.json");
   ASSERT_TRUE(in.good());
