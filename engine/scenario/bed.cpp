@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -105,8 +106,20 @@ void grain_speeds(const System& sys, double& rms_m_s, double& max_m_s) {
   max_m_s = std::sqrt(mx2);
 }
 
-bool settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress, BedPhase phase,
-            double* rms_out, double* max_out) {
+const char* to_string(SettleEnd e) {
+  switch (e) {
+    case SettleEnd::criteria:
+      return "criteria";
+    case SettleEnd::plateau:
+      return "plateau";
+    case SettleEnd::time_cap:
+      return "time_cap";
+  }
+  return "?";
+}
+
+SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress,
+                 BedPhase phase, double* rms_out, double* max_out) {
   const double dt = sys.config().dt_s;
   // The settling threshold of rolling friction holds for this phase only (SettleCriteria).
   struct ThresholdScope {
@@ -120,7 +133,9 @@ bool settle(System& sys, const SettleCriteria& c, double min_time_s, const BedPr
   const auto check_steps = std::max<long long>(1, std::llround(c.check_interval_s / dt));
   const double t0 = sys.time_s();
   double rms = 0, mx = 0;
-  bool met = false;
+  SettleEnd end = SettleEnd::time_cap;
+  // Creep floor: the lowest RMS speed since the bed became quiet, and when it was last lowered.
+  double low_m_s = std::numeric_limits<double>::infinity(), low_at_s = 0;
   while (sys.time_s() - t0 < c.max_time_s) {
     sys.advance(check_steps);
     grain_speeds(sys, rms, mx);
@@ -133,13 +148,22 @@ bool settle(System& sys, const SettleCriteria& c, double min_time_s, const BedPr
                fmt::format("t={:.3f}s rms={:.2e}m/s max={:.2e}m/s", elapsed, rms, mx));
     }
     if (elapsed >= min_time_s && rms < c.rms_speed_m_s && mx < c.max_speed_m_s) {
-      met = true;
+      end = SettleEnd::criteria;
+      break;
+    }
+    if (rms >= c.max_speed_m_s) {  // not quiet yet (pour, avalanche of the whole bed): no floor
+      low_m_s = std::numeric_limits<double>::infinity();
+    } else if (rms < kPlateauNewLow * low_m_s) {
+      low_m_s = rms;
+      low_at_s = elapsed;
+    } else if (c.plateau_window_s > 0 && elapsed >= min_time_s && elapsed - low_at_s >= c.plateau_window_s) {
+      end = SettleEnd::plateau;
       break;
     }
   }
   if (rms_out) *rms_out = rms;
   if (max_out) *max_out = mx;
-  return met;
+  return end;
 }
 
 void ramp_gravity(System& sys, const Vec3& to_m_s2, double ramp_s, double interval_s, const BedProgress& progress) {
@@ -217,7 +241,7 @@ BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progr
   if (progress) progress(BedPhase::fill, 1.0, fmt::format("{} grains", rep.grains_placed));
   // Settle under gravity.
   const double t0 = sys.time_s();
-  bool met = settle(sys, spec.settle, 0.0, progress, BedPhase::settle, &rep.rms_speed_m_s, &rep.max_speed_m_s);
+  rep.settle_end = settle(sys, spec.settle, 0.0, progress, BedPhase::settle, &rep.rms_speed_m_s, &rep.max_speed_m_s);
   rep.settle_time_s = sys.time_s() - t0;
   // Flatten: delete grains whose centre lies above the fill height.
   std::vector<bool> remove(sys.particles.size(), false);
@@ -230,11 +254,10 @@ BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progr
   if (spec.relax_gravity_m_s2)
     ramp_gravity(sys, *spec.relax_gravity_m_s2, spec.gravity_ramp_s, spec.settle.check_interval_s, progress);
   const double t1 = sys.time_s();
-  met =
-      settle(sys, spec.settle, spec.relax_time_s, progress, BedPhase::relax, &rep.rms_speed_m_s, &rep.max_speed_m_s) &&
-      met;
+  rep.relax_end =
+      settle(sys, spec.settle, spec.relax_time_s, progress, BedPhase::relax, &rep.rms_speed_m_s, &rep.max_speed_m_s);
   rep.relax_time_s = sys.time_s() - t1;
-  rep.settled = met;
+  rep.settled = rep.settle_end == SettleEnd::criteria && rep.relax_end == SettleEnd::criteria;
   rep.grains_kept = sys.particles.size();
   rep.surface_height_m = surface_height(sys, 0.5 * spec.container.diameter_m);
   double mass = 0;

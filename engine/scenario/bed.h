@@ -33,7 +33,20 @@ struct SettleCriteria {
   /// is braked above it, so such grains creep at ~1e-4 m/s and the RMS speed stays near 5e-5 m/s,
   /// above the paper's 1e-5 m/s criterion. The drop keeps the system's own threshold.
   double min_roll_vel_m_s = 1e-6;
+  /// Creep-floor stop (0: off, every phase runs to the criteria or max_time_s). Once the RMS speed
+  /// is below max_speed_m_s (the bed quiet as a whole), a phase also ends when the RMS speed has not
+  /// set a new low by kPlateauNewLow in this long: on the paper's bed it falls to a floor of
+  /// 2-4e-5 m/s within ~0.4 s and then only creeps, with small avalanches, above the paper's 1e-5
+  /// (BENCHMARKS.md, issue 12), so the rest of the cap buys nothing.
+  double plateau_window_s = 0;
 };
+
+/// A new low of the RMS speed (creep-floor stop) must be below this fraction of the previous low.
+inline constexpr double kPlateauNewLow = 0.9;
+
+/// How a settling phase ended.
+enum class SettleEnd { criteria, plateau, time_cap };
+const char* to_string(SettleEnd e);
 
 /// The placement lattice's default spacing, in largest grain diameters (BedSpec).
 inline constexpr double kLatticeSpacingDiameters = 1.04;
@@ -76,7 +89,9 @@ struct BedReport {
   std::size_t grains_kept = 0;
   double settle_time_s = 0;
   double relax_time_s = 0;
-  bool settled = false;  ///< criteria met (false: the time cap ended a phase)
+  bool settled = false;  ///< criteria met in both phases (false: the time cap or the creep floor ended one)
+  SettleEnd settle_end = SettleEnd::time_cap;  ///< how the settling of the pour ended
+  SettleEnd relax_end = SettleEnd::time_cap;   ///< how the relaxation after flattening ended
   double rms_speed_m_s = 0;
   double max_speed_m_s = 0;
   double surface_height_m = 0;  ///< mean height of the top of the grains near the axis
@@ -90,9 +105,10 @@ void add_container_walls(System& sys, const ContainerSpec& c, double height_m, s
 /// needed for the grain count; returns the number placed.
 std::size_t place_grains(System& sys, const BedSpec& spec);
 
-/// Runs until the grains meet the criteria or the time cap; returns true if the criteria were met.
-bool settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress, BedPhase phase,
-            double* rms_out = nullptr, double* max_out = nullptr);
+/// Runs until the grains meet the criteria, reach their creep floor (c.plateau_window_s) or the time
+/// cap, after at least min_time_s; returns which ended it.
+SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress,
+                 BedPhase phase, double* rms_out = nullptr, double* max_out = nullptr);
 
 /// Takes gravity from its present value to `to_m_s2` geometrically over ramp_s (same direction; in
 /// any other case, or with ramp_s = 0, at once), advancing the system meanwhile.

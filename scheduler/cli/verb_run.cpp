@@ -23,14 +23,23 @@ namespace gravsweep::cli {
 namespace {
 
 /// How the bed's settling ended, against the scenario's criteria (/bed/settle): "settled to the
-/// criteria", or which criterion the time cap left unmet and by how much (the report's speeds are
-/// those at the end of the relax; `settled` needs the criteria met in both phases).
+/// criteria", or what ended it instead (the time cap, or the creep floor of /bed/settle/plateau_window_s)
+/// and which criterion it left unmet by how much (the report's speeds are those at the end of the
+/// relax; `settled` needs the criteria met in both phases; beds written before settle_end and
+/// relax_end were reported were always ended by the criteria or the time cap).
 std::string settling_outcome(const nlohmann::json& report, const SettleCriteria& criteria) {
   const double rms = report.at("rms_speed_m_s").get<double>(), fastest = report.at("max_speed_m_s").get<double>();
   const double rms_max = criteria.rms_speed_m_s, fastest_max = criteria.max_speed_m_s;
   if (report.at("settled").get<bool>())
     return fmt::format("settled to the criteria (rms {:.1e} m/s <= {:g}, fastest {:.1e} m/s <= {:g})", rms, rms_max,
                        fastest, fastest_max);
+  auto ended_by = [&](const char* phase_key) {
+    const std::string end = report.value(phase_key, std::string("time_cap"));
+    return end == "plateau" ? fmt::format("at the creep floor (the RMS speed fell by less than {:.0f} % in "
+                                          "/bed/settle/plateau_window_s = {:g} s)",
+                                          100 * (1 - kPlateauNewLow), criteria.plateau_window_s)
+                            : std::string("by the time cap /bed/settle/max_time_s");
+  };
   std::string unmet;
   auto add = [&](const char* what, double found, double limit) {
     if (found <= limit) return;
@@ -38,12 +47,11 @@ std::string settling_outcome(const nlohmann::json& report, const SettleCriteria&
   };
   add("rms", rms, rms_max);
   add("fastest grain", fastest, fastest_max);
-  if (unmet.empty())  // the pour's settling was capped; the relax after flattening then met the criteria
-    return fmt::format(
-        "settling stopped by the time cap /bed/settle/max_time_s before the criteria held; after the relax they "
-        "hold (rms {:.1e} m/s <= {:g}, fastest {:.1e} m/s <= {:g})",
-        rms, rms_max, fastest, fastest_max);
-  return fmt::format("settling stopped by the time cap /bed/settle/max_time_s ({})", unmet);
+  if (unmet.empty())  // the pour's settling ended early; the relax after flattening then met the criteria
+    return fmt::format("settling stopped {} before the criteria held; after the relax they hold (rms {:.1e} m/s "
+                       "<= {:g}, fastest {:.1e} m/s <= {:g})",
+                       ended_by("settle_end"), rms, rms_max, fastest, fastest_max);
+  return fmt::format("settling stopped {} ({})", ended_by("relax_end"), unmet);
 }
 
 struct RunOptions {

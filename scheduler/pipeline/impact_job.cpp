@@ -122,6 +122,8 @@ BedJobResult run_bed_job(const json& scenario, const std::filesystem::path& bed_
   json report{{"grains_placed", rep.grains_placed},
               {"grains_kept", rep.grains_kept},
               {"settled", rep.settled},
+              {"settle_end", to_string(rep.settle_end)},
+              {"relax_end", to_string(rep.relax_end)},
               {"settle_time_s", rep.settle_time_s},
               {"relax_time_s", rep.relax_time_s},
               {"rms_speed_m_s", rep.rms_speed_m_s},
@@ -325,7 +327,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   m["wall_time_s"] = wall_s;
   td.metrics_json = m.dump();
   check_stop(stop, "drop");
-  DropJobResult out{trace_out, m};
+  DropJobResult out{trace_out, m, {}, {}};
   if (snaps) {
     out.snapshots = snaps->count();
     out.snapshot_bytes = snaps->bytes_per_snapshot();

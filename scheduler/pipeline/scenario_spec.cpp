@@ -385,6 +385,8 @@ ScenarioParams scenario_params(const json& s) {
   b.settle.max_time_s = bj["/settle/max_time_s"_json_pointer];
   b.settle.check_interval_s = bj["/settle/check_interval_s"_json_pointer];
   b.settle.min_roll_vel_m_s = bj["/settle/min_roll_vel_m_s"_json_pointer];
+  // Optional and without a default (0 = off), so that the bed keys of existing beds stay.
+  b.settle.plateau_window_s = bj.at("settle").value("plateau_window_s", 0.0);
   b.relax_time_s = bj.at("relax_time_s");
   b.grain_material = kGrainMaterial;
   b.wall_material = kWallMaterial;

@@ -109,6 +109,35 @@ TEST(Bed, GravityRampUnloadsTheBedGently) {
   EXPECT_LT(3 * ramped, sudden);
 }
 
+// Issue 12, the creep-floor stop (/bed/settle/plateau_window_s): a poured column whose criteria are
+// out of reach (rms 1e-7 m/s) ends its settling at the floor, after the pour has landed and with
+// the bed quiet (rms below the fastest-grain criterion), long before the cap; settling on for
+// another 0.2 s does not lower the RMS speed much below that floor, so the cap would buy nothing.
+TEST(Bed, SettlingStopsAtTheCreepFloorOnceTheBedIsQuiet) {
+  auto s = settled_column(0.08, 0.09, 0.0, 1);  // placed on the lattice, not yet poured
+  SettleCriteria c;
+  c.rms_speed_m_s = 1e-7;  // out of reach
+  c.max_speed_m_s = 1e-3;
+  c.max_time_s = 2.0;
+  c.plateau_window_s = 0.05;
+  double rms = 0, mx = 0;
+  const SettleEnd end = settle(*s, c, 0.0, {}, BedPhase::settle, &rms, &mx);
+  const double t_floor_s = s->time_s();
+  std::printf("creep floor at t = %.3f s: rms %.2e m/s, fastest %.2e m/s\n", t_floor_s, rms, mx);
+  EXPECT_EQ(end, SettleEnd::plateau);
+  EXPECT_GT(t_floor_s, 0.1 + c.plateau_window_s);  // the lattice falls ~9 cm first: ~0.14 s
+  EXPECT_LT(t_floor_s, 1.0);
+  EXPECT_LT(rms, c.max_speed_m_s);
+
+  SettleCriteria on = c;
+  on.plateau_window_s = 0;  // off: the time cap ends it
+  on.max_time_s = 0.2;
+  double rms_on = 0, mx_on = 0;
+  EXPECT_EQ(settle(*s, on, 0.0, {}, BedPhase::settle, &rms_on, &mx_on), SettleEnd::time_cap);
+  std::printf("0.2 s later: rms %.2e m/s, fastest %.2e m/s\n", rms_on, mx_on);
+  EXPECT_GT(rms_on, 0.2 * rms);
+}
+
 // 1 and 2 threads agree on a settled 500-grain bed after 1,000 steps: the only difference is the
 // order in which per-thread force buffers are summed (round-off), so positions agree to 1e-9 m
 // (2e-7 of a grain radius). The same thread count twice gives bit-identical results.

@@ -276,6 +276,30 @@ TEST(RunVerb, WritesBedTraceAndMetricsThenReusesTheBed) {
   EXPECT_NEAR(m2["vc_m_s"].get<double>(), 1.3, 0.08);
 }
 
+
+// Issue 12: with /bed/settle/plateau_window_s a bed whose criteria are out of reach stops at the
+// creep floor, long before the 2 s caps, and the bed line and report say so.
+TEST(RunVerb, ABedOutOfReachOfItsCriteriaStopsAtTheCreepFloorAndSaysSo) {
+  test::TempDir dir;
+  json s = test::tiny_scenario();
+  s["bed"]["settle"] = {{"rms_speed_m_s", 1e-8}, {"max_speed_m_s", 5e-3}, {"max_time_s", 2.0},
+                        {"plateau_window_s", 0.03}};
+  const auto spec = dir.path / "floor.json";
+  std::ofstream(spec) << s.dump(2);
+  const auto out = dir.path / "run";
+  const Cli r = gravsweep_cli(dir, "run " + spec.string() + " --out " + out.string() + " --threads 1 --quiet");
+  ASSERT_EQ(r.code, 0) << r.out << r.err;
+  const json rep = json::parse(std::ifstream(out / "metrics.json"))["bed_report"];
+  EXPECT_EQ(rep["settle_end"], "plateau") << rep.dump();
+  EXPECT_EQ(rep["relax_end"], "plateau") << rep.dump();
+  EXPECT_FALSE(rep["settled"].get<bool>());
+  EXPECT_LT(rep["settle_time_s"].get<double>(), 1.0);
+  EXPECT_LT(rep["relax_time_s"].get<double>(), 1.0);
+  EXPECT_NE(r.out.find("settling stopped at the creep floor (the RMS speed fell by less than 10 % in "
+                       "/bed/settle/plateau_window_s = 0.03 s) (rms "),
+            std::string::npos)
+      << r.out;
+}
 TEST(RunVerb, BadSpecExitsWithCode2AndThePointerBeforeAnyWork) {
   test::TempDir dir;
   json bad = test::tiny_scenario();
