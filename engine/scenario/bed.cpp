@@ -118,8 +118,8 @@ const char* to_string(SettleEnd e) {
   return "?";
 }
 
-SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress,
-                 BedPhase phase, double* rms_out, double* max_out) {
+SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress, BedPhase phase,
+                 double* rms_out, double* max_out) {
   const double dt = sys.config().dt_s;
   // The settling threshold of rolling friction holds for this phase only (SettleCriteria).
   struct ThresholdScope {
@@ -156,7 +156,8 @@ SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const 
     } else if (rms < kPlateauNewLow * low_m_s) {
       low_m_s = rms;
       low_at_s = elapsed;
-    } else if (c.plateau_window_s > 0 && elapsed >= min_time_s && elapsed - low_at_s >= c.plateau_window_s) {
+    } else if (c.plateau_window_s > 0 && elapsed >= min_time_s && elapsed - low_at_s >= c.plateau_window_s &&
+               rms < low_m_s / kPlateauNewLow) {  // at the floor now, not in a burst above it
       end = SettleEnd::plateau;
       break;
     }

@@ -35,7 +35,8 @@ struct SettleCriteria {
   double min_roll_vel_m_s = 1e-6;
   /// Creep-floor stop (0: off, every phase runs to the criteria or max_time_s). Once the RMS speed
   /// is below max_speed_m_s (the bed quiet as a whole), a phase also ends when the RMS speed has not
-  /// set a new low by kPlateauNewLow in this long: on the paper's bed it falls to a floor of
+  /// set a new low by kPlateauNewLow in this long and is back within that factor of the low (not
+  /// in a burst above it): on the paper's bed it falls to a floor of
   /// 2-4e-5 m/s within ~0.4 s and then only creeps, with small avalanches, above the paper's 1e-5
   /// (BENCHMARKS.md, issue 12), so the rest of the cap buys nothing.
   double plateau_window_s = 0;
@@ -107,8 +108,8 @@ std::size_t place_grains(System& sys, const BedSpec& spec);
 
 /// Runs until the grains meet the criteria, reach their creep floor (c.plateau_window_s) or the time
 /// cap, after at least min_time_s; returns which ended it.
-SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress,
-                 BedPhase phase, double* rms_out = nullptr, double* max_out = nullptr);
+SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress, BedPhase phase,
+                 double* rms_out = nullptr, double* max_out = nullptr);
 
 /// Takes gravity from its present value to `to_m_s2` geometrically over ramp_s (same direction; in
 /// any other case, or with ramp_s = 0, at once), advancing the system meanwhile.

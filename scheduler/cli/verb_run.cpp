@@ -35,9 +35,10 @@ std::string settling_outcome(const nlohmann::json& report, const SettleCriteria&
                        fastest, fastest_max);
   auto ended_by = [&](const char* phase_key) {
     const std::string end = report.value(phase_key, std::string("time_cap"));
-    return end == "plateau" ? fmt::format("at the creep floor (the RMS speed fell by less than {:.0f} % in "
-                                          "/bed/settle/plateau_window_s = {:g} s)",
-                                          100 * (1 - kPlateauNewLow), criteria.plateau_window_s)
+    return end == "plateau" ? fmt::format(
+                                  "at the creep floor (the RMS speed fell by less than {:.0f} % in "
+                                  "/bed/settle/plateau_window_s = {:g} s)",
+                                  100 * (1 - kPlateauNewLow), criteria.plateau_window_s)
                             : std::string("by the time cap /bed/settle/max_time_s");
   };
   std::string unmet;
@@ -48,10 +49,16 @@ std::string settling_outcome(const nlohmann::json& report, const SettleCriteria&
   add("rms", rms, rms_max);
   add("fastest grain", fastest, fastest_max);
   if (unmet.empty())  // the pour's settling ended early; the relax after flattening then met the criteria
-    return fmt::format("settling stopped {} before the criteria held; after the relax they hold (rms {:.1e} m/s "
-                       "<= {:g}, fastest {:.1e} m/s <= {:g})",
-                       ended_by("settle_end"), rms, rms_max, fastest, fastest_max);
-  return fmt::format("settling stopped {} ({})", ended_by("relax_end"), unmet);
+    return fmt::format(
+        "settling stopped {} before the criteria held; after the relax they hold (rms {:.1e} m/s "
+        "<= {:g}, fastest {:.1e} m/s <= {:g})",
+        ended_by("settle_end"), rms, rms_max, fastest, fastest_max);
+  const std::string pour_end = report.value("settle_end", std::string("time_cap"));
+  const bool pour_ended_otherwise =
+      pour_end != "criteria" && pour_end != report.value("relax_end", std::string("time_cap"));
+  return fmt::format(
+      "settling stopped {} ({}){}", ended_by("relax_end"), unmet,
+      pour_ended_otherwise ? "; the pour's settling before flattening ended " + ended_by("settle_end") : "");
 }
 
 struct RunOptions {

@@ -183,19 +183,18 @@ void engine_checks(const json& s, Checks& ck) {
     add_container_walls(sys, cs, 5.0, kWallMaterial);
     sys.initialize();
   };
-  const bool own_bed_materials = s.at("bed").contains("materials");
-  if (own_bed_materials && !ck.sound("/bed/materials")) return;
-  // Each time step is checked with the materials it is used with: the bed's and the drop's.
-  const std::pair<const char*, const char*> uses[] = {{"/materials", "/dt_s"},
-                                                      {own_bed_materials ? "/bed/materials" : "/materials", "/bed/dt_s"}};
+  const char* bed_materials_pointer = s.at("bed").contains("materials") ? "/bed/materials" : "/materials";
+  // Each time step is checked with the materials it is used with: the drop's and the bed's.
+  const std::pair<const char*, const char*> uses[] = {{"/materials", "/dt_s"}, {bed_materials_pointer, "/bed/dt_s"}};
   for (const auto& [materials_pointer, dt_pointer] : uses) {
+    if (!ck.sound(materials_pointer)) continue;
     const json& m = s[json::json_pointer(materials_pointer)];
     try {
       build(1e-12, m);
     } catch (const ConfigError& e) {
       ck.bad(materials_pointer, fmt::format("parameters the engine rejects ({})", e.what()),
              "materials and contact.pairs valid for the contact law");
-      return;
+      continue;
     }
     if (!ck.sound(dt_pointer)) continue;
     const double dt = s[json::json_pointer(dt_pointer)];
@@ -236,6 +235,14 @@ void check_size_and_steps(Checks& ck) {
                          grains, need / 1e9),
              fmt::format("a bed that fits this machine's memory ({:.3g} GB; at most about {:.3g} grains)", have / 1e9,
                          0.8 * have / kBytesPerGrain));
+  });
+  ck.run([&] {  // the creep-floor window: longer than a check, shorter than the cap it would shorten
+    if (!ck.sound("/bed/settle/plateau_window_s")) return;
+    const double w = ck.num("/bed/settle/plateau_window_s");
+    const double check = ck.num("/bed/settle/check_interval_s"), cap = ck.num("/bed/settle/max_time_s");
+    if (!(w >= check && w < cap))
+      ck.bad("/bed/settle/plateau_window_s",
+             fmt::format("a window of at least check_interval_s ({:g} s) and below max_time_s ({:g} s)", check, cap));
   });
   ck.run([&] {
     const double steps = ck.num("/stop/max_time_s") / ck.num("/dt_s");

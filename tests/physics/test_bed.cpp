@@ -127,7 +127,6 @@ TEST(Bed, SettlingStopsAtTheCreepFloorOnceTheBedIsQuiet) {
   EXPECT_EQ(end, SettleEnd::plateau);
   EXPECT_GT(t_floor_s, 0.1 + c.plateau_window_s);  // the lattice falls ~9 cm first: ~0.14 s
   EXPECT_LT(t_floor_s, 1.0);
-  EXPECT_LT(rms, c.max_speed_m_s);
 
   SettleCriteria on = c;
   on.plateau_window_s = 0;  // off: the time cap ends it

@@ -7,6 +7,7 @@
 
 #include "engine/scenario/paper_params.h"
 #include "scenario_helpers.h"
+#include "scheduler/pipeline/impact_job.h"
 #include "scheduler/pipeline/scenario_spec.h"
 #include "spec/schemas.h"
 
@@ -183,10 +184,29 @@ TEST(ScenarioSpec, TimeStepsAboveTheStabilityBoundAreRefused) {
   refused_at(s, "/bed/dt_s");
 }
 
+TEST(ScenarioSpec, ThePlateauWindowLiesBetweenACheckAndTheCap) {
+  json s = minimal();
+  s["bed"]["settle"]["plateau_window_s"] = 0.0;
+  refused_at(s, "/bed/settle/plateau_window_s");  // absent is off; 0 would be a second spelling
+  s["bed"]["settle"]["plateau_window_s"] = 1e-4;  // below the 1 ms check interval
+  refused_at(s, "/bed/settle/plateau_window_s");
+  s["bed"]["settle"]["plateau_window_s"] = 2.0;  // the default cap: it could never end a phase
+  refused_at(s, "/bed/settle/plateau_window_s");
+  s["bed"]["settle"]["plateau_window_s"] = 0.1;
+  EXPECT_NO_THROW(validate_scenario(s));
+}
+
 TEST(ScenarioSpec, TheBedsOwnMaterialsAreCheckedWithTheBedsTimeStep) {
   json s = minimal();
   s["bed"]["materials"]["grain"]["cor_normal"] = 1.5;
-  refused_at(s, "/bed/materials/grain/cor_normal");
+  s["dt_s"] = 5e-5;  // still checked (the drop's materials are sound), so both problems are listed
+  try {
+    validate_scenario(s, "spec.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const SpecError& e) {
+    EXPECT_NE(std::string(e.what()).find("/bed/materials/grain/cor_normal"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("/dt_s"), std::string::npos) << e.what();
+  }
   s = minimal();
   s["bed"]["materials"]["grain"]["young_modulus_Pa"] = 7e10;  // 100x stiffer: bound ~1.5 us
   refused_at(s, "/bed/dt_s");  // the default 5 us preparation step, checked with the bed's materials
@@ -214,6 +234,20 @@ TEST(ScenarioSpec, ExamplesAreValid) {
     ++n;
   }
   EXPECT_GE(n, 2);
+}
+
+// Examples that say they share a bed do: impact_1g_dt5us.json reuses impact_1g.json's bed (--bed),
+// and part 5b's drops land on part 5's cached bed (REPRODUCTION.md) through /bed/materials.
+TEST(ScenarioSpec, ExamplesThatShareABedHaveOneBedKey) {
+  const std::string ex = std::string(GRAVSWEEP_SOURCE_DIR) + "/examples/";
+  EXPECT_EQ(pipeline::bed_key(pipeline::load_scenario(ex + "impact_1g.json")),
+            pipeline::bed_key(pipeline::load_scenario(ex + "impact_1g_dt5us.json")));
+  auto base = [&](const std::string& sweep) {
+    return json::parse(std::ifstream(ex + "reproduction/" + sweep)).at("base");
+  };
+  const json part5 = base("part5_pkdgrav_1g.json"), part5b = base("part5b_pkdgrav_stiff_1g.json");
+  EXPECT_EQ(pipeline::bed_key(part5b), pipeline::bed_key(part5));
+  EXPECT_NE(part5b.at("materials"), part5.at("materials"));  // the drops' springs differ
 }
 
 TEST(ScenarioSpec, JsonSyntaxErrorsNameFileLineAndColumn) {
