@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -167,6 +168,11 @@ void run_bench(const BenchOptions& o) {
     fmt::print("{:<18} {:>9} {:>8} {:>22.1f} {:>22.2f} {:>20.0f} {:>16.0f}\n", r.bed, r.grains, r.threads,
                r.ns_per_particle_step, r.contacts_per_particle, r.bytes_per_particle, r.neighbour_builds);
   fmt::print("\n{} steps at dt = {} s, Table 1 Chrono set (hertz + sunday rolling, mu_r = 0.09).\n", o.steps, o.dt_s);
+  // The barrier wait of the threads moves the 2-thread figure by 10 % (main.cpp, BENCHMARKS.md).
+  const char* policy = std::getenv("OMP_WAIT_POLICY");
+  const char* spins = std::getenv("GOMP_SPINCOUNT");
+  fmt::print("OpenMP barrier waits: OMP_WAIT_POLICY={}, GOMP_SPINCOUNT={}.\n", policy ? policy : "(unset)",
+             spins ? spins : "(unset)");
 }
 
 }  // namespace

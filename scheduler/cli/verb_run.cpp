@@ -219,8 +219,9 @@ void setup_run(CLI::App& app) {
       "      drop's /materials when /bed/materials names the bed's (a stiffer spring on the same bed)\n"
       "--bed checks the bed against BED.sha256 first and refuses (exit 2) a bed that changed or is\n"
       "not a readable bed file; a bed without BED.sha256 (older runs) is used with a warning.\n\n"
-      "gravsweep waits passively between OpenMP steps (OMP_WAIT_POLICY=passive unless you set it):\n"
-      "with spinning threads an oversubscribed 2-core machine ran the paper's bed ~50x slower.");
+      "gravsweep's OpenMP threads spin briefly, then sleep, at each barrier (OMP_WAIT_POLICY=passive,\n"
+      "GOMP_SPINCOUNT=500, unless you set OMP_WAIT_POLICY): with unbounded spinning an oversubscribed\n"
+      "2-core machine ran the paper's bed ~50x slower; the short spin saves 10 % on a quiet machine.");
   sub->add_option("scenario", opt->scenario, "scenario spec (JSON, see schemas/scenario.schema.json)")
       ->required()
       ->check(CLI::ExistingFile);
