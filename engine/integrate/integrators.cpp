@@ -1,6 +1,9 @@
 #include "engine/integrate/integrators.h"
 
 #include <fmt/format.h>
+#include <omp.h>
+
+#include <algorithm>
 
 #include "engine/core/error.h"
 
@@ -8,46 +11,30 @@ namespace gravsweep {
 
 namespace {
 
-/// Runs body(i) on every particle in parallel; body returns the particle's new position, which
-/// the step checks read from registers (re-reading it from memory right after the store stalls).
+/// Runs body(i) on particles [begin, end); body returns the particle's new position, which the
+/// step checks read from registers (re-reading it from memory right after the store stalls).
 template <class Body>
-void end_loop(Particles& p, StepCheck& check, Body&& body) {
-  const std::size_t n = p.size();
-  long long bad = -1;
-  StateFault cause = StateFault::none;
-  double max_d2 = 0;
-#pragma omp parallel reduction(max : max_d2)
-  {
-    long long my_bad = -1;
-    StateFault my_cause = StateFault::none;
-#pragma omp for schedule(static) nowait
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec3 x = body(i);
-      const StateFault c = check.visit(x, i, &max_d2);
-      if (c != StateFault::none && my_bad < 0) {
-        my_bad = static_cast<long long>(i);
-        my_cause = c;
-      }
-    }
-    if (my_bad >= 0) {
-#pragma omp critical(gravsweep_step_check)
-      if (bad < 0 || my_bad < bad) {
-        bad = my_bad;
-        cause = my_cause;
-      }
+GRAVSWEEP_INLINE void end_loop(const StepCheck& check, std::size_t begin, std::size_t end, StepFindings& found,
+                               Body&& body) {
+  double max_d2 = found.max_displacement2_m2;
+  for (std::size_t i = begin; i < end; ++i) {
+    const Vec3 x = body(i);
+    const StateFault c = check.visit(x, i, &max_d2);
+    if (c != StateFault::none && found.bad_particle < 0) {
+      found.bad_particle = static_cast<long long>(i);
+      found.bad_cause = c;
     }
   }
-  check.bad_particle = bad;
-  check.bad_cause = cause;
-  check.max_displacement2_m2 = max_d2;
+  found.max_displacement2_m2 = max_d2;
 }
 
 /// Chrono::Multicore: v_{n+1} = v_n + h a(x_n, v_n); x_{n+1} = x_n + h v_{n+1} (dem-physics.md 1.6).
 class SemiImplicitEuler final : public Integrator {
  public:
   void begin_step(Particles&, double) override {}
-  void end_step(Particles& p, double dt, StepCheck& check) override {
-    end_loop(p, check, [&](std::size_t i) -> Vec3 {
+  void end_range(Particles& p, double dt, const StepCheck& check, std::size_t begin, std::size_t end,
+                 StepFindings& found) const override {
+    end_loop(check, begin, end, found, [&](std::size_t i) -> Vec3 {
       const Vec3 v = p.velocity_m_s[i] + dt * p.inv_mass_1_kg[i] * p.force_N[i];
       p.velocity_m_s[i] = v;
       p.omega_rad_s[i] += dt * p.inv_inertia_1_kg_m2[i] * p.torque_N_m[i];
@@ -71,8 +58,9 @@ class VelocityVerlet final : public Integrator {
       if (p.inv_mass_1_kg[i] > 0) p.position_m[i] += dt * p.velocity_m_s[i];
     }
   }
-  void end_step(Particles& p, double dt, StepCheck& check) override {
-    end_loop(p, check, [&](std::size_t i) -> Vec3 {
+  void end_range(Particles& p, double dt, const StepCheck& check, std::size_t begin, std::size_t end,
+                 StepFindings& found) const override {
+    end_loop(check, begin, end, found, [&](std::size_t i) -> Vec3 {
       const Vec3 v = p.velocity_m_s[i] + 0.5 * dt * p.inv_mass_1_kg[i] * p.force_N[i];
       p.velocity_m_s[i] = v;
       p.omega_rad_s[i] += 0.5 * dt * p.inv_inertia_1_kg_m2[i] * p.torque_N_m[i];
@@ -101,8 +89,9 @@ class LeapfrogKdk final : public Integrator {
       if (p.inv_mass_1_kg[i] > 0) p.position_m[i] += dt * p.velocity_m_s[i];
     }
   }
-  void end_step(Particles& p, double dt, StepCheck& check) override {
-    end_loop(p, check, [&](std::size_t i) -> Vec3 {
+  void end_range(Particles& p, double dt, const StepCheck& check, std::size_t begin, std::size_t end,
+                 StepFindings& found) const override {
+    end_loop(check, begin, end, found, [&](std::size_t i) -> Vec3 {
       const Vec3 v = p.velocity_m_s[i] + 0.5 * dt * p.inv_mass_1_kg[i] * p.force_N[i];
       p.velocity_m_s[i] = v;
       p.omega_rad_s[i] += 0.5 * dt * p.inv_inertia_1_kg_m2[i] * p.torque_N_m[i];
@@ -118,6 +107,17 @@ std::unique_ptr<Integrator> make() {
 }
 
 }  // namespace
+
+void StepCheck::merge(const StepFindings& f) {
+#pragma omp critical(gravsweep_step_check)
+  {
+    if (f.bad_particle >= 0 && (bad_particle < 0 || f.bad_particle < bad_particle)) {
+      bad_particle = f.bad_particle;
+      bad_cause = f.bad_cause;
+    }
+    max_displacement2_m2 = std::max(max_displacement2_m2, f.max_displacement2_m2);
+  }
+}
 
 const std::vector<IntegratorEntry>& integrator_table() {
   static const std::vector<IntegratorEntry> table = {

@@ -1,10 +1,12 @@
 // Time integrators, selected by name from one table (integrate/integrators.cpp).
-// Each splits a step into begin_step (before forces) and end_step (after forces); forces already
-// include gravity. Rotations use the sphere's scalar inertia (no gyroscopic term for spheres).
+// Each splits a step into begin_step (before forces) and end_range (after forces, run by the force
+// loop on each thread's share); forces already include gravity. Rotations use the sphere's scalar inertia (no
+// gyroscopic term for spheres).
 #pragma once
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -19,6 +21,23 @@ enum class StateFault : unsigned char {
   non_finite,      ///< NaN or inf in the position (a bad velocity reaches it in the same step)
   outside_domain,  ///< the centre left the domain: the particle left the container
 };
+
+/// What the end-of-step checks found on one thread's share of the particles.
+struct StepFindings {
+  long long bad_particle = -1;  ///< the first particle of the share whose state is bad
+  StateFault bad_cause = StateFault::none;
+  double max_displacement2_m2 = 0;
+};
+
+/// Particles [first, second) of n, thread t's even share of nt (the split of schedule(static)):
+/// the force sums and the end of step of a particle fall to the same thread.
+inline std::pair<std::size_t, std::size_t> even_share(std::size_t n, int t, int nt) {
+  const auto cut = [&](int k) {
+    return n / static_cast<std::size_t>(nt) * static_cast<std::size_t>(k) +
+           std::min(n % static_cast<std::size_t>(nt), static_cast<std::size_t>(k));
+  };
+  return {cut(t), cut(t + 1)};
+}
 
 /// Checks made on every particle in the integrator's last loop of a step, so the state is read
 /// once: non-finite values, a centre outside the domain, and the largest displacement since the
@@ -42,6 +61,9 @@ struct StepCheck {
     if (position_at_build != nullptr) *max_d2 = std::max(*max_d2, (x - position_at_build[i]).squaredNorm());
     return StateFault::none;
   }
+  /// Adds one share's findings (thread-safe): the lowest bad particle wins, displacements take
+  /// the maximum.
+  void merge(const StepFindings& f);
 };
 
 class Integrator {
@@ -49,8 +71,11 @@ class Integrator {
   virtual ~Integrator() = default;
   /// Called before the force evaluation of the step.
   virtual void begin_step(Particles& p, double dt_s) = 0;
-  /// Called after the forces at the new positions are known; runs `check` on every particle.
-  virtual void end_step(Particles& p, double dt_s, StepCheck& check) = 0;
+  /// The end of step of particles [begin, end), checked with `check`, findings into `found`;
+  /// called by each thread of a parallel region on its share (System::step runs it inside the
+  /// force loop's region).
+  virtual void end_range(Particles& p, double dt_s, const StepCheck& check, std::size_t begin, std::size_t end,
+                         StepFindings& found) const = 0;
   /// True when the force loop must read Particles::eval_velocity/eval_omega (predicted velocities).
   [[nodiscard]] virtual bool uses_eval_velocities() const { return false; }
   /// True when begin_step needs the forces of the previous step (evaluated once before step 1).

@@ -14,6 +14,16 @@
 
 namespace gravsweep {
 
+/// Work of a row of the pair loop, in units of a listed pair that does not touch (a distance
+/// test): a row costs kRowWork, a touching pair kTouchingWork more (the contact law). Set so
+/// that the two threads of the 0.1 m/s2 drop spend equal time in pair + wall work (perf per
+/// thread: 35.5 % / 35.8 % of the samples at 6 and 9; 3 and 6 left thread 0 15 % more, 10 and 14
+/// left thread 1 10 % more; BENCHMARKS.md, issue 12).
+inline constexpr std::uint32_t kRowWork = 2;
+inline constexpr std::uint32_t kTouchingWork = 6;
+/// Work of a particle-wall candidate in the same units (System adds it, add_wall_work).
+inline constexpr std::uint32_t kWallWork = 9;
+
 class VerletList {
  public:
   static constexpr double kLargeRadiusFactor = 2.5;
@@ -39,6 +49,14 @@ class VerletList {
   std::vector<ContactHistory> history;
   /// Beside history, only when frame histories are kept (set_frame_history); else empty.
   std::vector<FrameHistory> frame_history;
+  /// Pair-loop work before row i, for splitting the rows between threads (force_loop.h,
+  /// balanced_rows): the sum over earlier rows of listed pairs + kTouchingWork x touching pairs
+  /// (active histories carried over at the build) + kRowWork. Set by build(); empty after
+  /// clear(), extend() and remap() until the next build (the split then weighs listed pairs only).
+  std::vector<std::uint32_t> work_offset;
+  /// Adds `work` per particle-wall candidate to the work prefix of the last build (codes
+  /// particle * walls + wall, increasing, as System keeps them); nothing when there is none.
+  void add_wall_work(const std::vector<std::uint32_t>& codes, std::size_t walls, std::uint32_t work);
 
   /// Keep a FrameHistory per pair (the law or rolling model uses_frame_history). Switching it on
   /// gives every listed pair an empty record.

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "engine/contact/hertz_batch.h"
@@ -50,6 +51,10 @@ struct ForceContext {
   bool use_eval_velocities;
   bool track_energy;
   int threads;
+  /// Set inside System::step: the integrator's end of step runs on each thread's share right
+  /// after the force sums (one parallel region a step), its findings merged into *check.
+  const Integrator* finish = nullptr;
+  StepCheck* check = nullptr;
   // Outputs.
   StepStats stats{};
   OverlapFailure failure{};
@@ -63,15 +68,53 @@ struct TouchingPair {
   double dist2_m2, m_eff_kg;
 };
 
-/// The pair skeleton every particle-particle path shares (scalar and batched): this thread's
-/// static share of the half neighbour list (orphaned `omp for`, inside force_loop's parallel
-/// region); a listed pair that no longer touches has its history erased; two fixed particles are
-/// skipped; an overlap beyond kMaxOverlapFraction is recorded in `worst` (the exact ratio is
-/// computed only then); visit(const TouchingPair&, ContactHistory&) evaluates the rest.
+/// Rows [begin, end) of thread t's share (of nt) of the half list: cut where the pair-loop work
+/// before a row (`work`, n + 1 prefix sums, plus `row_work` per row) reaches t / nt of the total,
+/// so a thread whose rows hold more touching pairs gets fewer rows. Static rows gave thread 0 1.5x
+/// thread 1's pair work in a 0.1 m/s2 drop: after the gravity ramp the bottom of the bed keeps its
+/// contacts and the top opens (BENCHMARKS.md, issue 12). Depends only on the list: every step
+/// between two builds cuts alike.
+inline std::pair<std::size_t, std::size_t> balanced_rows(const std::uint32_t* work, std::uint32_t row_work,
+                                                         std::size_t n, int t, int nt) {
+  if (n == 0) return {0, 0};
+  auto before = [&](std::size_t i) {
+    return static_cast<double>(work[i]) + static_cast<double>(row_work) * static_cast<double>(i);
+  };
+  auto cut = [&](int k) -> std::size_t {
+    if (k <= 0) return 0;
+    if (k >= nt) return n;
+    const double target = before(n) * k / nt;
+    std::size_t lo = 0, hi = n;  // the first row with at least `target` work before it
+    while (lo < hi) {
+      const std::size_t mid = lo + (hi - lo) / 2;
+      if (before(mid) < target)
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    return lo;
+  };
+  return {cut(t), cut(t + 1)};
+}
+
+/// The rows of the half list one thread takes in force_loop: [begin, end). A thread writes forces
+/// only to particles from its first row on (each pair is listed under its smaller index), which
+/// is what lets force_loop clear and sum no more of a thread's buffer than that.
+struct ThreadRows {
+  std::size_t begin = 0, end = 0;
+};
+
+/// The pair skeleton every particle-particle path shares (scalar and batched): rows [row_begin,
+/// row_end) of the half neighbour list, this thread's share (force_loop cuts it with
+/// balanced_rows); a listed pair that no longer touches has its history erased; two fixed
+/// particles are skipped; an overlap beyond kMaxOverlapFraction is recorded in `worst` (the exact
+/// ratio is computed only then); visit(const TouchingPair&, ContactHistory&) evaluates the rest.
+/// Always inlined: called through a lambda, the batch state of the caller would otherwise be read
+/// through references on every pair (+10 % on the 1 g drop, measured).
 template <class Visit>
-void for_each_touching_pair(ForceContext& c, OverlapFailure& worst, Visit&& visit) {
+GRAVSWEEP_INLINE void for_each_touching_pair(ForceContext& c, std::size_t row_begin, std::size_t row_end,
+                                             OverlapFailure& worst, Visit&& visit) {
   const Particles& p = c.p;
-  const std::size_t n = p.size();
   const Vec3* X = p.position_m.data();
   const double* R = p.radius_m.data();
   const double* M = p.mass_kg.data();
@@ -79,8 +122,7 @@ void for_each_touching_pair(ForceContext& c, OverlapFailure& worst, Visit&& visi
   const std::uint32_t* off = c.nlist.offset.data();
   const std::uint32_t* nbr = c.nlist.neighbor.data();
   ContactHistory* hist = c.nlist.history.data();
-#pragma omp for schedule(static) nowait
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = row_begin; i < row_end; ++i) {
     const Vec3 xi = X[i];
     const double ri = R[i];
     for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
@@ -119,7 +161,8 @@ GRAVSWEEP_INLINE void evaluate_contact(const ContactGeometry& g, const PairCoeff
 /// or none rolling): the touching pairs of this thread's share are gathered into batches,
 /// evaluated vectorised, and scattered back in list order.
 template <bool kRolling>
-void pair_loop_batched(ForceContext& c, Vec3* F, Vec3* T, long long& contacts, double& energy, OverlapFailure& worst) {
+void pair_loop_batched(ForceContext& c, const ThreadRows& rows, Vec3* F, Vec3* T, long long& contacts, double& energy,
+                       OverlapFailure& worst) {
   const Particles& p = c.p;
   const Vec3* V = c.use_eval_velocities ? p.eval_velocity_m_s.data() : p.velocity_m_s.data();
   const Vec3* W = c.use_eval_velocities ? p.eval_omega_rad_s.data() : p.omega_rad_s.data();
@@ -150,7 +193,7 @@ void pair_loop_batched(ForceContext& c, Vec3* F, Vec3* T, long long& contacts, d
     contacts += batch.count;
     batch.count = 0;
   };
-  for_each_touching_pair(c, worst, [&](const TouchingPair& t, ContactHistory& h) {
+  for_each_touching_pair(c, rows.begin, rows.end, worst, [&](const TouchingPair& t, ContactHistory& h) {
     const std::uint32_t i = t.i, j = t.j;
     batch.add(t.k, i, j, t.d_m, t.dist2_m2, R[i], R[j], t.m_eff_kg, V[i], V[j], W[i], W[j], c.pairs(mat[i], mat[j]), h);
     if (batch.full()) flush();
@@ -161,7 +204,8 @@ void pair_loop_batched(ForceContext& c, Vec3* F, Vec3* T, long long& contacts, d
 /// The particle-particle part of force_loop for every other (law, rolling) pair: one contact at
 /// a time through evaluate_contact.
 template <class Law, class Rolling>
-void pair_loop_scalar(ForceContext& c, Vec3* F, Vec3* T, long long& contacts, double& energy, OverlapFailure& worst) {
+void pair_loop_scalar(ForceContext& c, const ThreadRows& rows, Vec3* F, Vec3* T, long long& contacts, double& energy,
+                      OverlapFailure& worst) {
   constexpr bool kFrames = Law::uses_frame_history || Rolling::uses_frame_history;
   const Particles& p = c.p;
   const Vec3* V = c.use_eval_velocities ? p.eval_velocity_m_s.data() : p.velocity_m_s.data();
@@ -172,7 +216,7 @@ void pair_loop_scalar(ForceContext& c, Vec3* F, Vec3* T, long long& contacts, do
   ContactForce out;
   ContactGeometry g;
   FrameHistory scratch;  // frame histories are stored only when a model reads them
-  for_each_touching_pair(c, worst, [&](const TouchingPair& t, ContactHistory& h) {
+  for_each_touching_pair(c, rows.begin, rows.end, worst, [&](const TouchingPair& t, ContactHistory& h) {
     const std::uint32_t i = t.i, j = t.j;
     const double dist = std::sqrt(t.dist2_m2);
     const double rsum = R[i] + R[j];
@@ -197,9 +241,11 @@ void pair_loop_scalar(ForceContext& c, Vec3* F, Vec3* T, long long& contacts, do
   });
 }
 
-/// Particle-wall contacts: this thread's static share of the wall candidates (particle, wall).
+/// Particle-wall contacts: the wall candidates (particle, wall) of this thread's rows, so that a
+/// thread writes only to particles from its first row on (force_loop sums no more than that).
 template <class Law, class Rolling>
-void wall_loop(ForceContext& c, Vec3* F, Vec3* T, long long& wall_contacts, double& energy, OverlapFailure& worst) {
+void wall_loop(ForceContext& c, const ThreadRows& rows, Vec3* F, Vec3* T, long long& wall_contacts, double& energy,
+               OverlapFailure& worst) {
   constexpr bool kFrames = Law::uses_frame_history || Rolling::uses_frame_history;
   const std::size_t n_walls = c.walls.size();
   if (n_walls == 0) return;
@@ -214,9 +260,13 @@ void wall_loop(ForceContext& c, Vec3* F, Vec3* T, long long& wall_contacts, doub
   ContactForce out;
   ContactGeometry g;
   FrameHistory scratch;
-  const std::size_t n_cand = c.wall_candidates.size();
-#pragma omp for schedule(static) nowait
-  for (std::size_t k = 0; k < n_cand; ++k) {
+  // Candidate codes are particle * walls + wall, increasing.
+  auto below = [](std::uint32_t code, std::uint64_t bound) { return code < bound; };
+  const auto first =
+      std::lower_bound(c.wall_candidates.begin(), c.wall_candidates.end(), std::uint64_t{rows.begin} * n_walls, below);
+  const auto last = std::lower_bound(first, c.wall_candidates.end(), std::uint64_t{rows.end} * n_walls, below);
+  const auto k_end = static_cast<std::size_t>(last - c.wall_candidates.begin());
+  for (auto k = static_cast<std::size_t>(first - c.wall_candidates.begin()); k < k_end; ++k) {
     const std::uint32_t code = c.wall_candidates[k];
     const std::size_t i = code / n_walls, w = code % n_walls;
     ContactHistory& h = c.wall_history[k];
@@ -246,6 +296,33 @@ void wall_loop(ForceContext& c, Vec3* F, Vec3* T, long long& wall_contacts, doub
   }
 }
 
+/// The first row of thread k of nt (k = nt: n): the cut of balanced_rows on the work prefix of the
+/// last list build, or on the listed pairs alone (plus kRowWork a row) when rows changed since.
+inline std::size_t first_row(const VerletList& list, std::size_t n, int k, int nt) {
+  const bool weighed = list.work_offset.size() == n + 1;
+  return balanced_rows(weighed ? list.work_offset.data() : list.offset.data(), weighed ? 0 : kRowWork, n, k, nt).first;
+}
+
+/// Particles per block of force_loop's sum + end of step: the block's force and torque sums
+/// (48 bytes a particle) stay in L1 until the integrator reads them.
+inline constexpr std::size_t kFinishBlock = 256;
+
+/// Adds thread t's force and torque buffers (t >= 1) to particle i's sums, for the threads whose
+/// rows begin at or before i (the others never write to i: their buffers hold zeros there, and
+/// adding them would change no bit), and zeroes what it read: a buffer of t >= 1 is all zeros
+/// between force passes (System::initialize zeroes it), so force_loop need not clear it.
+GRAVSWEEP_INLINE void add_thread_sums(const ForceContext& c, const std::size_t* first, int nt, std::size_t i, Vec3& f,
+                                      Vec3& tq) {
+  for (int tt = 1; tt < nt && first[tt] <= i; ++tt) {
+    f += c.thread_force[tt][i];
+    tq += c.thread_torque[tt][i];
+  }
+}
+
+/// One force evaluation: particle-particle and particle-wall contacts, each thread on its rows
+/// (cut by work, balanced_rows) into its own buffer; the buffers summed with gravity in a fixed
+/// order (deterministic for a given thread count); then, inside the same parallel region, the
+/// integrator's end of step on each thread's share of the particles when c.finish is set.
 template <class Law, class Rolling>
 void force_loop(ForceContext& c) {
   Particles& p = c.p;
@@ -259,41 +336,52 @@ void force_loop(ForceContext& c) {
 #pragma omp parallel num_threads(c.threads) reduction(+ : contacts, wall_contacts, energy)
   {
     const int t = omp_get_thread_num();
+    const int nt = omp_get_num_threads();
+    thread_local std::vector<std::size_t> first;  // first row of each thread, and n
+    first.resize(static_cast<std::size_t>(nt) + 1);
+    for (int k = 0; k <= nt; ++k) first[static_cast<std::size_t>(k)] = first_row(c.nlist, n, k, nt);
+    const ThreadRows rows{first[static_cast<std::size_t>(t)], first[static_cast<std::size_t>(t) + 1]};
     // Thread 0 accumulates straight into the particles' force and torque arrays (one buffer pair
-    // per extra thread; the sum below keeps the order gravity + thread 0 + thread 1 + ...).
+    // per extra thread; the sum below keeps the order gravity + thread 0 + thread 1 + ...), and
+    // clears them whole; the buffers of t >= 1 are zeros already (add_thread_sums).
     // Nothing reads force_N / torque_N_m between here and the sum.
     Vec3* F = t == 0 ? p.force_N.data() : c.thread_force[t].data();
     Vec3* T = t == 0 ? p.torque_N_m.data() : c.thread_torque[t].data();
-    std::fill(F, F + n, Vec3::Zero());
-    std::fill(T, T + n, Vec3::Zero());
+    std::fill(F + rows.begin, F + n, Vec3::Zero());
+    std::fill(T + rows.begin, T + n, Vec3::Zero());
     OverlapFailure mine;
     if constexpr (kHasHertzBatch<Law, Rolling>)
-      pair_loop_batched<std::is_same_v<Rolling, RollingSunday>>(c, F, T, contacts, energy, mine);
+      pair_loop_batched<std::is_same_v<Rolling, RollingSunday>>(c, rows, F, T, contacts, energy, mine);
     else
-      pair_loop_scalar<Law, Rolling>(c, F, T, contacts, energy, mine);
-    wall_loop<Law, Rolling>(c, F, T, wall_contacts, energy, mine);
+      pair_loop_scalar<Law, Rolling>(c, rows, F, T, contacts, energy, mine);
+    wall_loop<Law, Rolling>(c, rows, F, T, wall_contacts, energy, mine);
     if (mine.failed()) {
 #pragma omp critical(gravsweep_force_failure)
       if (mine.ratio > worst.ratio) worst = mine;
     }
-    // Sum the thread buffers in a fixed order and add gravity (same parallel region).
+    // Sum the thread buffers in a fixed order and add gravity (same parallel region), each thread
+    // on an even share of the particles; then finish the step on that same share (no barrier:
+    // a particle's update reads only its own sums).
 #pragma omp barrier
-    const int nt = omp_get_num_threads();
-#pragma omp for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) {
-      // The same expression as with a buffer for thread 0 (gravity first, then each thread's
-      // sum): contraction into FMAs and rounding stay those of the former layout.
-      Vec3 f = inv_m[i] > 0 ? Vec3(M[i] * c.gravity_m_s2) : Vec3::Zero();
-      Vec3 tq = Vec3::Zero();
-      f += p.force_N[i];
-      tq += p.torque_N_m[i];
-      for (int tt = 1; tt < nt; ++tt) {
-        f += c.thread_force[tt][i];
-        tq += c.thread_torque[tt][i];
+    const auto [lo, hi] = even_share(n, t, nt);
+    StepFindings found;
+    for (std::size_t b = lo; b < hi; b += kFinishBlock) {
+      const std::size_t e = std::min(hi, b + kFinishBlock);
+      for (std::size_t i = b; i < e; ++i) {
+        // The same expression as with a buffer for thread 0 (gravity first, then each thread's
+        // sum): contraction into FMAs and rounding stay those of the former layout.
+        Vec3 f = inv_m[i] > 0 ? Vec3(M[i] * c.gravity_m_s2) : Vec3::Zero();
+        Vec3 tq = Vec3::Zero();
+        f += p.force_N[i];
+        tq += p.torque_N_m[i];
+        add_thread_sums(c, first.data(), nt, i, f, tq);
+        p.force_N[i] = f;
+        p.torque_N_m[i] = tq;
       }
-      p.force_N[i] = f;
-      p.torque_N_m[i] = tq;
+      // The block's sums are still in L1 when the integrator reads them back.
+      if (c.finish != nullptr) c.finish->end_range(p, c.dt_s, *c.check, b, e, found);
     }
+    if (c.finish != nullptr) c.check->merge(found);
   }
   c.stats.contacts = contacts;
   c.stats.wall_contacts = wall_contacts;

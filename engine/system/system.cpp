@@ -175,16 +175,19 @@ void System::rebuild_neighbors() {
   wall_history_ = std::move(hist);
   wall_frame_history_ = std::move(frame);
   wall_count_at_build_ = nw;
+  nlist_.add_wall_work(wall_candidates_, nw, kWallWork);
   rebuild_due_ = false;
 }
 
-void System::compute_forces() { force_pass(false); }
+void System::compute_forces() { force_pass(false, nullptr); }
 
-void System::force_pass(bool displacement_checked) {
+void System::force_pass(bool displacement_checked, StepCheck* finish) {
   if (!initialized_) initialize();
   // Inside step() the previous end-of-step checks measured the displacements; otherwise (a call
   // from outside, positions possibly edited) measure them now.
   if (rebuild_due_ || (!displacement_checked && nlist_.needs_rebuild(particles))) rebuild_neighbors();
+  // The end of step compares with the positions of this (possibly just rebuilt) list.
+  if (finish != nullptr) finish->position_at_build = nlist_.positions_at_build(particles.size());
   ForceContext ctx{particles,
                    walls,
                    nlist_,
@@ -199,7 +202,9 @@ void System::force_pass(bool displacement_checked) {
                    config_.dt_s,
                    integrator_->uses_eval_velocities() && have_forces_,
                    config_.track_energy,
-                   threads()};
+                   threads(),
+                   finish != nullptr ? integrator_.get() : nullptr,
+                   finish};
   force_fn_(ctx);
   stats_ = ctx.stats;
   have_forces_ = true;
@@ -232,15 +237,13 @@ void System::step() {
   omp_set_num_threads(threads());  // integrators use the default team size
   if (integrator_->needs_initial_forces() && !have_forces_) compute_forces();
   integrator_->begin_step(particles, dt);
-  force_pass(have_step_checks_);
   StepCheck check;
   if (config_.domain) {
     check.have_domain = true;
     check.lo_m = config_.domain->lo_m;
     check.hi_m = config_.domain->hi_m;
   }
-  check.position_at_build = nlist_.positions_at_build(particles.size());
-  integrator_->end_step(particles, dt, check);
+  force_pass(have_step_checks_, &check);  // forces, then the integrator's end of step on them
   ++step_;
   time_s_ += dt;
   if (check.bad_particle >= 0) raise_state_failure(check.bad_particle, check.bad_cause);

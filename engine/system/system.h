@@ -129,7 +129,9 @@ class System {
   /// The last step's end checks measured every displacement. Particles edited between steps
   /// (positions, walls) must be followed by invalidate() or compute_forces().
   bool have_step_checks_ = false;
-  void force_pass(bool displacement_checked);
+  /// Forces on the current state; with `finish`, the integrator's end of step follows in the same
+  /// parallel region, checked against `finish` (inside step()).
+  void force_pass(bool displacement_checked, StepCheck* finish);
   void rebuild_neighbors();
   void raise_state_failure(long long particle, StateFault cause);
 };
