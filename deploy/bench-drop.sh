@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Wall time of the first SECONDS of a drop, for BENCHMARKS.md (issue 12): ROUNDS rounds (default 4)
+# of `gravsweep run SPEC --bed BED --threads 2 --snapshot-interval 0` with SPEC's /stop/max_time_s
+# cut to SECONDS (default 0.12), interleaved with a second binary when one is given; then the
+# minimum and median wall seconds of each binary and its projectile's deepest point (the same
+# depth to the last digit means the same arithmetic).
+#
+#   deploy/bench-drop.sh SPEC.json BED.h5 [OTHER_GRAVSWEEP] [ROUNDS] [SECONDS]
+#   deploy/bench-drop.sh examples/impact_low_g.json data/reproduction/beds/8318ca9692b4d76c94b3.h5 /tmp/gravsweep-main
+#
+# Run it on an otherwise idle machine; the load average is printed with the results.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+usage="usage: deploy/bench-drop.sh SPEC.json BED.h5 [OTHER_GRAVSWEEP] [ROUNDS] [SECONDS]"
+spec="${1:?$usage}"
+bed="${2:?$usage}"
+other="${3:-}"
+rounds="${4:-4}"
+seconds="${5:-0.12}"
+py=/usr/bin/python3
+this="${GRAVSWEEP:-$root/build/scheduler/gravsweep}"
+binaries=("$this")
+[ -n "$other" ] && binaries+=("$other")
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+"$py" - "$spec" "$seconds" "$work/spec.json" <<'PY'
+import json, sys
+spec = json.load(open(sys.argv[1]))
+spec.pop("$schema", None)
+spec.setdefault("stop", {})["max_time_s"] = float(sys.argv[2])
+json.dump(spec, open(sys.argv[3], "w"), indent=1)
+PY
+for r in $(seq 1 "$rounds"); do
+  for i in "${!binaries[@]}"; do
+    if ! "${binaries[$i]}" run "$work/spec.json" --out "$work/out$i" --bed "$bed" --threads 2 --snapshot-interval 0 \
+      >/dev/null 2>"$work/err"; then
+      cat "$work/err" >&2
+      exit 1
+    fi
+    "$py" -c "import json,sys; m=json.load(open(sys.argv[1])); print(sys.argv[2], m['wall_time_s'], repr(m['max_depth_m']))" \
+      "$work/out$i/metrics.json" "$i" >>"$work/times"
+  done
+done
+echo "$rounds rounds, first $seconds s of $spec on $bed, 2 threads, load average $(cut -d' ' -f1-3 /proc/loadavg)"
+"$py" - "$work/times" "${binaries[@]}" <<'PY'
+import statistics, sys
+rows = [line.split() for line in open(sys.argv[1])]
+print(f"{'binary':50s} {'min_wall_s':>10s} {'median_wall_s':>13s} {'max_depth_m':>20s}")
+for i, b in enumerate(sys.argv[2:]):
+    mine = [r for r in rows if r[0] == str(i)]
+    walls = [float(r[1]) for r in mine]
+    print(f"{b:50s} {min(walls):10.2f} {statistics.median(walls):13.2f} {mine[-1][2]:>20s}")
+PY
