@@ -1,7 +1,6 @@
 #include "engine/integrate/integrators.h"
 
 #include <fmt/format.h>
-#include <omp.h>
 
 #include <algorithm>
 
@@ -111,11 +110,11 @@ std::unique_ptr<Integrator> make() {
 void StepCheck::merge(const StepFindings& f) {
 #pragma omp critical(gravsweep_step_check)
   {
-    if (f.bad_particle >= 0 && (bad_particle < 0 || f.bad_particle < bad_particle)) {
-      bad_particle = f.bad_particle;
-      bad_cause = f.bad_cause;
+    if (f.bad_particle >= 0 && (found.bad_particle < 0 || f.bad_particle < found.bad_particle)) {
+      found.bad_particle = f.bad_particle;
+      found.bad_cause = f.bad_cause;
     }
-    max_displacement2_m2 = std::max(max_displacement2_m2, f.max_displacement2_m2);
+    found.max_displacement2_m2 = std::max(found.max_displacement2_m2, f.max_displacement2_m2);
   }
 }
 

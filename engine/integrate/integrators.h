@@ -1,7 +1,7 @@
 // Time integrators, selected by name from one table (integrate/integrators.cpp).
 // Each splits a step into begin_step (before forces) and end_range (after forces, run by the force
-// loop on each thread's share); forces already include gravity. Rotations use the sphere's scalar inertia (no
-// gyroscopic term for spheres).
+// loop on each thread's share); forces already include gravity. Rotations use the sphere's scalar
+// inertia (no gyroscopic term for spheres).
 #pragma once
 #include <memory>
 #include <string>
@@ -22,9 +22,10 @@ enum class StateFault : unsigned char {
   outside_domain,  ///< the centre left the domain: the particle left the container
 };
 
-/// What the end-of-step checks found on one thread's share of the particles.
+/// What the end-of-step checks found: on one thread's share of the particles, or on all of them
+/// once merged into StepCheck::found.
 struct StepFindings {
-  long long bad_particle = -1;  ///< the first particle of the share whose state is bad
+  long long bad_particle = -1;  ///< the first particle whose state is bad
   StateFault bad_cause = StateFault::none;
   double max_displacement2_m2 = 0;
 };
@@ -47,10 +48,8 @@ struct StepCheck {
   bool have_domain = false;
   Vec3 lo_m = Vec3::Zero(), hi_m = Vec3::Zero();
   const Vec3* position_at_build = nullptr;  ///< null: no list yet (rebuild anyway)
-  // Outputs (reduced over threads).
-  long long bad_particle = -1;
-  StateFault bad_cause = StateFault::none;
-  double max_displacement2_m2 = 0;
+  // Output: every thread's findings merged (merge).
+  StepFindings found;
 
   /// Per-particle check on the particle's new position (a NaN or inf in a velocity reaches the
   /// position in the same step); returns what is wrong (none = fine) and updates *max_d2.
@@ -61,8 +60,8 @@ struct StepCheck {
     if (position_at_build != nullptr) *max_d2 = std::max(*max_d2, (x - position_at_build[i]).squaredNorm());
     return StateFault::none;
   }
-  /// Adds one share's findings (thread-safe): the lowest bad particle wins, displacements take
-  /// the maximum.
+  /// Adds one share's findings to `found` (thread-safe): the lowest bad particle wins,
+  /// displacements take the maximum.
   void merge(const StepFindings& f);
 };
 

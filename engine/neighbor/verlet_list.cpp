@@ -239,32 +239,35 @@ void VerletList::build(const Particles& p, double skin_m, int threads) {
     std::copy(chunk_neighbors[ch].begin(), chunk_neighbors[ch].end(),
               new_neighbor.begin() + new_offset[ch * kBuildChunk]);
 
-  // Carry histories over: both lists are sorted by j within each i, so merge.
+  // Carry histories over: both lists are sorted by j within each i, so merge. The touching pairs
+  // carried over (active histories) of row i are counted on the way, into count_[i + 1] (free
+  // once new_offset is summed), for the work prefix below.
   std::vector<ContactHistory> new_history(new_neighbor.size());
   std::vector<FrameHistory> new_frame(keep_frame_ ? new_neighbor.size() : 0);
   const bool have_old = offset.size() == n + 1;
+  std::fill(count_.begin(), count_.end(), 0u);
 #pragma omp parallel for schedule(dynamic, 256) num_threads(threads)
   for (std::size_t i = 0; i < n; ++i) {
     if (!have_old) continue;
     std::uint32_t a = offset[i];
     const std::uint32_t a_end = offset[i + 1];
+    std::uint32_t touching = 0;
     for (std::uint32_t b = new_offset[i]; b < new_offset[i + 1] && a < a_end; ++b) {
       while (a < a_end && neighbor[a] < new_neighbor[b]) ++a;
       if (a < a_end && neighbor[a] == new_neighbor[b]) {
         new_history[b] = history[a];
         if (keep_frame_) new_frame[b] = frame_history[a];
+        touching += history[a].active ? 1u : 0u;
       }
     }
+    count_[i + 1] = touching;
   }
   offset = std::move(new_offset);
   neighbor = std::move(new_neighbor);
   history = std::move(new_history);
   work_offset.assign(n + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) {
-    std::uint32_t touching = 0;
-    for (std::uint32_t k = offset[i]; k < offset[i + 1]; ++k) touching += history[k].active ? 1u : 0u;
-    work_offset[i + 1] = work_offset[i] + (offset[i + 1] - offset[i]) + kTouchingWork * touching + kRowWork;
-  }
+  for (std::size_t i = 0; i < n; ++i)
+    work_offset[i + 1] = work_offset[i] + (offset[i + 1] - offset[i]) + kTouchingWork * count_[i + 1] + kRowWork;
   frame_history = std::move(new_frame);
   position_at_build_ = p.position_m;
   // The cell scratch is rebuilt from nothing at every build (rare in a settled bed: none in the

@@ -68,33 +68,34 @@ struct TouchingPair {
   double dist2_m2, m_eff_kg;
 };
 
-/// Rows [begin, end) of thread t's share (of nt) of the half list: cut where the pair-loop work
-/// before a row (`work`, n + 1 prefix sums, plus `row_work` per row) reaches t / nt of the total,
-/// so a thread whose rows hold more touching pairs gets fewer rows. Static rows gave thread 0 1.5x
-/// thread 1's pair work in a 0.1 m/s2 drop: after the gravity ramp the bottom of the bed keeps its
-/// contacts and the top opens (BENCHMARKS.md, issue 12). Depends only on the list: every step
-/// between two builds cuts alike.
-inline std::pair<std::size_t, std::size_t> balanced_rows(const std::uint32_t* work, std::uint32_t row_work,
-                                                         std::size_t n, int t, int nt) {
-  if (n == 0) return {0, 0};
+/// The first row of thread k's share (of nt; k = nt gives n) of the half list: where the
+/// pair-loop work before a row (`work`, n + 1 prefix sums, plus `row_work` per row) reaches k / nt
+/// of the total, so a thread whose rows hold more touching pairs gets fewer rows. Static rows gave
+/// thread 0 1.5x thread 1's pair work in a 0.1 m/s2 drop: after the gravity ramp the bottom of the
+/// bed keeps its contacts and the top opens (BENCHMARKS.md, issue 12). Depends only on the list:
+/// every step between two builds cuts alike.
+inline std::size_t balanced_cut(const std::uint32_t* work, std::uint32_t row_work, std::size_t n, int k, int nt) {
+  if (n == 0 || k <= 0) return 0;
+  if (k >= nt) return n;
   auto before = [&](std::size_t i) {
     return static_cast<double>(work[i]) + static_cast<double>(row_work) * static_cast<double>(i);
   };
-  auto cut = [&](int k) -> std::size_t {
-    if (k <= 0) return 0;
-    if (k >= nt) return n;
-    const double target = before(n) * k / nt;
-    std::size_t lo = 0, hi = n;  // the first row with at least `target` work before it
-    while (lo < hi) {
-      const std::size_t mid = lo + (hi - lo) / 2;
-      if (before(mid) < target)
-        lo = mid + 1;
-      else
-        hi = mid;
-    }
-    return lo;
-  };
-  return {cut(t), cut(t + 1)};
+  const double target = before(n) * k / nt;
+  std::size_t lo = 0, hi = n;  // the first row with at least `target` work before it
+  while (lo < hi) {
+    const std::size_t mid = lo + (hi - lo) / 2;
+    if (before(mid) < target)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
+/// Rows [begin, end) of thread t's share of nt: the cuts of balanced_cut at t and t + 1.
+inline std::pair<std::size_t, std::size_t> balanced_rows(const std::uint32_t* work, std::uint32_t row_work,
+                                                         std::size_t n, int t, int nt) {
+  return {balanced_cut(work, row_work, n, t, nt), balanced_cut(work, row_work, n, t + 1, nt)};
 }
 
 /// The rows of the half list one thread takes in force_loop: [begin, end). A thread writes forces
@@ -106,7 +107,7 @@ struct ThreadRows {
 
 /// The pair skeleton every particle-particle path shares (scalar and batched): rows [row_begin,
 /// row_end) of the half neighbour list, this thread's share (force_loop cuts it with
-/// balanced_rows); a listed pair that no longer touches has its history erased; two fixed
+/// balanced_cut); a listed pair that no longer touches has its history erased; two fixed
 /// particles are skipped; an overlap beyond kMaxOverlapFraction is recorded in `worst` (the exact
 /// ratio is computed only then); visit(const TouchingPair&, ContactHistory&) evaluates the rest.
 /// Always inlined: called through a lambda, the batch state of the caller would otherwise be read
@@ -296,11 +297,11 @@ void wall_loop(ForceContext& c, const ThreadRows& rows, Vec3* F, Vec3* T, long l
   }
 }
 
-/// The first row of thread k of nt (k = nt: n): the cut of balanced_rows on the work prefix of the
-/// last list build, or on the listed pairs alone (plus kRowWork a row) when rows changed since.
+/// The first row of thread k of nt (k = nt: n): balanced_cut on the work prefix of the last list
+/// build, or on the listed pairs alone (plus kRowWork a row) when rows changed since.
 inline std::size_t first_row(const VerletList& list, std::size_t n, int k, int nt) {
   const bool weighed = list.work_offset.size() == n + 1;
-  return balanced_rows(weighed ? list.work_offset.data() : list.offset.data(), weighed ? 0 : kRowWork, n, k, nt).first;
+  return balanced_cut(weighed ? list.work_offset.data() : list.offset.data(), weighed ? 0 : kRowWork, n, k, nt);
 }
 
 /// Particles per block of force_loop's sum + end of step: the block's force and torque sums
@@ -319,7 +320,7 @@ GRAVSWEEP_INLINE void add_thread_sums(const ForceContext& c, const std::size_t* 
 }
 
 /// One force evaluation: particle-particle and particle-wall contacts, each thread on its rows
-/// (cut by work, balanced_rows) into its own buffer; the buffers summed with gravity in a fixed
+/// (cut by work, balanced_cut) into its own buffer; the buffers summed with gravity in a fixed
 /// order (deterministic for a given thread count); then, inside the same parallel region, the
 /// integrator's end of step on each thread's share of the particles when c.finish is set.
 template <class Law, class Rolling>

@@ -246,8 +246,8 @@ void System::step() {
   force_pass(have_step_checks_, &check);  // forces, then the integrator's end of step on them
   ++step_;
   time_s_ += dt;
-  if (check.bad_particle >= 0) raise_state_failure(check.bad_particle, check.bad_cause);
-  if (check.position_at_build == nullptr || check.max_displacement2_m2 > 0.25 * config_.skin_m * config_.skin_m)
+  if (check.found.bad_particle >= 0) raise_state_failure(check.found.bad_particle, check.found.bad_cause);
+  if (check.position_at_build == nullptr || check.found.max_displacement2_m2 > 0.25 * config_.skin_m * config_.skin_m)
     rebuild_due_ = true;
   have_step_checks_ = true;
 }
