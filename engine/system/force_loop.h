@@ -105,11 +105,25 @@ struct ThreadRows {
   std::size_t begin = 0, end = 0;
 };
 
+/// The touching pairs of a stretch of the half list, in list order, as the filter of
+/// for_each_touching_pair leaves them for the visits: slot, particles, centre offset, |d|^2.
+struct TouchingBuffer {
+  static constexpr int kSize = 64;
+  int count = 0;
+  std::uint32_t k[kSize], i[kSize], j[kSize];
+  Vec3 d_m[kSize];
+  double dist2_m2[kSize];
+};
+
 /// The pair skeleton every particle-particle path shares (scalar and batched): rows [row_begin,
 /// row_end) of the half neighbour list, this thread's share (force_loop cuts it with
 /// balanced_cut); a listed pair that no longer touches has its history erased; two fixed
 /// particles are skipped; an overlap beyond kMaxOverlapFraction is recorded in `worst` (the exact
 /// ratio is computed only then); visit(const TouchingPair&, ContactHistory&) evaluates the rest.
+/// Two passes over each stretch of TouchingBuffer::kSize touching pairs: a filter without a
+/// branch on the distance test (whether a listed pair touches is a coin toss at rest, about 60 %
+/// of the listed pairs, and a mispredicted branch stalls the loads of the next neighbours'
+/// positions), then the visits in list order, so sums and histories are those of one pass.
 /// Always inlined: called through a lambda, the batch state of the caller would otherwise be read
 /// through references on every pair (+10 % on the 1 g drop, measured).
 template <class Visit>
@@ -123,6 +137,21 @@ GRAVSWEEP_INLINE void for_each_touching_pair(ForceContext& c, std::size_t row_be
   const std::uint32_t* off = c.nlist.offset.data();
   const std::uint32_t* nbr = c.nlist.neighbor.data();
   ContactHistory* hist = c.nlist.history.data();
+  TouchingBuffer buf;
+  auto visit_buffer = [&] {
+    for (int b = 0; b < buf.count; ++b) {
+      const std::uint32_t i = buf.i[b], j = buf.j[b];
+      if (inv_m[i] == 0 && inv_m[j] == 0) continue;  // two fixed particles
+      const double ri = R[i], rsum = ri + R[j], dist2 = buf.dist2_m2[b];
+      const double r_min = std::min(ri, R[j]);
+      const double limit = rsum - kMaxOverlapFraction * r_min;
+      if (dist2 < limit * limit) worst.consider((rsum - std::sqrt(dist2)) / r_min, static_cast<long long>(i), j, -1);
+      const double mi = inv_m[i] == 0 ? kInf : M[i], mj = inv_m[j] == 0 ? kInf : M[j];
+      const double m_eff = std::isinf(mi) ? mj : std::isinf(mj) ? mi : mi * mj / (mi + mj);
+      visit(TouchingPair{buf.k[b], i, j, buf.d_m[b], dist2, m_eff}, hist[buf.k[b]]);
+    }
+    buf.count = 0;
+  };
   for (std::size_t i = row_begin; i < row_end; ++i) {
     const Vec3 xi = X[i];
     const double ri = R[i];
@@ -131,20 +160,21 @@ GRAVSWEEP_INLINE void for_each_touching_pair(ForceContext& c, std::size_t row_be
       const Vec3 d = X[j] - xi;
       const double rsum = ri + R[j];
       const double dist2 = d.squaredNorm();
+      const bool touching = dist2 < rsum * rsum;
       ContactHistory& h = hist[k];
-      if (dist2 >= rsum * rsum) {
-        if (h.active) h.active = false;  // contact ended: history erased (no write otherwise)
-        continue;
-      }
-      if (inv_m[i] == 0 && inv_m[j] == 0) continue;  // two fixed particles
-      const double r_min = std::min(ri, R[j]);
-      const double limit = rsum - kMaxOverlapFraction * r_min;
-      if (dist2 < limit * limit) worst.consider((rsum - std::sqrt(dist2)) / r_min, static_cast<long long>(i), j, -1);
-      const double mi = inv_m[i] == 0 ? kInf : M[i], mj = inv_m[j] == 0 ? kInf : M[j];
-      const double m_eff = std::isinf(mi) ? mj : std::isinf(mj) ? mi : mi * mj / (mi + mj);
-      visit(TouchingPair{k, static_cast<std::uint32_t>(i), j, d, dist2, m_eff}, h);
+      if (h.active & !touching) h.active = false;  // contact ended: history erased (no write otherwise)
+      // Written whether or not the pair touches; only a touching pair keeps its slot.
+      const int b = buf.count;
+      buf.k[b] = k;
+      buf.i[b] = static_cast<std::uint32_t>(i);
+      buf.j[b] = j;
+      buf.d_m[b] = d;
+      buf.dist2_m2[b] = dist2;
+      buf.count = b + static_cast<int>(touching);
+      if (buf.count == TouchingBuffer::kSize) visit_buffer();
     }
   }
+  visit_buffer();
 }
 
 /// One contact through the law and the rolling model: a new contact (history not active) starts
