@@ -43,38 +43,4 @@ double wall_distance(const Wall& w, const Vec3& x) {
   return d.dot(w.normal);
 }
 
-bool touch_wall(const Wall& w, const Vec3& x, double r, WallTouch& out) {
-  const Vec3 d = x - w.point_m;
-  switch (w.kind) {
-    case WallKind::plane:
-    case WallKind::disk: {
-      const double dist = d.dot(w.normal);
-      if (dist >= r || dist <= -r) return false;  // not touching, or fully behind the wall
-      if (w.kind == WallKind::disk) {
-        const Vec3 radial = d - dist * w.normal;
-        if (radial.squaredNorm() > w.radius_m * w.radius_m) return false;
-      }
-      out.n = -w.normal;
-      out.distance_m = dist;
-      out.overlap_m = r - dist;
-      out.R_eff_m = r;
-      return true;
-    }
-    case WallKind::cylinder: {
-      const double axial = d.dot(w.normal);
-      if (axial < 0 || axial > w.height_m) return false;
-      const Vec3 radial = d - axial * w.normal;
-      const double rho = radial.norm();
-      const double dist = w.radius_m - rho;
-      if (dist >= r || rho <= 0) return false;
-      out.n = radial / rho;
-      out.distance_m = dist;
-      out.overlap_m = r - dist;
-      out.R_eff_m = w.concave_curvature ? r * w.radius_m / (w.radius_m - r) : r;
-      return true;
-    }
-  }
-  return false;
-}
-
 }  // namespace gravsweep

@@ -1,6 +1,7 @@
 // Analytic walls: infinite planes, a flat disk bottom, and the concave inner side of a cylinder.
 // Walls are fixed and of infinite mass; each has its own material.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -36,8 +37,41 @@ struct WallTouch {
   double R_eff_m;     ///< effective radius of the pair
 };
 
-/// True when the sphere (centre x, radius r) touches the wall; fills `out`.
-bool touch_wall(const Wall& w, const Vec3& x, double r, WallTouch& out);
+/// True when the sphere (centre x, radius r) touches the wall; fills `out`. Inline: the force
+/// loop calls it for every particle-wall candidate of every step.
+inline bool touch_wall(const Wall& w, const Vec3& x, double r, WallTouch& out) {
+  const Vec3 d = x - w.point_m;
+  switch (w.kind) {
+    case WallKind::plane:
+    case WallKind::disk: {
+      const double dist = d.dot(w.normal);
+      if (dist >= r || dist <= -r) return false;  // not touching, or fully behind the wall
+      if (w.kind == WallKind::disk) {
+        const Vec3 radial = d - dist * w.normal;
+        if (radial.squaredNorm() > w.radius_m * w.radius_m) return false;
+      }
+      out.n = -w.normal;
+      out.distance_m = dist;
+      out.overlap_m = r - dist;
+      out.R_eff_m = r;
+      return true;
+    }
+    case WallKind::cylinder: {
+      const double axial = d.dot(w.normal);
+      if (axial < 0 || axial > w.height_m) return false;
+      const Vec3 radial = d - axial * w.normal;
+      const double rho = radial.norm();
+      const double dist = w.radius_m - rho;
+      if (dist >= r || rho <= 0) return false;
+      out.n = radial / rho;
+      out.distance_m = dist;
+      out.overlap_m = r - dist;
+      out.R_eff_m = w.concave_curvature ? r * w.radius_m / (w.radius_m - r) : r;
+      return true;
+    }
+  }
+  return false;
+}
 
 /// Signed distance of a point from the wall surface, positive on the domain side.
 double wall_distance(const Wall& w, const Vec3& x);

@@ -299,7 +299,7 @@ void wall_loop(ForceContext& c, const ThreadRows& rows, Vec3* F, Vec3* T, long l
   const auto k_end = static_cast<std::size_t>(last - c.wall_candidates.begin());
   for (auto k = static_cast<std::size_t>(first - c.wall_candidates.begin()); k < k_end; ++k) {
     const std::uint32_t code = c.wall_candidates[k];
-    const std::size_t i = code / n_walls, w = code % n_walls;
+    const std::size_t i = code / n_walls, w = code - i * n_walls;  // one division
     ContactHistory& h = c.wall_history[k];
     WallTouch touch;
     if (!touch_wall(c.walls[w], X[i], R[i], touch)) {

@@ -276,9 +276,14 @@ double System::potential_energy_J() const {
 int System::contact_count(ParticleIndex i) const {
   int count = 0;
   const std::size_t n = particles.size();
-  for (std::size_t a = 0; a < n; ++a)
-    for (std::uint32_t k = nlist_.offset[a]; k < nlist_.offset[a + 1]; ++k)
-      if ((a == i || nlist_.neighbor[k] == i) && nlist_.history[k].active) ++count;
+  if (nlist_.offset.size() != n + 1) return 0;  // no list yet: no contact was evaluated
+  // Row i holds the pairs with larger partners; the others are listed under their partner's row.
+  // One pass over the partners (called at every trace sample: O(pairs), no per-row loop).
+  for (std::uint32_t k = nlist_.offset[i]; k < nlist_.offset[i + 1]; ++k) count += nlist_.history[k].active;
+  const std::uint32_t* nbr = nlist_.neighbor.data();
+  const std::size_t below = nlist_.offset[i];  // rows before i end here
+  for (std::size_t k = 0; k < below; ++k)
+    if (nbr[k] == i && nlist_.history[k].active) ++count;
   const std::size_t nw = wall_count_at_build_;
   const auto first =
       std::lower_bound(wall_candidates_.begin(), wall_candidates_.end(), static_cast<std::uint32_t>(i * nw));

@@ -100,6 +100,33 @@ TEST_P(HistoryLayoutTest, RemovingAGrainKeepsEveryOtherHistory) {
   EXPECT_NO_FATAL_FAILURE(expect_same_grains(ref, 0, removed, 0));
 }
 
+// contact_count(i) (the projectile's contacts in every trace sample) counts the pairs listed under
+// i and under its partners' rows, and i's walls: after a force pass it equals contact_counts() and
+// the spheres and walls that overlap i at the positions of that pass.
+TEST(ContactCount, CountsEveryTouchingPartnerAndWall) {
+  System s(layout_config("hertz", "sunday"));
+  fill(s, true);
+  for (int k = 0; k < kSteps / 3; ++k) s.step();
+  s.compute_forces();  // active histories now match the current positions
+  const auto& p = s.particles;
+  const std::vector<int> all = s.contact_counts();
+  int touching_grains = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    int expected = 0;
+    for (std::size_t j = 0; j < p.size(); ++j)
+      if (j != i && (p.position_m[j] - p.position_m[i]).norm() < p.radius_m[i] + p.radius_m[j]) ++expected;
+    for (const Wall& w : s.walls) {
+      WallTouch touch;
+      if (touch_wall(w, p.position_m[i], p.radius_m[i], touch)) ++expected;
+    }
+    EXPECT_EQ(s.contact_count(static_cast<ParticleIndex>(i)), expected) << "particle " << i;
+    EXPECT_EQ(all[i], expected) << "particle " << i;
+    touching_grains += expected > 0;
+  }
+  EXPECT_GT(touching_grains, 20);  // every lattice grain touches something; grain 0 nothing
+  EXPECT_EQ(all[0], 0);
+}
+
 INSTANTIATE_TEST_SUITE_P(Laws, HistoryLayoutTest,
                          ::testing::Values(std::make_tuple("hertz", "sunday"), std::make_tuple("hertz", "zhang"),
                                            std::make_tuple("hooke", "zhang"), std::make_tuple("hooke", "none")));
