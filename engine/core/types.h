@@ -8,10 +8,13 @@
 #include <numbers>
 
 /// Contact kernels are inlined into the one pair loop (engine/system/force_loop.h).
+/// GRAVSWEEP_INLINE_LAMBDA goes after a lambda's parameter list: `[&]() GRAVSWEEP_INLINE_LAMBDA {`.
 #if defined(__GNUC__)
 #define GRAVSWEEP_INLINE [[gnu::always_inline]] inline
+#define GRAVSWEEP_INLINE_LAMBDA __attribute__((always_inline))
 #else
 #define GRAVSWEEP_INLINE inline
+#define GRAVSWEEP_INLINE_LAMBDA
 #endif
 
 namespace gravsweep {

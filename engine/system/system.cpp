@@ -203,6 +203,7 @@ void System::force_pass(bool displacement_checked, StepCheck* finish) {
                    integrator_->uses_eval_velocities() && have_forces_,
                    config_.track_energy,
                    threads(),
+                   config_.pair_filter_min_pairs,
                    finish != nullptr ? integrator_.get() : nullptr,
                    finish};
   force_fn_(ctx);

@@ -38,6 +38,9 @@ struct SystemConfig {
   int threads = 0;    ///< OpenMP threads; 0 = OpenMP default
   /// Systems smaller than this run on one thread (thread start-up costs more than it saves).
   std::size_t parallel_min_particles = 512;
+  /// Listed pairs of a thread's share from which the pair loop filters touching pairs without a
+  /// branch before it visits them (force_loop.h, kFilterMinPairs); results are the same either way.
+  std::uint32_t pair_filter_min_pairs = kFilterMinPairs;
   std::optional<Domain> domain;
   bool track_energy = false;    ///< accumulate the normal spring energy
   bool check_time_step = true;  ///< reject dt above the law's stability bound
