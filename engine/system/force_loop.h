@@ -116,18 +116,18 @@ struct TouchingBuffer {
   double dist2_m2[kSize];
 };
 
-/// What both ways of for_each_touching_pair do with a touching pair (slot k, rows i < j, centre
-/// offset d = x_j - x_i, |d|^2): skip two fixed particles, record an overlap beyond
-/// kMaxOverlapFraction in `worst`, and visit the rest with their effective mass.
+/// What both ways of for_each_touching_pair do with a touching pair (slot k, rows i < j with
+/// radius ri of i, centre offset d = x_j - x_i, |d|^2): skip two fixed particles, record an
+/// overlap beyond kMaxOverlapFraction in `worst`, and visit the rest with their effective mass.
 template <class Visit>
 GRAVSWEEP_INLINE void visit_touching(const Particles& p, ContactHistory* hist, std::uint32_t k, std::uint32_t i,
-                                     std::uint32_t j, const Vec3& d, double dist2, OverlapFailure& worst,
+                                     std::uint32_t j, double ri, const Vec3& d, double dist2, OverlapFailure& worst,
                                      Visit&& visit) {
   const double* R = p.radius_m.data();
   const double* M = p.mass_kg.data();
   const double* inv_m = p.inv_mass_1_kg.data();
   if (inv_m[i] == 0 && inv_m[j] == 0) return;  // two fixed particles
-  const double ri = R[i], rsum = ri + R[j];
+  const double rsum = ri + R[j];
   const double r_min = std::min(ri, R[j]);
   const double limit = rsum - kMaxOverlapFraction * r_min;
   if (dist2 < limit * limit) worst.consider((rsum - std::sqrt(dist2)) / r_min, static_cast<long long>(i), j, -1);
@@ -141,10 +141,10 @@ GRAVSWEEP_INLINE void visit_touching(const Particles& p, ContactHistory* hist, s
 /// balanced_cut); a listed pair that no longer touches has its history erased; two fixed
 /// particles are skipped; an overlap beyond kMaxOverlapFraction is recorded in `worst` (the exact
 /// ratio is computed only then); visit(const TouchingPair&, ContactHistory&) evaluates the rest.
-/// From c.filter_min_pairs listed pairs on (kFilterMinPairs), two passes over each stretch of TouchingBuffer::kSize
-/// touching pairs: a filter without a branch on the distance test (whether a listed pair touches
-/// is a coin toss at rest, about 60 % of the listed pairs), then the visits in list order; below,
-/// one pass with a branch per listed pair.
+/// kFilter (a share of at least c.filter_min_pairs listed pairs, filter_pairs): two passes over
+/// each stretch of TouchingBuffer::kSize touching pairs, a filter without a branch on the
+/// distance test (whether a listed pair touches is a coin toss at rest, about 60 % of the listed
+/// pairs), then the visits in list order. Otherwise one pass with a branch per listed pair.
 /// Always inlined: called through a lambda, the batch state of the caller would otherwise be read
 /// through references on every pair (+10 % on the 1 g drop, measured).
 template <bool kFilter, class Visit>
@@ -153,8 +153,6 @@ GRAVSWEEP_INLINE void for_each_touching_pair(ForceContext& c, std::size_t row_be
   const Particles& p = c.p;
   const Vec3* X = p.position_m.data();
   const double* R = p.radius_m.data();
-  const double* M = p.mass_kg.data();
-  const double* inv_m = p.inv_mass_1_kg.data();
   const std::uint32_t* off = c.nlist.offset.data();
   const std::uint32_t* nbr = c.nlist.neighbor.data();
   ContactHistory* hist = c.nlist.history.data();
@@ -172,22 +170,15 @@ GRAVSWEEP_INLINE void for_each_touching_pair(ForceContext& c, std::size_t row_be
           if (h.active) h.active = false;  // contact ended: history erased (no write otherwise)
           continue;
         }
-        // visit_touching written out, with row i's radius and inverse mass at hand (through
-        // visit_touching this way ran 4 % slower on the paper's bed).
-        if (inv_m[i] == 0 && inv_m[j] == 0) continue;  // two fixed particles
-        const double r_min = std::min(ri, R[j]);
-        const double limit = rsum - kMaxOverlapFraction * r_min;
-        if (dist2 < limit * limit) worst.consider((rsum - std::sqrt(dist2)) / r_min, static_cast<long long>(i), j, -1);
-        const double mi = inv_m[i] == 0 ? kInf : M[i], mj = inv_m[j] == 0 ? kInf : M[j];
-        const double m_eff = std::isinf(mi) ? mj : std::isinf(mj) ? mi : mi * mj / (mi + mj);
-        visit(TouchingPair{k, static_cast<std::uint32_t>(i), j, d, dist2, m_eff}, h);
+        visit_touching(p, hist, k, static_cast<std::uint32_t>(i), j, ri, d, dist2, worst, visit);
       }
     }
   } else {
     TouchingBuffer buf;
     auto visit_buffer = [&]() GRAVSWEEP_INLINE_LAMBDA {  // inlined at both calls (see above)
       for (int b = 0; b < buf.count; ++b)
-        visit_touching(p, hist, buf.k[b], buf.i[b], buf.j[b], buf.d_m[b], buf.dist2_m2[b], worst, visit);
+        visit_touching(p, hist, buf.k[b], buf.i[b], buf.j[b], p.radius_m[buf.i[b]], buf.d_m[b], buf.dist2_m2[b], worst,
+                       visit);
       buf.count = 0;
     };
     for (std::size_t i = row_begin; i < row_end; ++i) {
@@ -218,8 +209,8 @@ GRAVSWEEP_INLINE void for_each_touching_pair(ForceContext& c, std::size_t row_be
 
 /// True when this thread's rows hold at least c.filter_min_pairs listed pairs: its pair loop
 /// then filters (for_each_touching_pair<true>). Each way is its own instantiation of the pair
-/// loop: both inlined into one function, the branch-per-pair way ran 8 % slower on the paper's
-/// bed (register spills).
+/// loop: with both inlined into one function the branch-per-pair way ran 4-8 % slower on the
+/// paper's bed (BENCHMARKS.md).
 inline bool filter_pairs(const ForceContext& c, const ThreadRows& rows) {
   const std::uint32_t* off = c.nlist.offset.data();
   return rows.end > rows.begin && off[rows.end] - off[rows.begin] >= c.filter_min_pairs;
