@@ -156,41 +156,23 @@ GRAVSWEEP_INLINE void for_each_touching_pair(ForceContext& c, std::size_t row_be
   const std::uint32_t* off = c.nlist.offset.data();
   const std::uint32_t* nbr = c.nlist.neighbor.data();
   ContactHistory* hist = c.nlist.history.data();
-  if constexpr (!kFilter) {
-    for (std::size_t i = row_begin; i < row_end; ++i) {
-      const Vec3 xi = X[i];
-      const double ri = R[i];
-      for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
-        const std::uint32_t j = nbr[k];
-        const Vec3 d = X[j] - xi;
-        const double rsum = ri + R[j];
-        const double dist2 = d.squaredNorm();
-        ContactHistory& h = hist[k];
-        if (dist2 >= rsum * rsum) {
-          if (h.active) h.active = false;  // contact ended: history erased (no write otherwise)
-          continue;
-        }
-        visit_touching(p, hist, k, static_cast<std::uint32_t>(i), j, ri, d, dist2, worst, visit);
-      }
-    }
-  } else {
-    TouchingBuffer buf;
-    auto visit_buffer = [&]() GRAVSWEEP_INLINE_LAMBDA {  // inlined at both calls (see above)
-      for (int b = 0; b < buf.count; ++b)
-        visit_touching(p, hist, buf.k[b], buf.i[b], buf.j[b], p.radius_m[buf.i[b]], buf.d_m[b], buf.dist2_m2[b], worst,
-                       visit);
-      buf.count = 0;
-    };
-    for (std::size_t i = row_begin; i < row_end; ++i) {
-      const Vec3 xi = X[i];
-      const double ri = R[i];
-      for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
-        const std::uint32_t j = nbr[k];
-        const Vec3 d = X[j] - xi;
-        const double rsum = ri + R[j];
-        const double dist2 = d.squaredNorm();
-        const bool touching = dist2 < rsum * rsum;
-        ContactHistory& h = hist[k];
+  TouchingBuffer buf;                                  // kFilter only
+  auto visit_buffer = [&]() GRAVSWEEP_INLINE_LAMBDA {  // inlined at both calls (see above)
+    for (int b = 0; b < buf.count; ++b)
+      visit_touching(p, hist, buf.k[b], buf.i[b], buf.j[b], R[buf.i[b]], buf.d_m[b], buf.dist2_m2[b], worst, visit);
+    buf.count = 0;
+  };
+  for (std::size_t i = row_begin; i < row_end; ++i) {
+    const Vec3 xi = X[i];
+    const double ri = R[i];
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+      const std::uint32_t j = nbr[k];
+      const Vec3 d = X[j] - xi;
+      const double rsum = ri + R[j];
+      const double dist2 = d.squaredNorm();
+      const bool touching = dist2 < rsum * rsum;
+      ContactHistory& h = hist[k];
+      if constexpr (kFilter) {
         if (h.active & !touching) h.active = false;  // contact ended: history erased (no write otherwise)
         // Written whether or not the pair touches; only a touching pair keeps its slot.
         const int b = buf.count;
@@ -201,10 +183,16 @@ GRAVSWEEP_INLINE void for_each_touching_pair(ForceContext& c, std::size_t row_be
         buf.dist2_m2[b] = dist2;
         buf.count = b + static_cast<int>(touching);
         if (buf.count == TouchingBuffer::kSize) visit_buffer();
+      } else {
+        if (!touching) {
+          if (h.active) h.active = false;  // contact ended: history erased (no write otherwise)
+          continue;
+        }
+        visit_touching(p, hist, k, static_cast<std::uint32_t>(i), j, ri, d, dist2, worst, visit);
       }
     }
-    visit_buffer();
   }
+  if constexpr (kFilter) visit_buffer();
 }
 
 /// True when this thread's rows hold at least c.filter_min_pairs listed pairs: its pair loop
