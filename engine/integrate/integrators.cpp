@@ -27,6 +27,19 @@ GRAVSWEEP_INLINE void end_loop(const StepCheck& check, std::size_t begin, std::s
   found.max_displacement2_m2 = max_d2;
 }
 
+/// The closing half kick v += dt/2 a, w += dt/2 alpha of velocity Verlet and of the kick-drift-kick
+/// leapfrog on particles [begin, end), with the step checks.
+void closing_half_kick(Particles& p, double dt, const StepCheck& check, std::size_t begin, std::size_t end,
+                       StepFindings& found) {
+  end_loop(check, begin, end, found, [&](std::size_t i) -> Vec3 {
+    const Vec3 v = p.velocity_m_s[i] + 0.5 * dt * p.inv_mass_1_kg[i] * p.force_N[i];
+    p.velocity_m_s[i] = v;
+    p.omega_rad_s[i] += 0.5 * dt * p.inv_inertia_1_kg_m2[i] * p.torque_N_m[i];
+    // Positions moved in begin_step; a NaN velocity shows in the position next step.
+    return std::isfinite(v.x() + v.y() + v.z()) ? p.position_m[i] : v;
+  });
+}
+
 /// Chrono::Multicore: v_{n+1} = v_n + h a(x_n, v_n); x_{n+1} = x_n + h v_{n+1} (dem-physics.md 1.6).
 class SemiImplicitEuler final : public Integrator {
  public:
@@ -59,13 +72,7 @@ class VelocityVerlet final : public Integrator {
   }
   void end_range(Particles& p, double dt, const StepCheck& check, std::size_t begin, std::size_t end,
                  StepFindings& found) const override {
-    end_loop(check, begin, end, found, [&](std::size_t i) -> Vec3 {
-      const Vec3 v = p.velocity_m_s[i] + 0.5 * dt * p.inv_mass_1_kg[i] * p.force_N[i];
-      p.velocity_m_s[i] = v;
-      p.omega_rad_s[i] += 0.5 * dt * p.inv_inertia_1_kg_m2[i] * p.torque_N_m[i];
-      // Positions moved in begin_step; a NaN velocity shows in the position next step.
-      return std::isfinite(v.x() + v.y() + v.z()) ? p.position_m[i] : v;
-    });
+    closing_half_kick(p, dt, check, begin, end, found);
   }
 };
 
@@ -90,13 +97,7 @@ class LeapfrogKdk final : public Integrator {
   }
   void end_range(Particles& p, double dt, const StepCheck& check, std::size_t begin, std::size_t end,
                  StepFindings& found) const override {
-    end_loop(check, begin, end, found, [&](std::size_t i) -> Vec3 {
-      const Vec3 v = p.velocity_m_s[i] + 0.5 * dt * p.inv_mass_1_kg[i] * p.force_N[i];
-      p.velocity_m_s[i] = v;
-      p.omega_rad_s[i] += 0.5 * dt * p.inv_inertia_1_kg_m2[i] * p.torque_N_m[i];
-      // Positions moved in begin_step; a NaN velocity shows in the position next step.
-      return std::isfinite(v.x() + v.y() + v.z()) ? p.position_m[i] : v;
-    });
+    closing_half_kick(p, dt, check, begin, end, found);
   }
 };
 
