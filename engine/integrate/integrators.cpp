@@ -109,14 +109,11 @@ std::unique_ptr<Integrator> make() {
 }  // namespace
 
 void StepCheck::merge(const StepFindings& f) {
-#pragma omp critical(gravsweep_step_check)
-  {
-    if (f.bad_particle >= 0 && (found.bad_particle < 0 || f.bad_particle < found.bad_particle)) {
-      found.bad_particle = f.bad_particle;
-      found.bad_cause = f.bad_cause;
-    }
-    found.max_displacement2_m2 = std::max(found.max_displacement2_m2, f.max_displacement2_m2);
+  if (f.bad_particle >= 0 && (found.bad_particle < 0 || f.bad_particle < found.bad_particle)) {
+    found.bad_particle = f.bad_particle;
+    found.bad_cause = f.bad_cause;
   }
+  found.max_displacement2_m2 = std::max(found.max_displacement2_m2, f.max_displacement2_m2);
 }
 
 const std::vector<IntegratorEntry>& integrator_table() {

@@ -60,8 +60,9 @@ struct StepCheck {
     if (position_at_build != nullptr) *max_d2 = std::max(*max_d2, (x - position_at_build[i]).squaredNorm());
     return StateFault::none;
   }
-  /// Adds one share's findings to `found` (thread-safe): the lowest bad particle wins,
-  /// displacements take the maximum.
+  /// Adds one share's findings to `found` (not thread-safe: the force loop merges each thread's
+  /// findings after its parallel region): the lowest bad particle wins, displacements take the
+  /// maximum.
   void merge(const StepFindings& f);
 };
 

@@ -361,6 +361,18 @@ inline std::size_t first_row(const VerletList& list, std::size_t n, int k, int n
   return balanced_cut(weighed ? list.work_offset.data() : list.offset.data(), weighed ? 0 : kRowWork, n, k, nt);
 }
 
+/// What one thread of force_loop counts and finds, in its own cache line: combined in thread
+/// order after the parallel region instead of through OpenMP reductions and critical sections,
+/// whose shared lock both threads reached at the same moment every step and then slept on (futex
+/// calls, -7 % on the 0.1 m/s2 drop; BENCHMARKS.md). The fixed order also makes the tracked
+/// elastic energy the same sum every run.
+struct alignas(64) ThreadTally {
+  long long contacts = 0, wall_contacts = 0;
+  double energy_J = 0;
+  OverlapFailure worst;
+  StepFindings found;
+};
+
 /// Particles per block of force_loop's sum + end of step: the block's force and torque sums
 /// (48 bytes a particle) stay in L1 until the integrator reads them.
 inline constexpr std::size_t kFinishBlock = 256;
@@ -386,14 +398,16 @@ void force_loop(ForceContext& c) {
   const std::size_t n = p.size();
   const double* M = p.mass_kg.data();
   const double* inv_m = p.inv_mass_1_kg.data();
-  long long contacts = 0, wall_contacts = 0;
-  double energy = 0;
-  OverlapFailure worst;
+  // One tally per thread, combined in thread order after the region (no lock in the region).
+  std::vector<ThreadTally> tally(static_cast<std::size_t>(std::max(1, c.threads)));
+  int team = 1;
 
-#pragma omp parallel num_threads(c.threads) reduction(+ : contacts, wall_contacts, energy)
+#pragma omp parallel num_threads(c.threads)
   {
     const int t = omp_get_thread_num();
     const int nt = omp_get_num_threads();
+    if (t == 0) team = nt;
+    ThreadTally& mine = tally[static_cast<std::size_t>(t)];
     thread_local std::vector<std::size_t> first;  // first row of each thread, and n
     first.resize(static_cast<std::size_t>(nt) + 1);
     for (int k = 0; k <= nt; ++k) first[static_cast<std::size_t>(k)] = first_row(c.nlist, n, k, nt);
@@ -407,30 +421,25 @@ void force_loop(ForceContext& c) {
     Vec3* T = t == 0 ? p.torque_N_m.data() : c.thread_torque[t].data();
     std::fill(F + rows.begin, F + n, Vec3::Zero());
     std::fill(T + rows.begin, T + n, Vec3::Zero());
-    OverlapFailure mine;
     if constexpr (kHasHertzBatch<Law, Rolling>) {
       constexpr bool kRolling = std::is_same_v<Rolling, RollingSunday>;
       if (filter_pairs(c, rows))
-        pair_loop_batched<kRolling, true>(c, rows, F, T, contacts, energy, mine);
+        pair_loop_batched<kRolling, true>(c, rows, F, T, mine.contacts, mine.energy_J, mine.worst);
       else
-        pair_loop_batched<kRolling, false>(c, rows, F, T, contacts, energy, mine);
+        pair_loop_batched<kRolling, false>(c, rows, F, T, mine.contacts, mine.energy_J, mine.worst);
     } else {
       if (filter_pairs(c, rows))
-        pair_loop_scalar<Law, Rolling, true>(c, rows, F, T, contacts, energy, mine);
+        pair_loop_scalar<Law, Rolling, true>(c, rows, F, T, mine.contacts, mine.energy_J, mine.worst);
       else
-        pair_loop_scalar<Law, Rolling, false>(c, rows, F, T, contacts, energy, mine);
+        pair_loop_scalar<Law, Rolling, false>(c, rows, F, T, mine.contacts, mine.energy_J, mine.worst);
     }
-    wall_loop<Law, Rolling>(c, rows, F, T, wall_contacts, energy, mine);
-    if (mine.failed()) {
-#pragma omp critical(gravsweep_force_failure)
-      if (mine.ratio > worst.ratio) worst = mine;
-    }
+    wall_loop<Law, Rolling>(c, rows, F, T, mine.wall_contacts, mine.energy_J, mine.worst);
     // Sum the thread buffers in a fixed order and add gravity (same parallel region), each thread
     // on an even share of the particles; then finish the step on that same share (no barrier:
     // a particle's update reads only its own sums).
 #pragma omp barrier
     const auto [lo, hi] = even_share(n, t, nt);
-    StepFindings found;
+    StepFindings& found = mine.found;
     for (std::size_t b = lo; b < hi; b += kFinishBlock) {
       const std::size_t e = std::min(hi, b + kFinishBlock);
       for (std::size_t i = b; i < e; ++i) {
@@ -447,12 +456,16 @@ void force_loop(ForceContext& c) {
       // The block's sums are still in L1 when the integrator reads them back.
       if (c.finish != nullptr) c.finish->end_range(p, c.dt_s, *c.check, b, e, found);
     }
-    if (c.finish != nullptr) c.check->merge(found);
   }
-  c.stats.contacts = contacts;
-  c.stats.wall_contacts = wall_contacts;
-  c.stats.elastic_energy_J = energy;
-  c.failure = worst;
+  c.stats = StepStats{};
+  for (std::size_t t = 0; t < static_cast<std::size_t>(team); ++t) {
+    const ThreadTally& x = tally[t];
+    c.stats.contacts += x.contacts;
+    c.stats.wall_contacts += x.wall_contacts;
+    c.stats.elastic_energy_J += x.energy_J;
+    if (x.worst.failed() && x.worst.ratio > c.failure.ratio) c.failure = x.worst;
+    if (c.finish != nullptr) c.check->merge(x.found);
+  }
 }
 
 }  // namespace gravsweep

@@ -139,29 +139,46 @@ TEST(Bed, SettlingStopsAtTheCreepFloorOnceTheBedIsQuiet) {
 
 // 1 and 2 threads agree on a settled 500-grain bed after 1,000 steps: the only difference is the
 // order in which per-thread force buffers are summed (round-off), so positions agree to 1e-9 m
-// (2e-7 of a grain radius). The same thread count twice gives bit-identical results.
+// (2e-7 of a grain radius). The same thread count twice gives bit-identical results. The step's
+// counters, tallied per thread and combined after the parallel region (force_loop.h,
+// ThreadTally), count every thread's share: the same contacts and wall contacts for 1, 2 and 3
+// threads, the same elastic energy to round-off, and the same bits for 3 threads twice.
 TEST(Threads, OneAndTwoThreadsAgree) {
   auto base = settled_column(0.08, 0.09, 0.15, 1);
   ASSERT_GT(base->particles.size(), 400u);
   ASSERT_LT(base->particles.size(), 800u);
+  struct Run {
+    std::vector<Vec3> x_m;
+    StepStats stats;
+  };
   auto run = [&](int threads) {
     SystemConfig cfg = base->config();
     cfg.threads = threads;
     cfg.dt_s = 1e-6;
+    cfg.track_energy = true;
     System s(cfg);
     s.particles = base->particles;
     s.walls = base->walls;
     s.initialize();
     s.advance(1000);
-    EXPECT_GT(s.stats().contacts, 500);  // a real, loaded bed
-    return s.particles.position_m;
+    EXPECT_GT(s.stats().contacts, 500);      // a real, loaded bed
+    EXPECT_GT(s.stats().wall_contacts, 50);  // resting on the floor and the side wall
+    return Run{s.particles.position_m, s.stats()};
   };
-  const auto one = run(1), two = run(2), two_again = run(2);
+  const Run one = run(1), two = run(2), two_again = run(2), three = run(3), three_again = run(3);
   double worst = 0;
-  for (std::size_t i = 0; i < one.size(); ++i) worst = std::max(worst, (one[i] - two[i]).norm());
-  std::printf("max |x(1 thread) - x(2 threads)| = %.3g m over %zu grains\n", worst, one.size());
+  for (std::size_t i = 0; i < one.x_m.size(); ++i) worst = std::max(worst, (one.x_m[i] - two.x_m[i]).norm());
+  std::printf("max |x(1 thread) - x(2 threads)| = %.3g m over %zu grains; %lld contacts, %lld with walls\n", worst,
+              one.x_m.size(), one.stats.contacts, one.stats.wall_contacts);
   EXPECT_LT(worst, 1e-9);
-  for (std::size_t i = 0; i < two.size(); ++i) ASSERT_EQ(two[i], two_again[i]) << "particle " << i;
+  for (std::size_t i = 0; i < two.x_m.size(); ++i) ASSERT_EQ(two.x_m[i], two_again.x_m[i]) << "particle " << i;
+  for (const Run* r : {&two, &three}) {
+    EXPECT_EQ(r->stats.contacts, one.stats.contacts);
+    EXPECT_EQ(r->stats.wall_contacts, one.stats.wall_contacts);
+    EXPECT_NEAR(r->stats.elastic_energy_J, one.stats.elastic_energy_J, 1e-9 * one.stats.elastic_energy_J);
+  }
+  EXPECT_GT(one.stats.elastic_energy_J, 0);
+  EXPECT_EQ(three.stats.elastic_energy_J, three_again.stats.elastic_energy_J);
 }
 
 namespace {
