@@ -398,15 +398,14 @@ void force_loop(ForceContext& c) {
   const std::size_t n = p.size();
   const double* M = p.mass_kg.data();
   const double* inv_m = p.inv_mass_1_kg.data();
-  // One tally per thread, combined in thread order after the region (no lock in the region).
+  // One tally per thread, combined in thread order after the region (no lock in the region). A
+  // team smaller than asked leaves tallies untouched: zeros, which add nothing to the combination.
   std::vector<ThreadTally> tally(static_cast<std::size_t>(std::max(1, c.threads)));
-  int team = 1;
 
 #pragma omp parallel num_threads(c.threads)
   {
     const int t = omp_get_thread_num();
     const int nt = omp_get_num_threads();
-    if (t == 0) team = nt;
     ThreadTally& mine = tally[static_cast<std::size_t>(t)];
     thread_local std::vector<std::size_t> first;  // first row of each thread, and n
     first.resize(static_cast<std::size_t>(nt) + 1);
@@ -458,8 +457,7 @@ void force_loop(ForceContext& c) {
     }
   }
   c.stats = StepStats{};
-  for (std::size_t t = 0; t < static_cast<std::size_t>(team); ++t) {
-    const ThreadTally& x = tally[t];
+  for (const ThreadTally& x : tally) {
     c.stats.contacts += x.contacts;
     c.stats.wall_contacts += x.wall_contacts;
     c.stats.elastic_energy_J += x.energy_J;
