@@ -23,6 +23,9 @@ using Vec3 = Eigen::Vector3d;
 using Quat = Eigen::Quaterniond;
 
 inline constexpr double kPi = std::numbers::pi;
+/// Earth's gravity as the paper uses it (Sunday et al. 2021: 9.81 m/s2): the reference of the
+/// values that are scaled with gravity (stop speed, rolling threshold).
+inline constexpr double kEarthGravity_m_s2 = 9.81;
 inline constexpr double kInf = std::numeric_limits<double>::infinity();
 /// Small-number guard used by Chrono for |delta_t| and contact-circle radii (dem-physics.md 1.4).
 inline constexpr double kTinyLength_m = 1e-12;

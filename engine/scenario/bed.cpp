@@ -106,6 +106,20 @@ void grain_speeds(const System& sys, double& rms_m_s, double& max_m_s) {
   max_m_s = std::sqrt(mx2);
 }
 
+BedRestState bed_rest_state(const System& sys, double surface_height_m, double grain_diameter_m) {
+  BedRestState r;
+  grain_speeds(sys, r.rms_speed_m_s, r.max_speed_m_s);
+  const auto& p = sys.particles;
+  const double layer_bottom_m = surface_height_m - kSurfaceLayerDiameters * grain_diameter_m;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.size_class[i] != SizeClass::grain || p.inv_mass_1_kg[i] == 0 || p.position_m[i].z() < layer_bottom_m)
+      continue;
+    r.max_surface_speed_m_s = std::max(r.max_surface_speed_m_s, p.velocity_m_s[i].norm());
+    ++r.surface_grains;
+  }
+  return r;
+}
+
 const char* to_string(SettleEnd e) {
   switch (e) {
     case SettleEnd::criteria:
@@ -167,7 +181,32 @@ SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const 
   return end;
 }
 
-void ramp_gravity(System& sys, const Vec3& to_m_s2, double ramp_s, double interval_s, const BedProgress& progress) {
+void stop_grains(System& sys) {
+  auto& p = sys.particles;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (p.size_class[i] != SizeClass::grain || p.inv_mass_1_kg[i] == 0) continue;
+    // Power of the force (gravity included) and of the torque of the last step: negative when the
+    // grain moves or spins against them, past the bottom of its potential well.
+    if (p.force_N[i].dot(p.velocity_m_s[i]) < 0) p.velocity_m_s[i].setZero();
+    if (p.torque_N_m[i].dot(p.omega_rad_s[i]) < 0) p.omega_rad_s[i].setZero();
+  }
+}
+
+void quench(System& sys, double time_s, double interval_s, const BedProgress& progress) {
+  const double dt = sys.config().dt_s;
+  const long long chunk = std::max<long long>(1, std::llround(interval_s / dt));
+  const auto steps = static_cast<long long>(std::llround(time_s / dt));
+  for (long long k = 0; k < steps; k += chunk) {
+    sys.advance(std::min(chunk, steps - k));
+    stop_grains(sys);
+    if (progress)
+      progress(BedPhase::relax, static_cast<double>(k) / static_cast<double>(steps),
+               fmt::format("quench: {:.3f} of {:.3f} s", static_cast<double>(k) * dt, time_s));
+  }
+}
+
+void ramp_gravity(System& sys, const Vec3& to_m_s2, double ramp_s, double interval_s, const BedProgress& progress,
+                  bool quench_grains) {
   const Vec3 g0 = sys.config().gravity_m_s2;
   const double n0 = g0.norm(), n1 = to_m_s2.norm();
   const double dt = sys.config().dt_s;
@@ -179,6 +218,7 @@ void ramp_gravity(System& sys, const Vec3& to_m_s2, double ramp_s, double interv
       const double f = static_cast<double>(k) / static_cast<double>(steps);
       sys.set_gravity(to_m_s2 / n1 * (n0 * std::pow(n1 / n0, f)));  // geometric: equal ratios per step
       sys.advance(std::min(chunk, steps - k));
+      if (quench_grains) stop_grains(sys);
       if (progress)
         progress(BedPhase::relax, 0.0, fmt::format("gravity ramp: {:.3g} m/s2", sys.config().gravity_m_s2.norm()));
     }
@@ -252,8 +292,13 @@ BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progr
   if (progress) progress(BedPhase::flatten, 1.0, fmt::format("{} grains kept", sys.particles.size()));
   // Relax the new surface (at the drop's gravity when the bed was settled at another, reached by a
   // geometric ramp so that the contacts unload gradually).
+  const bool quenched = spec.quench_interval_s > 0 && spec.quench_time_s > 0;
   if (spec.relax_gravity_m_s2)
-    ramp_gravity(sys, *spec.relax_gravity_m_s2, spec.gravity_ramp_s, spec.settle.check_interval_s, progress);
+    ramp_gravity(sys, *spec.relax_gravity_m_s2, spec.gravity_ramp_s, spec.settle.check_interval_s, progress, quenched);
+  if (quenched) {
+    quench(sys, spec.quench_time_s, spec.quench_interval_s, progress);
+    rep.quench_time_s = spec.quench_time_s;
+  }
   const double t1 = sys.time_s();
   rep.relax_end =
       settle(sys, spec.settle, spec.relax_time_s, progress, BedPhase::relax, &rep.rms_speed_m_s, &rep.max_speed_m_s);

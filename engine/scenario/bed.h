@@ -76,6 +76,17 @@ struct BedSpec {
   /// contacts' elastic energy into a bed that gravity barely holds: measured 1 cm/s RMS grain speed
   /// still 0.4 s later.
   double gravity_ramp_s = 0.1;
+  /// Kinetic-energy quench of a bed relaxed at another gravity (0: off): during the ramp and for
+  /// quench_time_s after it, every quench_interval_s, each grain that moves against the force on
+  /// it (F.v < 0: past the bottom of its potential well) is stopped, its spin likewise against its
+  /// torque. Grains still fall, slide and roll where the forces take them (a rattler lands in its
+  /// cage), but the elastic energy the contacts release as gravity falls is taken out instead of
+  /// launching grains that a weak gravity barely brings back: the per-grain form of the FIRE
+  /// minimiser's velocity reset (Bitzek et al. 2006, PRL 97, 170201), relaxing the packing to its
+  /// equilibrium at the new gravity. The relaxation that follows runs free, at least relax_time_s,
+  /// and its criteria are measured on free grains.
+  double quench_interval_s = 0;
+  double quench_time_s = 0;
 };
 
 /// Phase of bed preparation, for progress reporting.
@@ -90,7 +101,8 @@ struct BedReport {
   std::size_t grains_kept = 0;
   double settle_time_s = 0;
   double relax_time_s = 0;
-  bool settled = false;  ///< criteria met in both phases (false: the time cap or the creep floor ended one)
+  double quench_time_s = 0;  ///< time run under the quench after the ramp (0: no quench)
+  bool settled = false;      ///< criteria met in both phases (false: the time cap or the creep floor ended one)
   SettleEnd settle_end = SettleEnd::time_cap;  ///< how the settling of the pour ended
   SettleEnd relax_end = SettleEnd::time_cap;   ///< how the relaxation after flattening ended
   double rms_speed_m_s = 0;
@@ -113,7 +125,15 @@ SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const 
 
 /// Takes gravity from its present value to `to_m_s2` geometrically over ramp_s (same direction; in
 /// any other case, or with ramp_s = 0, at once), advancing the system meanwhile.
-void ramp_gravity(System& sys, const Vec3& to_m_s2, double ramp_s, double interval_s, const BedProgress& progress = {});
+/// With quench, stop_grains after each interval (BedSpec::quench_interval_s).
+void ramp_gravity(System& sys, const Vec3& to_m_s2, double ramp_s, double interval_s, const BedProgress& progress = {},
+                  bool quench = false);
+
+/// Stops each free grain moving against its force, and its spin against its torque (BedSpec quench).
+void stop_grains(System& sys);
+
+/// Runs time_s, applying stop_grains every interval_s (BedSpec::quench_interval_s).
+void quench(System& sys, double time_s, double interval_s, const BedProgress& progress = {});
 
 /// The whole preparation: walls, placement, settling, flattening, relaxation.
 BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progress = {});
@@ -123,6 +143,18 @@ double surface_height(const System& sys, double container_radius_m);
 
 /// RMS and maximum speed of the free grains (size class grain).
 void grain_speeds(const System& sys, double& rms_m_s, double& max_m_s);
+
+/// How still a bed is, for comparison with the impact it will receive: the speeds of grains that
+/// the projectile meets first (their centre within kSurfaceLayerDiameters grain diameters below
+/// the mean surface, or above it) and of the whole bed.
+struct BedRestState {
+  double rms_speed_m_s = 0;
+  double max_speed_m_s = 0;
+  double max_surface_speed_m_s = 0;
+  std::size_t surface_grains = 0;
+};
+inline constexpr double kSurfaceLayerDiameters = 2.0;
+BedRestState bed_rest_state(const System& sys, double surface_height_m, double grain_diameter_m);
 
 /// Packing fraction of the grains in a coaxial cylinder (axis distance < core_radius_m, z_lo_m < z <
 /// z_hi_m): each sphere's volume inside the z slab, exactly (layered crystals bias a count of whole

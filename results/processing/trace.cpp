@@ -269,8 +269,11 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
   }
   m.apeak_m_s2 = peak_acceleration(a, out.velocity_down_m_s, i_start, i_end, pass.start.step, pass.end.step, w,
                                    m.vc_m_s - out.rest_speed_offset_m_s, g);
-  m.zstop_m = interp_at(t, out.depth_m, m.t_end_s);
-  const Rebound rb = rebound_of(out.velocity_down_m_s, out.depth_m, i_start, i_end, m.vc_m_s, o);
+  const std::size_t i_last_depth = own_kinematics ? n - 1 : i_end;  // trace_steps.h, rebound_of
+  const Rebound rb = rebound_of(out.velocity_down_m_s, out.depth_m, i_start, i_end, i_last_depth, m.vc_m_s, o);
+  m.zstop_m = rb.max_depth_m;  // Sect. 2.3: the maximum penetration depth
+  m.depth_at_end_m = interp_at(t, out.depth_m, m.t_end_s);
+  m.final_depth_m = out.depth_m.back();
   m.rebound = rb.rebound;
   if (!rb.note.empty()) m.note += (m.note.empty() ? "" : "; ") + rb.note;
   out.i_start = i_start;

@@ -60,15 +60,17 @@ struct MetricOptions {
 
 /// The paper's metrics of one collision.
 struct Metrics {
-  double vc_m_s = 0;      ///< collision velocity (speed at collision start)
-  double apeak_m_s2 = 0;  ///< peak (upward) acceleration of the filtered trace
-  double zstop_m = 0;     ///< penetration depth at collision end
-  double tstop_s = 0;     ///< collision duration (end - start)
-  double t_start_s = 0;   ///< collision start: no longer in free fall
-  double t_end_s = 0;     ///< collision end: acceleration below end_threshold_g after the peak,
-                          ///< with the speed below end_speed_fraction * vc
-  bool rebound = false;   ///< moved up after contact, or came within one grain of the floor
-  std::string note;       ///< why a metric could not be found, if so
+  double vc_m_s = 0;          ///< collision velocity (speed at collision start)
+  double apeak_m_s2 = 0;      ///< peak (upward) acceleration of the filtered trace
+  double zstop_m = 0;         ///< penetration depth: the maximum depth of the collision (Sect. 2.3)
+  double depth_at_end_m = 0;  ///< depth at the collision end (below zstop_m after a rebound)
+  double final_depth_m = 0;   ///< depth at the last sample of the record
+  double tstop_s = 0;         ///< collision duration (end - start)
+  double t_start_s = 0;       ///< collision start: no longer in free fall
+  double t_end_s = 0;         ///< collision end: acceleration below end_threshold_g after the peak,
+                              ///< with the speed below end_speed_fraction * vc
+  bool rebound = false;       ///< rose back by more than 10 % of zstop after it (trace_steps::rebound_of)
+  std::string note;           ///< why a metric could not be found, if so
 };
 
 /// A processed trace: the filtered, bias-corrected acceleration, the velocity and depth (the

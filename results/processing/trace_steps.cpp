@@ -323,24 +323,30 @@ double peak_acceleration(const std::vector<double>& a, const std::vector<double>
 }
 
 Rebound rebound_of(const std::vector<double>& v, const std::vector<double>& z, std::size_t i_start, std::size_t i_end,
-                   double vc, const MetricOptions& o) {
+                   std::size_t i_last_depth, double vc, const MetricOptions& o) {
   Rebound r;
-  double vmin = 0, zmax = 0;
-  for (std::size_t k = i_start; k <= std::min(v.size() - 1, i_end); ++k) {
-    vmin = std::min(vmin, v[k]);
-    zmax = std::max(zmax, z[k]);
-  }
+  const std::size_t last = std::min(v.size() - 1, i_end);
+  double vmin = 0;
+  for (std::size_t k = i_start; k <= last; ++k) vmin = std::min(vmin, v[k]);
+  r.i_max_depth = i_start;
+  for (std::size_t k = i_start; k <= std::min(z.size() - 1, i_last_depth); ++k)
+    if (z[k] > z[r.i_max_depth]) r.i_max_depth = k;
+  r.max_depth_m = z[r.i_max_depth];
+  // The one rule: back up by more than kReboundRiseFraction of the deepest point, at any time
+  // after it (a bounce off the floor that falls back in still rose).
+  double z_after_min = r.max_depth_m;
+  for (std::size_t k = r.i_max_depth; k < z.size(); ++k) z_after_min = std::min(z_after_min, z[k]);
+  const double rise_m = r.max_depth_m - z_after_min;
   auto add = [&](const std::string& s) { r.note += (r.note.empty() ? "" : "; ") + s; };
-  if (vmin < -std::max(0.1 * vc, 0.01)) {
+  if (r.max_depth_m > 0 && rise_m > kReboundRiseFraction * r.max_depth_m) {
     r.rebound = true;
-    add(fmt::format("moved up at {:.3f} m/s", -vmin));
+    add(fmt::format("rose {:.4f} m back up from its deepest point {:.4f} m", rise_m, r.max_depth_m));
   }
+  if (vmin < -std::max(0.1 * vc, 0.01)) add(fmt::format("moved up at {:.3f} m/s", -vmin));
   if (o.fill_height_m) {
     const double grain = o.grain_diameter_m.value_or(0.0);
-    if (zmax >= *o.fill_height_m - grain) {
-      r.rebound = true;
-      add(fmt::format("reached {:.3f} m, within one grain of the floor at {:.3f} m", zmax, *o.fill_height_m));
-    }
+    if (r.max_depth_m >= *o.fill_height_m - grain)
+      add(fmt::format("reached {:.3f} m, within one grain of the floor at {:.3f} m", r.max_depth_m, *o.fill_height_m));
   }
   return r;
 }

@@ -178,12 +178,23 @@ double peak_acceleration(const std::vector<double>& a, const std::vector<double>
                          std::size_t i_end, bool step_start, bool step_end, std::size_t w, double vc_m_s,
                          double g_m_s2);
 
-/// Rebound: clearly moving up during the collision, or down to within one grain of the floor.
+/// A rebound rises back by more than this fraction of the maximum depth after reaching it.
+inline constexpr double kReboundRiseFraction = 0.1;
+
+/// The deepest point in [i_start, i_last_depth] (the paper's zstop, Sect. 2.3: the maximum
+/// penetration depth; the caller passes the record's last sample when the depth is the record's own,
+/// as a DEM projectile may still sink slowly after the acceleration criterion ended the collision
+/// at low gravity, and the collision end for a depth integrated from an accelerometer, which drifts
+/// after it) and the one rebound rule: after its deepest point the projectile rose back
+/// by more than kReboundRiseFraction of that depth (anywhere in the rest of the record). Moving up
+/// fast and reaching within one grain of the floor are noted, not flagged by themselves.
 struct Rebound {
   bool rebound = false;
-  std::string note;  ///< "moved up at ... m/s; reached ... m, within one grain of the floor ..."
+  double max_depth_m = 0;
+  std::size_t i_max_depth = 0;
+  std::string note;  ///< "rose ... back up ...; moved up at ... m/s; reached ... m, within one grain of the floor ..."
 };
 Rebound rebound_of(const std::vector<double>& v, const std::vector<double>& z, std::size_t i_start, std::size_t i_end,
-                   double vc_m_s, const MetricOptions& o);
+                   std::size_t i_last_depth, double vc_m_s, const MetricOptions& o);
 
 }  // namespace gravsweep::results::trace_steps

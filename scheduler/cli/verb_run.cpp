@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -67,22 +68,26 @@ struct RunOptions {
   std::string bed;
   int threads = 0;
   bool quiet = false;
-  double snapshot_interval_s = -1;  ///< < 0: the scenario's /output/snapshot_interval_s, else kRunSnapshotInterval_s
+  double snapshot_interval_s = -1;  ///< < 0: the scenario's, else kRunSnapshotInterval_sqrt_D_g
   bool no_figures = false;
 };
 
-/// `run`'s grain snapshots when neither the scenario nor --snapshot-interval sets them (issue 15):
-/// 200 per simulated second, about 40 for a drop to rest (BENCHMARKS.md: bytes and slowdown).
-constexpr double kRunSnapshotInterval_s = 0.005;
+/// `run`'s grain snapshots when neither the scenario nor --snapshot-interval sets them: every
+/// 0.05 sqrt(D/g) of simulated time (D the projectile diameter; 5 ms at 9.81 m/s2 and 10 cm),
+/// about 40 for a drop to rest at any gravity (BENCHMARKS.md: bytes and slowdown). A fixed 5 ms
+/// wrote 601 snapshots, 93 MB, for a 3 s drop at 0.001 m/s2.
+constexpr double kRunSnapshotInterval_sqrt_D_g = 0.05;
 
 /// The snapshot interval of this run: --snapshot-interval, else the scenario file's own
-/// /output/snapshot_interval_s, else kRunSnapshotInterval_s (campaign drops default to none).
-double snapshot_interval(const RunOptions& o) {
+/// /output/snapshot_interval_s, else kRunSnapshotInterval_sqrt_D_g (campaign drops default to none).
+double snapshot_interval(const RunOptions& o, const nlohmann::json& validated) {
   if (o.snapshot_interval_s >= 0) return o.snapshot_interval_s;
   std::ifstream f(o.scenario);
   const auto raw = nlohmann::json::parse(f, nullptr, false);
   const auto ptr = "/output/snapshot_interval_s"_json_pointer;
-  return raw.is_object() && raw.contains(ptr) && raw[ptr].is_number() ? raw[ptr].get<double>() : kRunSnapshotInterval_s;
+  if (raw.is_object() && raw.contains(ptr) && raw[ptr].is_number()) return raw[ptr].get<double>();
+  const double D = validated["/projectile/diameter_m"_json_pointer], g = validated["gravity_m_s2"];
+  return kRunSnapshotInterval_sqrt_D_g * std::sqrt(D / g);
 }
 
 /// Fig. 2 of the drop next to its trace; a drop the metrics cannot measure gets none (said why).
@@ -132,7 +137,7 @@ void print_metrics(const nlohmann::json& m, const nlohmann::json& bed_report) {
 
 void run_impact(const RunOptions& o) {
   nlohmann::json scenario = pipeline::load_scenario(o.scenario);  // refuses bad specs first
-  scenario["output"]["snapshot_interval_s"] = snapshot_interval(o);
+  scenario["output"]["snapshot_interval_s"] = snapshot_interval(o, scenario);
   if (!o.bed.empty()) {  // verified before any work: checksum, then the layout (bad -> exit 2)
     std::string unverified;
     (void)pipeline::read_user_bed(o.bed, &unverified);
@@ -203,14 +208,17 @@ void setup_run(CLI::App& app) {
       "run",
       "Run one impact as in Sunday et al. 2021 Sect. 2.2-2.3: fill the container, settle the grains,\n"
       "flatten the bed at the fill height, drop the projectile, stop when it rests, and measure\n"
-      "vc, apeak, zstop, tstop (Butterworth 500 Hz, end at a < 0.1 g with the speed below 10 % of vc)\n"
-      "and the rebound flag.\n"
+      "vc, apeak, zstop (the maximum depth), tstop (Butterworth 500 Hz; the collision ends at a < 0.1 g,\n"
+      "the paper's rule, with the speed below 10 % of vc, our addition: without it a lull between\n"
+      "force-chain bursts ends some collisions 5-100 ms early) and the rebound flag (back up by more\n"
+      "than 10 % of zstop). The stop criterion scales with gravity (schemas: /stop), and the bed must\n"
+      "be at rest relative to the impact (/at_rest).\n"
       "Writes DIR/bed.h5 (the prepared bed, reusable) with its checksum DIR/bed.h5.sha256,\n"
       "DIR/trace.h5 (the projectile at 10 kHz), DIR/metrics.json, DIR/fig2.png (Sunday et al.\n"
       "Fig. 2, as `gravsweep plot trace`), grain snapshots DIR/snapshots.h5 with DIR/snapshots.xdmf (open it in "
       "ParaView: grains and\n"
-      "projectile as point sets, every 5 ms unless the scenario or --snapshot-interval says\n"
-      "otherwise), and prints the metrics. The spec is checked against\n"
+      "projectile as point sets, every 0.05 sqrt(D/g): 5 ms at 9.81 m/s2 for the 10 cm projectile, unless\n"
+      "the scenario or --snapshot-interval says otherwise), and prints the metrics. The spec is checked against\n"
       "schemas/scenario.schema.json before any work; errors name the JSON pointer of the field.\n\n"
       "Examples:\n"
       "  gravsweep run examples/impact_1g.json --out runs/1g\n"
@@ -235,8 +243,8 @@ void setup_run(CLI::App& app) {
   sub->add_flag("--quiet", opt->quiet, "no progress bar");
   sub->add_option("--snapshot-interval", opt->snapshot_interval_s,
                   fmt::format("grain snapshots every S s of simulated time into DIR/snapshots.h5 + .xdmf; 0: none "
-                              "(default: the scenario's /output/snapshot_interval_s, else {})",
-                              kRunSnapshotInterval_s))
+                              "(default: the scenario's /output/snapshot_interval_s, else {} sqrt(D/g))",
+                              kRunSnapshotInterval_sqrt_D_g))
       ->check(CLI::NonNegativeNumber);
   sub->add_flag("--no-figures", opt->no_figures, "do not draw DIR/fig2.png");
   sub->callback([opt]() {

@@ -71,6 +71,27 @@ void gather_points(const Particles& p, const std::vector<int>& contacts, std::si
   }
 }
 
+/// The slowest impact a bed in this state is at rest for under the criterion's fractions.
+double slowest_impact_at_rest_m_s(const BedRestState& r, const AtRestCriterion& c) {
+  return std::max(r.max_surface_speed_m_s / c.surface_speed_fraction, r.rms_speed_m_s / c.rms_speed_fraction);
+}
+
+/// Refuses a bed whose grains still move too fast for this drop's impact (/at_rest), with the figures.
+void require_at_rest(const System& sys, const results::BedData& bed, const ScenarioParams& p,
+                     const std::filesystem::path& bed_path) {
+  const BedRestState r = bed_rest_state(sys, bed.surface_height_m, p.bed.grains.diameter_m);
+  const AtRestCriterion& c = p.at_rest;
+  const double v = c.impact_speed_m_s;
+  if (r.max_surface_speed_m_s < c.surface_speed_fraction * v && r.rms_speed_m_s < c.rms_speed_fraction * v) return;
+  throw ConfigError(fmt::format(
+      "bed {} is not at rest for an impact at {:.4g} m/s: its fastest surface grain moves at {:.3g} m/s (at "
+      "most {:g} of the impact speed allowed, /at_rest/surface_speed_fraction: {:.3g} m/s) and its RMS grain "
+      "speed is {:.3g} m/s (at most {:g}: {:.3g} m/s); it is at rest for impacts of at least {:.3g} m/s. "
+      "Settle the bed longer (/bed/settle) or drop faster",
+      bed_path.string(), v, r.max_surface_speed_m_s, c.surface_speed_fraction, c.surface_speed_fraction * v,
+      r.rms_speed_m_s, c.rms_speed_fraction, c.rms_speed_fraction * v, slowest_impact_at_rest_m_s(r, c)));
+}
+
 }  // namespace
 
 json bed_key(const json& scenario) { return bed_key_of_validated(validate_scenario(scenario)); }
@@ -110,6 +131,7 @@ BedJobResult run_bed_job(const json& scenario, const std::filesystem::path& bed_
   double wall_h = 0;
   for (const auto& w : sys.walls)
     if (w.kind == WallKind::cylinder) wall_h = w.height_m;
+  const BedRestState rest = bed_rest_state(sys, rep.surface_height_m, p.bed.grains.diameter_m);
   b.container_diameter_m = p.bed.container.diameter_m;
   b.wall_height_m = wall_h;
   b.fill_height_m = p.bed.fill_height_m;
@@ -126,8 +148,12 @@ BedJobResult run_bed_job(const json& scenario, const std::filesystem::path& bed_
               {"relax_end", to_string(rep.relax_end)},
               {"settle_time_s", rep.settle_time_s},
               {"relax_time_s", rep.relax_time_s},
-              {"rms_speed_m_s", rep.rms_speed_m_s},
-              {"max_speed_m_s", rep.max_speed_m_s},
+              {"quench_time_s", rep.quench_time_s},
+              {"rms_speed_m_s", rest.rms_speed_m_s},
+              {"max_speed_m_s", rest.max_speed_m_s},
+              {"max_surface_speed_m_s", rest.max_surface_speed_m_s},
+              {"surface_grains", rest.surface_grains},
+              {"at_rest_for_impacts_above_m_s", slowest_impact_at_rest_m_s(rest, p.at_rest)},
               {"surface_height_m", rep.surface_height_m},
               {"bulk_density_kg_m3", rep.bulk_density_kg_m3},
               {"steps", sys.step_count()},
@@ -230,6 +256,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   // Rebuild the bed in a fresh system: bit-exact state, no contact history (as after any restart).
   System sys(p.drop_config);
   load_bed(sys, bed);
+  require_at_rest(sys, bed, p, bed_in);
 
   // Grain snapshots (issue 15): the grains keep the order of bed.h5, the projectile comes last.
   std::unique_ptr<results::SnapshotWriter> snaps;
@@ -294,8 +321,15 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
     results::MeasuredTrial trial = results::dem_trial_of(td, {"", "", trace_out});
     results::process_trial(trial);
     const results::Metrics& r = trial.processed.metrics;
-    m = json{{"vc_m_s", r.vc_m_s},       {"apeak_m_s2", r.apeak_m_s2}, {"zstop_m", r.zstop_m}, {"tstop_s", r.tstop_s},
-             {"t_start_s", r.t_start_s}, {"t_end_s", r.t_end_s},       {"rebound", r.rebound}, {"note", r.note}};
+    m = json{{"vc_m_s", r.vc_m_s},
+             {"apeak_m_s2", r.apeak_m_s2},
+             {"zstop_m", r.zstop_m},
+             {"tstop_s", r.tstop_s},
+             {"t_start_s", r.t_start_s},
+             {"t_end_s", r.t_end_s},
+             {"rebound", r.rebound},
+             {"note", r.note},
+             {"depth_at_end_m", r.depth_at_end_m}};
   } catch (const std::exception& e) {
     m = json{{"vc_m_s", nullptr},    {"apeak_m_s2", nullptr}, {"zstop_m", nullptr}, {"tstop_s", nullptr},
              {"t_start_s", nullptr}, {"t_end_s", nullptr},    {"rebound", nullptr}, {"metrics_error", e.what()}};

@@ -14,6 +14,7 @@
 #include "engine/contact/registry.h"
 #include "engine/integrate/integrators.h"
 #include "engine/scenario/paper_params.h"
+#include "scheduler/sweep/canonical.h"
 #include "spec/schemas.h"
 
 // Typed JSON (nlohmann's from_json, found by argument-dependent lookup) for the engine's material
@@ -245,11 +246,13 @@ void check_size_and_steps(Checks& ck) {
              fmt::format("a window of at least check_interval_s ({:g} s) and below max_time_s ({:g} s)", check, cap));
   });
   ck.run([&] {
-    const double steps = ck.num("/stop/max_time_s") / ck.num("/dt_s");
+    const double g = ck.num("/gravity_m_s2"), D = ck.num("/projectile/diameter_m");
+    const double max_time_s = drop_stop(ck.at("/stop"), g, D).max_time_s;
+    const double steps = max_time_s / ck.num("/dt_s");
     if (steps > kMaxSteps)
       ck.bad("/dt_s", fmt::format("{:g}", ck.num("/dt_s")),
-             fmt::format("a time step giving at most {:g} steps over stop.max_time_s ({:g} s)", kMaxSteps,
-                         ck.num("/stop/max_time_s")));
+             fmt::format("a time step giving at most {:g} steps over the stop's time cap ({:g} s)", kMaxSteps,
+                         max_time_s));
   });
 }
 
@@ -337,6 +340,34 @@ void check_output(Checks& ck) {
 
 }  // namespace
 
+DropStop drop_stop(const json& stop, double gravity_m_s2, double projectile_diameter_m) {
+  const double speed_scale_m_s = std::sqrt(gravity_m_s2 * projectile_diameter_m);
+  const double time_scale_s = std::sqrt(projectile_diameter_m / gravity_m_s2);
+  auto pick = [&](const char* absolute, const char* scaled, double scale) {
+    return stop.contains(absolute) ? stop.at(absolute).get<double>() : stop.at(scaled).get<double>() * scale;
+  };
+  DropStop out;
+  out.speed_m_s = pick("speed_m_s", "speed_sqrt_gD", speed_scale_m_s);
+  out.hold_time_s = pick("hold_time_s", "hold_time_sqrt_D_g", time_scale_s);
+  out.max_time_s = pick("max_time_s", "max_time_sqrt_D_g", time_scale_s);
+  return out;
+}
+
+double drop_min_roll_vel_m_s(const json& s) {
+  const json& r = s.at("rolling_threshold");
+  if (r.contains("min_roll_vel_m_s")) return r.at("min_roll_vel_m_s");
+  return r.at("min_roll_vel_at_9_81_m_s").get<double>() *
+         std::sqrt(s.at("gravity_m_s2").get<double>() / kEarthGravity_m_s2);
+}
+
+double reference_impact_speed_m_s(const json& s) {
+  const json& p = s.at("projectile");
+  if (p.contains("impact_speed_m_s")) return p.at("impact_speed_m_s");
+  const double g = s.at("gravity_m_s2");
+  const double h = std::max(p.at("drop_height_m").get<double>(), s["/grains/diameter_m"_json_pointer].get<double>());
+  return std::sqrt(2 * g * h);
+}
+
 json validate_scenario(const json& scenario, const std::string& source) {
   json s = scenario;
   std::vector<SpecProblem> problems;
@@ -362,6 +393,20 @@ json load_scenario(const std::filesystem::path& path) {
   return validate_scenario(j, path.string());
 }
 
+std::uint64_t site_seed(const json& s) {
+  const json& pj = s.at("projectile");
+  const auto seed = pj.at("seed").get<std::uint64_t>();
+  if (pj.at("site_draw") == "seed") return seed;
+  // The sweep point: everything that makes one drop differ from another except the engine's
+  // settings (threads, dt, output, stop), so thread counts and outputs never move the site.
+  const json point{{"gravity_m_s2", s.at("gravity_m_s2")},
+                   {"projectile", pj},
+                   {"grains", s.at("grains")},
+                   {"container", s.at("container")}};
+  const std::string hex = sweep::sha256_hex(sweep::canonical_json(point));
+  return std::stoull(hex.substr(0, 16), nullptr, 16);
+}
+
 ScenarioParams scenario_params(const json& s) {
   ScenarioParams out;
   out.gravity_m_s2 = s.at("gravity_m_s2");
@@ -374,6 +419,7 @@ ScenarioParams scenario_params(const json& s) {
   out.drop_config = base_config(s, s.at("materials"));
   out.drop_config.dt_s = s.at("dt_s");
   out.drop_config.gravity_m_s2 = Vec3(0, 0, -out.gravity_m_s2);
+  out.drop_config.options.min_roll_vel_m_s = drop_min_roll_vel_m_s(s);
 
   BedSpec& b = out.bed;
   b.container.diameter_m = s["/container/diameter_m"_json_pointer];
@@ -399,6 +445,10 @@ ScenarioParams scenario_params(const json& s) {
   b.wall_material = kWallMaterial;
   if (settle_g != out.gravity_m_s2) b.relax_gravity_m_s2 = Vec3(0, 0, -out.gravity_m_s2);
   b.gravity_ramp_s = bj.at("gravity_ramp_s");
+  if (bj.contains("quench")) {
+    b.quench_interval_s = bj["/quench/interval_s"_json_pointer];
+    b.quench_time_s = bj["/quench/time_s"_json_pointer];
+  }
 
   const json& pj = s.at("projectile");
   ProjectileSpec& ps = out.projectile;
@@ -409,7 +459,7 @@ ScenarioParams scenario_params(const json& s) {
   if (pj.contains("drop_height_m")) ps.drop_height_m = pj.at("drop_height_m").get<double>();
   ps.start_gap_m = pj.at("start_gap_m");
   // Random start (paper, Chrono repeats: radial and vertical start within two grain diameters).
-  std::mt19937_64 rng(pj.at("seed").get<std::uint64_t>());
+  std::mt19937_64 rng(site_seed(s));
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const double lat = pj.at("lateral_offset_max_grain_diameters").get<double>() * b.grains.diameter_m;
   const double r = lat * std::sqrt(u(rng));
@@ -418,9 +468,10 @@ ScenarioParams scenario_params(const json& s) {
   ps.lateral_offset_y_m = r * std::sin(phi);
   ps.vertical_offset_m = pj.at("vertical_offset_max_grain_diameters").get<double>() * b.grains.diameter_m * u(rng);
 
-  out.stop.speed_m_s = s["/stop/speed_m_s"_json_pointer];
-  out.stop.hold_time_s = s["/stop/hold_time_s"_json_pointer];
-  out.stop.max_time_s = s["/stop/max_time_s"_json_pointer];
+  out.stop = drop_stop(s.at("stop"), out.gravity_m_s2, ps.diameter_m);
+  out.at_rest.surface_speed_fraction = s["/at_rest/surface_speed_fraction"_json_pointer];
+  out.at_rest.rms_speed_fraction = s["/at_rest/rms_speed_fraction"_json_pointer];
+  out.at_rest.impact_speed_m_s = reference_impact_speed_m_s(s);
   out.sample_rate_hz = s["/output/sample_rate_hz"_json_pointer];
   out.snapshot_interval_s = s["/output/snapshot_interval_s"_json_pointer];
 

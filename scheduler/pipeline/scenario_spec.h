@@ -27,6 +27,29 @@ nlohmann::json validate_scenario(const nlohmann::json& scenario, const std::stri
 /// Reads a scenario file (JSON) and validates it; parse errors name the file, line and column.
 nlohmann::json load_scenario(const std::filesystem::path& path);
 
+/// The drop's stop criterion from a validated /stop: each quantity absolute when given, else in
+/// the drop's scales (speed in sqrt(g D), time in sqrt(D/g); scenario.schema.json, /stop).
+DropStop drop_stop(const nlohmann::json& stop, double gravity_m_s2, double projectile_diameter_m);
+
+/// The drop's rolling-friction regularisation speed (/rolling_threshold): Chrono's value at
+/// 9.81 m/s2 scaled by sqrt(g / 9.81), or the absolute value given.
+double drop_min_roll_vel_m_s(const nlohmann::json& validated);
+
+/// The impact speed the bed must be at rest for (/at_rest): impact_speed_m_s, or for a release
+/// from rest sqrt(2 g h) with h the drop height (at least one grain diameter).
+double reference_impact_speed_m_s(const nlohmann::json& validated);
+
+/// The seed of the drop's random start: /projectile/seed mixed with the sweep point (gravity,
+/// projectile incl. its speed or drop height, grains, container) unless site_draw is "seed".
+std::uint64_t site_seed(const nlohmann::json& validated);
+
+/// The bed's residual grain speeds a drop accepts, relative to its impact speed (/at_rest).
+struct AtRestCriterion {
+  double surface_speed_fraction = 0.01;
+  double rms_speed_fraction = 0.001;
+  double impact_speed_m_s = 0;  ///< reference_impact_speed_m_s
+};
+
 /// Everything the engine needs, from a validated scenario.
 struct ScenarioParams {
   SystemConfig bed_config;   ///< preparation: bed.dt_s, settle gravity
@@ -34,6 +57,7 @@ struct ScenarioParams {
   BedSpec bed;
   ProjectileSpec projectile;  ///< with its random offsets drawn from projectile.seed
   DropStop stop;
+  AtRestCriterion at_rest;
   double gravity_m_s2 = 9.81;
   double sample_rate_hz = 1e4;
   double snapshot_interval_s = 0;         ///< /output/snapshot_interval_s: grain snapshots, 0 = none

@@ -151,7 +151,7 @@ TEST(Reproduction, ModelRankOnTheWholeChronoCampaignFindsASaturatingDepthResista
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("Verdict: structure left that no named term explains"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("a generated form fits it: c * (1-exp(-z/0.04))"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("zstop 38.3 -> 18.3 %"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("zstop 38.3 -> 18.2 %"), std::string::npos) << r.out;
   // Each level alone: depth friction at 1 g (the test above), nothing named at 0.1 m/s2, where the
   // residuals still trend consistently with time (said, not hidden as "no structure").
   const auto low = gravsweep::testing::run_gravsweep(

@@ -155,15 +155,67 @@ TEST(Metrics, RejectsBadTracesWithReasons) {
   EXPECT_THROW(compute_metrics(tr, nov), std::invalid_argument);
 }
 
-TEST(Metrics, FlagsReachingTheFloor) {
+TEST(Metrics, ReachingTheFloorIsNotedNotFlaggedWithoutARise) {
   Poncelet p;
   MetricOptions o;
   o.impact_velocity_m_s = p.v0;
   o.fill_height_m = p.zstop() + 0.005;
   o.grain_diameter_m = 0.01;
-  EXPECT_TRUE(compute_metrics(sample(p, 1400, 0.02, 0.0, 0.0, 1), o).rebound);
+  const Metrics near_floor = compute_metrics(sample(p, 1400, 0.02, 0.0, 0.0, 1), o);
+  EXPECT_FALSE(near_floor.rebound) << near_floor.note;
+  EXPECT_NE(near_floor.note.find("within one grain of the floor"), std::string::npos) << near_floor.note;
   o.fill_height_m = 0.2;
-  EXPECT_FALSE(compute_metrics(sample(p, 1400, 0.02, 0.0, 0.0, 1), o).rebound);
+  const Metrics deep = compute_metrics(sample(p, 1400, 0.02, 0.0, 0.0, 1), o);
+  EXPECT_FALSE(deep.rebound);
+  EXPECT_EQ(deep.note.find("floor"), std::string::npos) << deep.note;
+}
+
+/// A DEM record (10 kHz, own v and z) that stops at depth v0^2 / (2 A) under a constant kinematic
+/// deceleration A, is pushed back up by the floor (up at A for rise_s, then braked at A), and
+/// rests: it rises A rise_s^2 back from its deepest point.
+Trace bouncing_dem_trace(double v0, double A, double rise_s) {
+  const double g = 9.81, dt = 1e-4, t_contact = 0.01;
+  Trace tr;
+  tr.source = TraceSource::dem;
+  double v = v0 - g * t_contact, z = -(v0 * t_contact - 0.5 * g * t_contact * t_contact), t_stop = -1;
+  for (int i = 0; i * dt < 0.2; ++i) {
+    const double t = i * dt;
+    double a = -g;  // free fall, then the collision's phases
+    if (t >= t_contact) {
+      if (t_stop < 0 && v <= 0) t_stop = t;
+      if (t_stop < 0 || t < t_stop + rise_s)
+        a = A;
+      else if (t < t_stop + 2 * rise_s)
+        a = -A;
+      else
+        a = 0, v = 0;
+    }
+    tr.t_s.push_back(t);
+    tr.accel_up_m_s2.push_back(a);
+    tr.velocity_down_m_s.push_back(v);
+    tr.depth_m.push_back(z);
+    v -= a * dt;
+    z += v * dt;
+  }
+  return tr;
+}
+
+TEST(Metrics, ZstopIsTheMaximumDepthAndARiseIsARebound) {
+  // The paper's zstop (Sect. 2.3) is the maximum penetration depth: a drop that bounces off the
+  // floor and comes to rest 6 mm higher keeps the depth it reached (the depth at the collision's
+  // end, the old zstop, was 5.4 mm of 8.3 here), and a rise of more than 10 % of it flags a rebound.
+  const double v0 = 1.0, A = 60.0;
+  const Metrics m = compute_metrics(bouncing_dem_trace(v0, A, 0.01), MetricOptions{});
+  const double zmax = v0 * v0 / (2 * A);
+  EXPECT_NEAR(m.zstop_m, zmax, 0.03 * zmax) << m.note;
+  EXPECT_LT(m.depth_at_end_m, 0.9 * zmax) << m.note;  // the old zstop under-reported it
+  EXPECT_NEAR(m.final_depth_m, zmax - A * 0.01 * 0.01, 0.1 * zmax);
+  EXPECT_TRUE(m.rebound) << m.note;
+  EXPECT_NE(m.note.find("back up from its deepest point"), std::string::npos) << m.note;
+  // A rise of under 10 % (elastic recovery of the bed) is no rebound; zstop is still the deepest.
+  const Metrics small = compute_metrics(bouncing_dem_trace(v0, A, 0.002), MetricOptions{});
+  EXPECT_FALSE(small.rebound) << small.note;
+  EXPECT_NEAR(small.zstop_m, zmax, 0.03 * zmax);
 }
 
 TEST(Metrics, SimulatedTracesGetNoBiasAndShortDipsDoNotEndTheCollision) {
@@ -226,7 +278,10 @@ TEST(Metrics, ALullBetweenBurstsDoesNotEndTheCollision) {
   // With the paper's threshold alone (no speed condition) the collision would end in the lull.
   MetricOptions threshold_only = o;
   threshold_only.end_speed_fraction = 1e9;
-  EXPECT_LT(compute_metrics(tr, threshold_only).zstop_m, 0.5 * z_rest);
+  const Metrics early = compute_metrics(tr, threshold_only);
+  EXPECT_LT(early.tstop_s, 0.5 * (t_rest - t_contact));
+  EXPECT_LT(early.depth_at_end_m, 0.5 * z_rest);
+  EXPECT_NEAR(early.zstop_m, z_rest, 0.02 * z_rest);  // the deepest point does not depend on the end
   // The same record as an accelerometer gives it: no v, no z; the impact speed is known.
   Trace lab;
   lab.t_s = tr.t_s;

@@ -243,19 +243,29 @@ TEST(TraceSteps, PeakLeavesOutTheRingingAndExtrapolatesAStepContactToVc) {
   EXPECT_DOUBLE_EQ(peak_acceleration(a, v, 10, 60, false, false, w, vc, kG), 100.0);
 }
 
-TEST(TraceSteps, ReboundWhenMovingUpOrReachingTheFloor) {
+TEST(TraceSteps, ReboundIsARiseFromTheDeepestPointOthersAreNotes) {
   MetricOptions o;
   std::vector<double> v(20, 0.3), z(20, 0.05);
-  EXPECT_FALSE(rebound_of(v, z, 2, 15, 1.0, o).rebound);
-  v[10] = -0.2;
-  const Rebound up = rebound_of(v, z, 2, 15, 1.0, o);
-  EXPECT_TRUE(up.rebound);
+  for (std::size_t k = 0; k < 20; ++k) z[k] = 0.001 * static_cast<double>(k);  // deepest at the end
+  const Rebound none = rebound_of(v, z, 2, 15, 15, 1.0, o);
+  EXPECT_FALSE(none.rebound);
+  EXPECT_EQ(none.i_max_depth, 15u);
+  EXPECT_DOUBLE_EQ(none.max_depth_m, 0.015);
+  v[10] = -0.2;  // moving up fast is noted, the rise decides
+  const Rebound up = rebound_of(v, z, 2, 15, 15, 1.0, o);
+  EXPECT_FALSE(up.rebound);
   EXPECT_NE(up.note.find("moved up at 0.200 m/s"), std::string::npos) << up.note;
-  v[10] = 0.3;
-  o.fill_height_m = 0.055;
+  for (std::size_t k = 11; k < 20; ++k) z[k] = 0.008;  // deepest 0.010 at sample 10, then 2 mm up
+  const Rebound rise = rebound_of(v, z, 2, 15, 15, 1.0, o);
+  EXPECT_EQ(rebound_of(v, z, 2, 15, 19, 1.0, o).i_max_depth, 10u);  // the search may run past the end
+  z[18] = 0.02;
+  EXPECT_EQ(rebound_of(v, z, 2, 15, 19, 1.0, o).i_max_depth, 18u);
+  EXPECT_TRUE(rise.rebound);
+  EXPECT_EQ(rise.i_max_depth, 10u);
+  EXPECT_NE(rise.note.find("back up"), std::string::npos) << rise.note;
+  o.fill_height_m = 0.015;
   o.grain_diameter_m = 0.01;
-  const Rebound floor = rebound_of(v, z, 2, 15, 1.0, o);
-  EXPECT_TRUE(floor.rebound);
+  const Rebound floor = rebound_of(v, z, 2, 15, 15, 1.0, o);
   EXPECT_NE(floor.note.find("within one grain of the floor"), std::string::npos) << floor.note;
 }
 

@@ -2,6 +2,7 @@
 // pointer of the bad field, the value found and what was expected.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <fstream>
 #include <sstream>
 
@@ -47,7 +48,7 @@ TEST(ScenarioSpec, DefaultsAreThePapersChronoSetup) {
   EXPECT_DOUBLE_EQ(s["/contact/pairs/grain-wall/mu_static"_json_pointer].get<double>(), 0.45);
   EXPECT_DOUBLE_EQ(s["dt_s"].get<double>(), 1e-6);
   EXPECT_DOUBLE_EQ(s["/output/sample_rate_hz"_json_pointer].get<double>(), 1e4);
-  EXPECT_DOUBLE_EQ(s["/stop/speed_m_s"_json_pointer].get<double>(), 1e-3);
+  EXPECT_DOUBLE_EQ(s["/stop/speed_sqrt_gD"_json_pointer].get<double>(), 1e-3);
   EXPECT_DOUBLE_EQ(s["/bed/settle/rms_speed_m_s"_json_pointer].get<double>(), 1e-5);
   // The engine parameters equal Table 1's Chrono set of engine/scenario/paper_params.h.
   const auto p = pipeline::scenario_params(s);
@@ -92,6 +93,64 @@ TEST(ScenarioSpec, OffsetsAreDrawnWithinTheirBoundsFromTheSeed) {
   s["projectile"]["seed"] = 2;
   const auto c = pipeline::scenario_params(validate_scenario(s));
   EXPECT_NE(a.projectile.lateral_offset_x_m, c.projectile.lateral_offset_x_m);
+}
+
+// Repeats are independent: the site is drawn from the seed and the sweep point, so the same seed
+// at another speed or gravity hits another site (before, seeds 1-3 hit the same three sites at
+// every speed and both gravity levels), while the same point always hits the same one.
+TEST(ScenarioSpec, TheSameSeedAtAnotherSpeedOrGravityHitsAnotherSite) {
+  json s = minimal();
+  s["projectile"]["vertical_offset_max_grain_diameters"] = 0.5;
+  auto site = [](const json& spec) {
+    const auto p = pipeline::scenario_params(validate_scenario(spec)).projectile;
+    return std::array<double, 3>{p.lateral_offset_x_m, p.lateral_offset_y_m, p.vertical_offset_m};
+  };
+  const auto a = site(s);
+  EXPECT_EQ(a, site(s));
+  json faster = s, lower = s, threads = s;
+  faster["projectile"]["impact_speed_m_s"] = 0.8;
+  lower["gravity_m_s2"] = 0.1;
+  threads["threads"] = 2;  // engine settings never move the site
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NE(a[k], site(faster)[k]) << k;
+    EXPECT_NE(a[k], site(lower)[k]) << k;
+  }
+  EXPECT_EQ(a, site(threads));
+  // site_draw "seed": the seed alone, as the committed reproduction parts were drawn.
+  s["projectile"]["site_draw"] = "seed";
+  faster["projectile"]["site_draw"] = "seed";
+  EXPECT_EQ(site(s), site(faster));
+}
+
+// The stop criterion is in the drop's own scales unless given absolute: at 9.81 m/s2 and 10 cm the
+// paper's 1 mm/s, 5 ms and 1 s; at 0.001 m/s2 a hundred times slower and longer.
+TEST(ScenarioSpec, TheStopScalesWithGravityUnlessGivenAbsolute) {
+  const auto at = [](double g, const json& stop) {
+    json s = minimal();
+    s["gravity_m_s2"] = g;
+    s["projectile"]["impact_speed_m_s"] = 0.05;
+    s["projectile"]["start_gap_m"] = 1e-4;
+    s["stop"] = stop;
+    return pipeline::scenario_params(validate_scenario(s));
+  };
+  const auto earth = at(9.81, json::object());
+  EXPECT_NEAR(earth.stop.speed_m_s, 1e-3, 1e-5);
+  EXPECT_NEAR(earth.stop.hold_time_s, 5e-3, 1e-4);
+  EXPECT_NEAR(earth.stop.max_time_s, 1.0, 0.01);
+  EXPECT_DOUBLE_EQ(earth.drop_config.options.min_roll_vel_m_s, 1e-4);  // Chrono's value at 1 g
+  const auto low = at(0.000981, json::object());
+  EXPECT_NEAR(low.stop.speed_m_s, 1e-3 / 100, 1e-7);
+  EXPECT_NEAR(low.stop.max_time_s, 100 * earth.stop.max_time_s, 1e-9);
+  EXPECT_NEAR(low.drop_config.options.min_roll_vel_m_s, 1e-6, 1e-12);
+  const auto fixed = at(0.001, json{{"speed_m_s", 2e-3}, {"max_time_s", 3.0}});
+  EXPECT_DOUBLE_EQ(fixed.stop.speed_m_s, 2e-3);
+  EXPECT_DOUBLE_EQ(fixed.stop.max_time_s, 3.0);
+  // A validated scenario (both forms present) validates again to the same drop: absolute wins.
+  json twice = minimal();
+  twice["stop"] = json{{"speed_m_s", 2e-3}};
+  const json once = validate_scenario(twice);
+  EXPECT_EQ(validate_scenario(once), once);
+  EXPECT_DOUBLE_EQ(pipeline::scenario_params(validate_scenario(once)).stop.speed_m_s, 2e-3);
 }
 
 TEST(ScenarioSpec, UnknownFieldsAreRefusedWithTheirPointer) {
