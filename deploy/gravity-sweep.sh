@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# The gravity sweep (GRAVITY.md): five gravity levels from 9.81 to 0.001 m/s2, speeds by Froude
+# number, run with gravsweep's own scheduler. The cheap levels run first (sweep priorities); every
+# run resumes where the last one stopped (kill it any time).
+#
+#   deploy/gravity-sweep.sh run      submit examples/gravity_sweep/*.json and run the workers
+#   deploy/gravity-sweep.sh status   progress with ETA
+#   deploy/gravity-sweep.sh export   finished levels -> data/gravity_sweep/ (measurement format, 2 kHz)
+#
+# Environment: GRAVSWEEP_CAMPAIGN (default runs/gravity_sweep/sweep.db), GRAVSWEEP_BIN (default
+# build/scheduler/gravsweep), WORKERS (1), THREADS (2).
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+gs="${GRAVSWEEP_BIN:-$root/build/scheduler/gravsweep}"
+db="${GRAVSWEEP_CAMPAIGN:-$root/runs/gravity_sweep/sweep.db}"
+data="$root/data/gravity_sweep"
+[ -x "$gs" ] || { "$root/deploy/install-deps.sh" && "$root/deploy/build.sh"; }
+
+case "${1:-}" in
+  run)
+    mkdir -p "$(dirname "$db")" "$data/beds"
+    for spec in "$root"/examples/gravity_sweep/g*.json; do "$gs" submit "$spec" --db "$db"; done
+    "$gs" resume --db "$db"
+    # Beds are kept in data/gravity_sweep/beds/ (commit them: a fresh machine skips their preparation).
+    exec nice -n 10 "$gs" work --db "$db" --workers "${WORKERS:-1}" --threads "${THREADS:-2}" --lease 300 \
+      --bed-cache "$data/beds"
+    ;;
+  status)
+    exec "$gs" status --db "$db"
+    ;;
+  export)
+    # One measurement campaign per level with finished drops, and one result table of all levels.
+    for spec in "$root"/examples/gravity_sweep/g*.json; do
+      sweep=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["sweep"])' "$spec")
+      dir="$data/${sweep#gravity_sweep_}"
+      rm -rf "$dir.tmp"
+      if "$gs" export --db "$db" --sweep "$sweep" --out "$dir.tmp" --rate-hz 2000; then
+        rm -rf "$dir" && mv "$dir.tmp" "$dir"
+      else
+        echo "export: $sweep: nothing exported (see above)"; rm -rf "$dir.tmp"
+      fi
+    done
+    "$gs" results --db "$db" --where 'sweep~gravity_sweep_' --where "kind=drop" --all --format csv \
+      --out "$data/results.csv"
+    "$gs" results --db "$db" --where 'sweep~gravity_sweep_' --where "kind=bed" --all --format csv \
+      --out "$data/beds.csv"
+    du -sh "$data"
+    ;;
+  *)
+    sed -n '2,12p' "$0"
+    exit 2
+    ;;
+esac
