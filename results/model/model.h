@@ -115,8 +115,13 @@ struct Table3Row {
   int trials = 0;
   double f0_N = NAN, f0_se_N = NAN, inv_d1_1_m = NAN, inv_d1_se_1_m = NAN, vt_m_s = NAN, vt_se_m_s = NAN;
   double alpha = NAN, alpha_se = NAN;
+  /// Bootstrap over whole drops (kTable3BootstrapResamples, fixed seed): uncertainties that
+  /// include the scatter between impact sites, which the OLS errors above understate when sites repeat.
+  double f0_boot_se_N = NAN, inv_d1_boot_se_1_m = NAN;
   std::string note;  ///< why a level was not fitted (too few trials or speeds); empty when fitted
 };
+inline constexpr int kTable3BootstrapResamples = 2000;
+inline constexpr unsigned kTable3BootstrapSeed = 1;
 /// Eq. 2 is a line in vc^2: a level is fitted only with at least kTable3MinTrials trials whose
 /// collision speeds span at least a factor kTable3MinSpeedRatio (one speed cannot separate f0
 /// from 1/d1).

@@ -3,7 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
+#include <random>
+#include <utility>
 #include <stdexcept>
 
 #include "results/model/model.h"
@@ -17,6 +20,53 @@ using namespace detail;
 // The paper's method: Table 3
 
 namespace {
+
+/// Eq. 2 fitted to apeak(vc^2) of the trials `pick` (indices into ts): f0 (N) and 1/d1 (1/m).
+std::pair<double, double> eq2_fit(const std::vector<const MeasuredTrial*>& ts, const std::vector<std::size_t>& pick,
+                                  double g, double mass) {
+  const auto n = static_cast<Eigen::Index>(pick.size());
+  Eigen::MatrixXd X(n, 2);
+  Eigen::VectorXd y(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto& m = ts[pick[static_cast<std::size_t>(i)]]->processed.metrics;
+    X(i, 0) = 1.0;
+    X(i, 1) = m.vc_m_s * m.vc_m_s;
+    y(i) = m.apeak_m_s2;
+  }
+  const Eigen::Vector2d b = X.colPivHouseholderQr().solve(y);
+  return {mass * (b(0) + g), b(1)};
+}
+
+/// Bootstrap standard errors of f0 and 1/d1 over whole drops (each drop resampled with its own
+/// site and scatter): with a site per drop they carry the site-to-site scatter that the OLS
+/// errors, which assume independent residuals about one line, leave out when sites repeat.
+void bootstrap_eq2(const std::vector<const MeasuredTrial*>& ts, double g, double mass, Table3Row& r) {
+  std::mt19937_64 rng(kTable3BootstrapSeed);
+  std::uniform_int_distribution<std::size_t> pick_one(0, ts.size() - 1);
+  std::vector<double> f0, inv_d1;
+  std::vector<std::size_t> pick(ts.size());
+  for (int b = 0; b < kTable3BootstrapResamples; ++b) {
+    double vmin = INFINITY, vmax = 0;
+    for (auto& k : pick) {
+      k = pick_one(rng);
+      vmin = std::min(vmin, ts[k]->processed.metrics.vc_m_s);
+      vmax = std::max(vmax, ts[k]->processed.metrics.vc_m_s);
+    }
+    if (!(vmax >= kTable3MinSpeedRatio * vmin)) continue;  // one speed cannot separate f0 from 1/d1
+    const auto [f, d] = eq2_fit(ts, pick, g, mass);
+    f0.push_back(f);
+    inv_d1.push_back(d);
+  }
+  auto sd = [](const std::vector<double>& x) {
+    if (x.size() < 2) return std::numeric_limits<double>::quiet_NaN();
+    const double mean = std::accumulate(x.begin(), x.end(), 0.0) / static_cast<double>(x.size());
+    double s2 = 0;
+    for (double v : x) s2 += (v - mean) * (v - mean);
+    return std::sqrt(s2 / static_cast<double>(x.size() - 1));
+  };
+  r.f0_boot_se_N = sd(f0);
+  r.inv_d1_boot_se_1_m = sd(inv_d1);
+}
 
 std::vector<Table3Row> table3_of(const Campaign& c, const std::vector<bool>& mask) {
   std::vector<Table3Row> rows;
@@ -81,6 +131,7 @@ std::vector<Table3Row> table3_of(const Campaign& c, const std::vector<bool>& mas
     }
     r.alpha = bl(1);
     r.alpha_se = std::sqrt(cvl(1, 1));
+    bootstrap_eq2(ts, g, mass, r);
     rows.push_back(r);
   }
   return rows;

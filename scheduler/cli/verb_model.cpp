@@ -185,23 +185,25 @@ void setup_model(CLI::App& app) {
   });
 
   auto o3 = std::make_shared<ModelOptions>();
-  auto* t3 =
-      sub->add_subcommand("table3",
-                          "The paper's method (Sunday et al. 2021 Sect. 4): per gravity level fit Eq. 2 to apeak(vc),\n"
-                          "print f0, 1/d1, vt (Eq. 5) and alpha (zstop ~ H^alpha) with standard errors, as Table 3.\n\n"
-                          "Examples:\n  gravsweep model table3 ../shared/data/measurements/depth-friction-dev\n"
-                          "  gravsweep model table3 campaign.db --where 'impact_speed_m_s>=0.5'");
+  auto* t3 = sub->add_subcommand(
+      "table3",
+      "The paper's method (Sunday et al. 2021 Sect. 4): per gravity level fit Eq. 2 to apeak(vc),\n"
+      "print f0, 1/d1, vt (Eq. 5) and alpha (zstop ~ H^alpha) with standard errors, as Table 3,\n"
+      "and bootstrap errors of f0 and 1/d1 over whole drops (*_boot_se_*: they include the\n"
+      "scatter between impact sites, which the least-squares errors understate when sites repeat).\n\n"
+      "Examples:\n  gravsweep model table3 ../shared/data/measurements/depth-friction-dev\n"
+      "  gravsweep model table3 campaign.db --where 'impact_speed_m_s>=0.5'");
   t3->add_option("dir", o3->dir, kDirHelp)->required();
   t3->add_option("--where", o3->where, kWhereHelp);
   add_format_option(t3, o3->format);
   t3->callback([o3]() {
     const auto c = load(o3->dir, o3->where);
-    results::Table t({"gravity_m_s2", "trials", "f0_N", "f0_se_N", "inv_d1_1_m", "inv_d1_se_1_m", "vt_m_s", "vt_se_m_s",
-                      "alpha", "alpha_se", "note"});
+    results::Table t({"gravity_m_s2", "trials", "f0_N", "f0_se_N", "f0_boot_se_N", "inv_d1_1_m", "inv_d1_se_1_m",
+                      "inv_d1_boot_se_1_m", "vt_m_s", "vt_se_m_s", "alpha", "alpha_se", "note"});
     for (const auto& r : results::table3(c))
-      t.add({num(r.g_m_s2), std::to_string(r.trials), num(r.f0_N, 3), num(r.f0_se_N, 2), num(r.inv_d1_1_m, 3),
-             num(r.inv_d1_se_1_m, 2), num(r.vt_m_s, 3), num(r.vt_se_m_s, 2), num(r.alpha, 3), num(r.alpha_se, 2),
-             r.note});
+      t.add({num(r.g_m_s2), std::to_string(r.trials), num(r.f0_N, 3), num(r.f0_se_N, 2), num(r.f0_boot_se_N, 2),
+             num(r.inv_d1_1_m, 3), num(r.inv_d1_se_1_m, 2), num(r.inv_d1_boot_se_1_m, 2), num(r.vt_m_s, 3),
+             num(r.vt_se_m_s, 2), num(r.alpha, 3), num(r.alpha_se, 2), r.note});
     t.print(o3->format);
   });
 

@@ -105,7 +105,14 @@ TEST(Table3, PaperMethodGivesParametersWithUncertainties) {
     EXPECT_GT(r.f0_se_N, 0);
     EXPECT_GT(r.inv_d1_se_1_m, 0);
     EXPECT_GT(r.alpha_se, 0);
+    // The bootstrap over drops: the order of the least-squares errors when every drop has
+    // its own scatter (the dev campaign's trials are independent), reproducible (fixed seed).
+    EXPECT_GT(r.f0_boot_se_N, 0.3 * r.f0_se_N);
+    EXPECT_LT(r.f0_boot_se_N, 3 * r.f0_se_N);
+    EXPECT_GT(r.inv_d1_boot_se_1_m, 0.3 * r.inv_d1_se_1_m);
+    EXPECT_LT(r.inv_d1_boot_se_1_m, 3 * r.inv_d1_se_1_m);
   }
+  EXPECT_EQ(table3(dev())[0].f0_boot_se_N, rows[0].f0_boot_se_N);
   // 1 g: f0 near the truth's 1.6 m g = 15.7 N and 1/d1 near 25 1/m, within 3 standard errors.
   EXPECT_NEAR(rows[0].f0_N, 15.7, 3 * rows[0].f0_se_N + 2);
   EXPECT_NEAR(rows[0].inv_d1_1_m, 25, 3 * rows[0].inv_d1_se_1_m);
