@@ -15,6 +15,7 @@
 #include "results/io/snapshot_file.h"
 #include "results/io/trace_file.h"
 #include "results/measurements/campaign.h"
+#include "results/model/collapse.h"
 #include "results/report/report.h"
 
 namespace gravsweep::results {
@@ -260,6 +261,26 @@ std::string draw_fig1(const Fig1Request& rq) {
                                         100 * bed.fill_height_m, bed.gravity_m_s2)}};
   plot(tmp, "bed", spec, rq.out);
   return what;
+}
+
+void draw_collapse(const Campaign& campaign, const std::string& out, const std::string& title) {
+  check_png(out);
+  ScratchDir tmp("collapse");
+  {
+    std::ofstream f(tmp.path / "collapse.csv");
+    f << "gravity_m_s2,froude,zstop_over_D,tstop_sqrt_g_over_D,apeak_over_g\n";
+    for (const auto& s : scaled_trials(campaign))
+      f << fmt::format("{},{},{},{},{}\n", s.gravity_m_s2, s.froude, s.zstop_over_D, s.tstop_sqrt_g_over_D,
+                       s.apeak_over_g);
+    if (!f) throw std::runtime_error(fmt::format("{}: cannot write", (tmp.path / "collapse.csv").string()));
+  }
+  json rows = json::array();
+  for (const auto& r : collapse(campaign))
+    rows.push_back({{"metric", r.metric},
+                    {"common_scatter_pct", r.common_scatter_pct},
+                    {"within_scatter_pct", r.within_scatter_pct},
+                    {"collapse_ratio", r.collapse_ratio}});
+  plot(tmp, "collapse", json{{"out", fs::absolute(out).string()}, {"title", title}, {"rows", rows}}, out);
 }
 
 }  // namespace gravsweep::results

@@ -13,6 +13,8 @@
 
 #include "results/processing/trace.h"
 
+#include "results/measurements/campaign.h"
+
 namespace gravsweep::results {
 
 struct Fig2Request {
@@ -34,5 +36,9 @@ struct Fig1Request {
 
 /// Draws Fig. 1; returns a one-line description of what was drawn.
 std::string draw_fig1(const Fig1Request& request);
+
+/// The Froude-number collapse (results/model/collapse.h): zstop/D, tstop sqrt(g/D), apeak/g against
+/// Fr, one colour per gravity level, each panel titled with its collapse numbers. `out`: PNG.
+void draw_collapse(const Campaign& campaign, const std::string& out, const std::string& title = "");
 
 }  // namespace gravsweep::results

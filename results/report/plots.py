@@ -409,6 +409,45 @@ def plot_bed():
     written.append(spec["out"])
 
 
+def plot_collapse():
+    """zstop/D, tstop sqrt(g/D) and apeak/g against Fr = vc / sqrt(g D), one colour per gravity
+    level (paper II's collapse), log axes, each level's mean +/- std at each Froude number."""
+    import json
+    spec = json.load(open(os.path.join(D, "collapse.json")))
+    rows = read(os.path.join(D, "collapse.csv"))
+    levels = sorted({num(r["gravity_m_s2"]) for r in rows}, reverse=True)
+    cmap = plt.get_cmap("viridis")
+    panels = [("zstop_over_D", "zstop / D"), ("tstop_sqrt_g_over_D", "tstop sqrt(g / D)"),
+              ("apeak_over_g", "apeak / g")]
+    fig, axs = plt.subplots(1, 3, figsize=(13, 4.2))
+    for ax, (key, lab) in zip(axs, panels):
+        for k, g in enumerate(levels):
+            c = cmap(k / max(1, len(levels) - 1))
+            pts = [(num(r["froude"]), num(r[key])) for r in rows if num(r["gravity_m_s2"]) == g]
+            pts = [p for p in pts if p[0] > 0 and p[1] > 0]
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], "o", color=c, ms=5, alpha=0.8,
+                    label=f"g = {g:g} m/s2")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("Fr = vc / sqrt(g D)")
+        ax.set_ylabel(lab)
+        ax.grid(alpha=0.3, which="both")
+    for row in spec.get("rows", []):
+        i = [p[0] for p in panels].index(row["metric"])
+        f = [num(row[k]) for k in ("common_scatter_pct", "within_scatter_pct", "collapse_ratio")]
+        axs[i].set_title(f"scatter about one curve {f[0]:.0f} %, within levels {f[1]:.0f} %, ratio {f[2]:.2f}",
+                         fontsize=8)
+    axs[0].legend(fontsize=7)
+    if spec.get("title"):
+        fig.suptitle(spec["title"], fontsize=10)
+    fig.tight_layout()
+    fig.savefig(spec["out"], dpi=120)
+    plt.close(fig)
+    written.append(spec["out"])
+
+
+if WHICH == "collapse":
+    plot_collapse()
 if WHICH == "trace":
     plot_trace()
 if WHICH == "bed":

@@ -170,6 +170,7 @@ void setup_model(CLI::App& app) {
                                  "Collision models m dv/dt = m g - R(z, v, g) as sums of named terms, compared with a\n"
                                  "measurement campaign. Run `gravsweep model terms` for the term library.");
   sub->require_subcommand(1);
+  setup_model_collapse(*sub);
 
   auto* terms = sub->add_subcommand("terms", "List the registered model terms.\n\nExample:\n  gravsweep model terms");
   auto tf = std::make_shared<std::string>("table");

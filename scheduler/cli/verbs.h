@@ -9,6 +9,8 @@ namespace gravsweep::cli {
 void setup_bench(CLI::App& app);
 void setup_measurements(CLI::App& app);
 void setup_model(CLI::App& app);
+/// `model collapse`, a sub-verb of `model` (verb_model_collapse.cpp).
+void setup_model_collapse(CLI::App& model);
 void setup_synth(CLI::App& app);
 void setup_report(CLI::App& app);
 void setup_run(CLI::App& app);

@@ -87,11 +87,33 @@ TEST(Cli, BadModelNameIsAUsageError) {
 }
 
 TEST(Cli, HelpTeachesWithExamples) {
-  for (const char* v : {"synth", "report", "model fit", "model rank", "measurements import"}) {
+  for (const char* v : {"synth", "report", "model fit", "model rank", "model collapse", "measurements import"}) {
     const auto r = run(std::string(v) + " --help");
     EXPECT_EQ(r.code, 0) << v;
     EXPECT_NE(r.out.find("Example"), std::string::npos) << v;
   }
+}
+
+TEST(Cli, ModelCollapsePrintsItsNumbersAndDrawsTheFroudeFigure) {
+  TempDir d;
+  const std::string c = d.str() + "/c";
+  ASSERT_EQ(run("synth --out '" + c + "' --gravity 9.81,0.1 --speeds 0.2,0.5,1.0 --repeats 2").code, 0);
+  const auto r = run("model collapse '" + c + "' --plot '" + d.str() + "/collapse.png' --format csv");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_NE(r.out.find("metric,levels,trials,common_scatter_pct,within_scatter_pct,between_levels_pct,collapse_ratio"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("zstop_over_D,2,12,"), std::string::npos) << r.out;
+  const auto png = gravsweep::test::png_stats(d.path / "collapse.png");
+  ASSERT_TRUE(png.ok);
+  EXPECT_GT(png.width, 1000);  // three panels side by side
+  EXPECT_GT(png.pixel_std, 0.05) << "a blank figure";
+  // One gravity level cannot collapse: a usage error, exit 2, saying why.
+  const std::string one = d.str() + "/one";
+  ASSERT_EQ(run("synth --out '" + one + "' --gravity 9.81 --speeds 0.2,0.5,1.0 --repeats 2").code, 0);
+  const auto refused = run("model collapse '" + one + "'", true);
+  EXPECT_EQ(refused.code, 2) << refused.out;
+  EXPECT_NE(refused.out.find("at least two levels"), std::string::npos) << refused.out;
 }
 
 TEST(Cli, ReportWritesFiguresAndSummary) {
