@@ -66,6 +66,10 @@ Referenced referenced_files(db::Database& db);
 /// folder beside it do not belong together, and removing "orphans" would destroy the wrong data.
 void check_files_belong(db::Database& db, const CampaignPaths& paths);
 
+/// Throws ConfigError when `<root>/quarantine` exists and is not a real folder (a symbolic link,
+/// a file): nothing is ever moved into or removed through a link.
+void check_quarantine_folder(const CampaignPaths& paths);
+
 struct OrphanReport {
   std::vector<std::string> moved;     ///< files_rel of files moved to quarantine (or found: dry run)
   std::vector<std::string> restored;  ///< moved, then found referenced, and put back
@@ -74,7 +78,8 @@ struct OrphanReport {
 
 /// Moves files no done job and no live attempt refers to, and older than the snapshot by
 /// `min_age_s`, to `<root>/quarantine/<stamp>/`; files quarantined by an earlier call are removed
-/// first (unless the database refers to them again: then they go back). Nothing moves in a dry run.
+/// first (unless the database refers to them again: then they go back), only from gravsweep's own
+/// `<stamp>/` batches and never through a symbolic link. Nothing moves in a dry run.
 OrphanReport quarantine_orphans(db::Database& db, const CampaignPaths& paths, bool dry_run, double min_age_s = 5.0);
 
 }  // namespace gravsweep::queue

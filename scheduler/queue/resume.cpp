@@ -28,7 +28,10 @@ void remove_lost_files(const CampaignPaths& paths, const Reclaimed& r) {
 
 ResumeReport resume(Database& db, const CampaignPaths& paths, const ResumeOptions& o) {
   ResumeReport rep;
-  if (o.remove_orphans) check_files_belong(db, paths);
+  if (o.remove_orphans) {
+    check_files_belong(db, paths);
+    check_quarantine_folder(paths);
+  }
   const double now = clock_s(db);
   Reclaimed lost;
   {

@@ -1,0 +1,89 @@
+// A campaign's files root: `resume` and `work` touch nothing outside the campaign.
+// - `resume` removes only what it quarantined itself (its `<ms>-<pid>/` batches), never through a
+//   symbolic link: a `quarantine` that is a link is refused, a user's file under it stays;
+// - a files root proves it belongs to the campaign by its marker (written at submit): a wrong
+//   `--files` is refused (exit 2, naming both) before anything in it is moved or deleted.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "scheduler_test_helpers.h"
+
+using namespace gravsweep;
+using namespace gravsweep::test;
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A no-op sweep of `n` jobs (gravity 0.01, 0.02, ...), named `name`.
+std::string noop_sweep(int n, const std::string& name = "files") {
+  json doc = {{"sweep", name},
+              {"job", "noop"},
+              {"base", {{"g", 1.0}, {"sleep_s", 0.0}}},
+              {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", json::array()}}}}};
+  for (int i = 1; i <= n; ++i) doc["axes"][0]["values"].push_back(i * 0.01);
+  return doc.dump();
+}
+
+/// A finished no-op campaign of `n` jobs in dir/<stem>.db.
+void finished_campaign(const fs::path& dir, int n, const std::string& stem = "c") {
+  write_text(dir / (stem + ".json"), noop_sweep(n, stem));
+  auto r = run_cli({"submit", stem + ".json", "--db", stem + ".db"}, dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run_cli({"work", "--db", stem + ".db", "--quiet"}, dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+}
+
+/// A user's folder holding `keep.txt` and `sub/deep.txt`.
+void user_folder(const fs::path& dir) {
+  fs::create_directories(dir / "sub");
+  write_text(dir / "keep.txt", "a");
+  write_text(dir / "sub" / "deep.txt", "b");
+}
+
+void expect_user_folder(const fs::path& dir) {
+  EXPECT_TRUE(fs::exists(dir / "keep.txt")) << dir;
+  EXPECT_TRUE(fs::exists(dir / "sub" / "deep.txt")) << dir;
+}
+
+}  // namespace
+
+TEST(FilesRoot, ResumeRefusesAQuarantineThatIsASymlinkAndLeavesItsTargetAlone) {
+  TempDir d;
+  ASSERT_NO_FATAL_FAILURE(finished_campaign(d.path, 2));
+  user_folder(d.path / "victim");
+  fs::create_directory_symlink(d.path / "victim", d.path / "c.files" / "quarantine");
+  const auto r = run_cli({"resume", "--db", "c.db"}, d.path);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("symbolic link"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("quarantine"), std::string::npos) << r.err;
+  expect_user_folder(d.path / "victim");
+}
+
+TEST(FilesRoot, ResumeRemovesOnlyItsOwnQuarantineBatchesNeverThroughALink) {
+  TempDir d;
+  ASSERT_NO_FATAL_FAILURE(finished_campaign(d.path, 2));
+  const fs::path q = d.path / "c.files" / "quarantine";
+  // gravsweep's own batch of an earlier resume: removed.
+  const fs::path own = q / "1700000000000-4242" / "noop" / "deadbeef.a1.json";
+  fs::create_directories(own.parent_path());
+  write_text(own, "orphan");
+  // A user's file and folder under quarantine/, and a folder shaped like a batch but not named like one.
+  write_text(q / "notes.txt", "mine");
+  user_folder(q / "mine" / "traces");
+  // A batch that is a link to a user's folder, and a link inside a real batch: links go, targets stay.
+  user_folder(d.path / "victim2" / "traces");
+  fs::create_directory_symlink(d.path / "victim2", q / "1700000000001-4243");
+  user_folder(d.path / "victim3");
+  fs::create_directory_symlink(d.path / "victim3", q / "1700000000000-4242" / "traces");
+  const auto r = run_cli({"resume", "--db", "c.db"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("quarantined files removed: 1"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(own));
+  EXPECT_TRUE(fs::exists(q / "notes.txt"));
+  expect_user_folder(q / "mine" / "traces");
+  expect_user_folder(d.path / "victim2" / "traces");
+  expect_user_folder(d.path / "victim3");
+}
