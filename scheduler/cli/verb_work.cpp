@@ -145,7 +145,11 @@ int supervise(const WorkOptions& o, int threads) {
 
 int run_work(const WorkOptions& o) {
   // Refuses what is not a campaign before any worker starts (migrates a version-1 campaign).
-  { db::Database db = queue::open_campaign(o.db, queue::OpenMode::write, o.files); }
+  // Refuses a files root of another campaign before any worker deletes a file in it.
+  {
+    db::Database db = queue::open_campaign(o.db, queue::OpenMode::write, o.files);
+    queue::bind_files_root(db, queue::CampaignPaths(o.db, o.files));
+  }
   if (o.heartbeat_s > 0 && o.heartbeat_s * 2 > o.lease_s)
     throw UsageError(
         fmt::format("--heartbeat: found {} s, expected at most half of --lease ({} s), or the lease "

@@ -43,6 +43,13 @@ void user_folder(const fs::path& dir) {
   write_text(dir / "sub" / "deep.txt", "b");
 }
 
+std::size_t count_regular(const fs::path& dir) {
+  std::size_t n = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.is_regular_file()) ++n;
+  return n;
+}
+
 void expect_user_folder(const fs::path& dir) {
   EXPECT_TRUE(fs::exists(dir / "keep.txt")) << dir;
   EXPECT_TRUE(fs::exists(dir / "sub" / "deep.txt")) << dir;
@@ -86,4 +93,102 @@ TEST(FilesRoot, ResumeRemovesOnlyItsOwnQuarantineBatchesNeverThroughALink) {
   expect_user_folder(q / "mine" / "traces");
   expect_user_folder(d.path / "victim2" / "traces");
   expect_user_folder(d.path / "victim3");
+}
+
+namespace {
+
+/// Sets every file under `dir` a minute back: older than resume's 5 s margin for orphans.
+void age_files(const fs::path& dir) {
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.is_regular_file()) fs::last_write_time(e.path(), fs::file_time_type::clock::now() - std::chrono::minutes(1));
+}
+
+std::string marker_id(const fs::path& root) {
+  std::ifstream in(root / "gravsweep-campaign.json");
+  return json::parse(in).at("campaign_id").get<std::string>();
+}
+
+}  // namespace
+
+TEST(FilesRoot, SubmitWritesTheMarkerNamingTheCampaign) {
+  TempDir d;
+  ASSERT_NO_FATAL_FAILURE(finished_campaign(d.path, 2));
+  db::Database db((d.path / "c.db").string());
+  const std::string id = sql_text(db, "SELECT value FROM queue_meta WHERE key='campaign_id'");
+  EXPECT_EQ(id.size(), 32u);
+  EXPECT_EQ(marker_id(d.path / "c.files"), id);
+}
+
+TEST(FilesRoot, AnotherCampaignsFolderIsRefusedBeforeAnythingMoves) {
+  TempDir d;
+  ASSERT_NO_FATAL_FAILURE(finished_campaign(d.path, 3, "other"));
+  age_files(d.path / "other.files");
+  const std::size_t before = count_regular(d.path / "other.files");
+  // A fresh campaign (no done jobs: the "most outputs missing" check cannot tell) given the wrong folder.
+  write_text(d.path / "c.json", noop_sweep(2, "c"));
+  ASSERT_EQ(run_cli({"submit", "c.json", "--db", "c.db"}, d.path).code, 0);
+  for (const std::vector<std::string> verb : {std::vector<std::string>{"resume"},
+                                              {"resume", "--dry-run"},
+                                              {"resume", "--keep-orphans"},
+                                              {"work", "--quiet"}}) {
+    std::vector<std::string> args = verb;
+    args.insert(args.end(), {"--db", "c.db", "--files", (d.path / "other.files").string()});
+    const auto r = run_cli(args, d.path);
+    EXPECT_EQ(r.code, 2) << verb[0] << ": " << r.out << r.err;
+    EXPECT_NE(r.err.find("other.files"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("other.db"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("c.db"), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(count_regular(d.path / "other.files"), before);
+  EXPECT_FALSE(fs::exists(d.path / "other.files" / "quarantine"));
+}
+
+TEST(FilesRoot, AnUnmarkedFolderWithForeignFilesIsRefusedAndKept) {
+  TempDir d;
+  write_text(d.path / "c.json", noop_sweep(2, "c"));
+  ASSERT_EQ(run_cli({"submit", "c.json", "--db", "c.db"}, d.path).code, 0);
+  // A user's folder that happens to hold tmp/ and beds/ (e.g. --files $HOME).
+  const fs::path fake = d.path / "fakeroot";
+  fs::create_directories(fake / "tmp");
+  fs::create_directories(fake / "beds");
+  write_text(fake / "tmp" / "draft.txt", "mine");
+  write_text(fake / "beds" / "sand.h5", "mine too");
+  age_files(fake);
+  for (const std::string verb : {"resume", "work"}) {
+    const auto r = run_cli({verb, "--db", "c.db", "--files", fake.string()}, d.path);
+    EXPECT_EQ(r.code, 2) << verb << ": " << r.out << r.err;
+    EXPECT_NE(r.err.find("fakeroot"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("c.db"), std::string::npos) << r.err;
+  }
+  EXPECT_TRUE(fs::exists(fake / "tmp" / "draft.txt"));
+  EXPECT_TRUE(fs::exists(fake / "beds" / "sand.h5"));
+  EXPECT_FALSE(fs::exists(fake / "gravsweep-campaign.json"));
+}
+
+TEST(FilesRoot, AnEarlierCampaignWithoutAMarkerGetsOneWhereItIsSafe) {
+  TempDir d;
+  ASSERT_NO_FATAL_FAILURE(finished_campaign(d.path, 2));
+  // As an earlier gravsweep left it: no marker, no campaign id.
+  fs::remove(d.path / "c.files" / "gravsweep-campaign.json");
+  {
+    db::Database db((d.path / "c.db").string());
+    db::Statement st(db, "DELETE FROM queue_meta WHERE key='campaign_id'");
+    st.run();
+  }
+  auto r = run_cli({"resume", "--db", "c.db", "--dry-run"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(d.path / "c.files" / "gravsweep-campaign.json")) << "a dry run writes nothing";
+  r = run_cli({"resume", "--db", "c.db"}, d.path);  // the default folder beside the database
+  ASSERT_EQ(r.code, 0) << r.err;
+  db::Database db((d.path / "c.db").string());
+  EXPECT_EQ(marker_id(d.path / "c.files"), sql_text(db, "SELECT value FROM queue_meta WHERE key='campaign_id'"));
+  // A given folder holding only what the campaign wrote is adopted too; an empty one as well.
+  fs::rename(d.path / "c.files", d.path / "moved");
+  fs::remove(d.path / "moved" / "gravsweep-campaign.json");
+  r = run_cli({"resume", "--db", "c.db", "--files", (d.path / "moved").string()}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(d.path / "moved" / "gravsweep-campaign.json"));
+  r = run_cli({"resume", "--db", "c.db", "--files", (d.path / "empty").string(), "--keep-orphans"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(d.path / "empty" / "gravsweep-campaign.json"));
 }

@@ -166,8 +166,9 @@ TEST(PostgresCampaign, SlurmSubmitDryRunPrintsOneArrayOfPilotWorkers) {
     EXPECT_NE(r.out.find(line), std::string::npos) << line << " not in:\n" << r.out;
   EXPECT_FALSE(fs::exists(store.files / "slurm")) << "a dry run submits and writes nothing";
   // An SQLite campaign is refused: its file must not be shared between nodes.
-  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
-  r = run_cli({"slurm", "submit", "--db", "c.db", "--dry-run"}, d.path);
+  // (lite.db: c.files beside c.db is the server campaign's files root, marked as its own)
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "lite.db"}, d.path).code, 0);
+  r = run_cli({"slurm", "submit", "--db", "lite.db", "--dry-run"}, d.path);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("PostgreSQL"), std::string::npos) << r.err;
 }
