@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -195,6 +196,9 @@ Status status(db::Database& db, std::size_t max_running = 20);
 // ---- results ----------------------------------------------------------------------------------
 /// Column names of the results table, in display order (fixed, parameters, metrics).
 std::vector<std::string> result_columns(db::Database& db);
+/// The names of the results columns that hold numbers (fixed INTEGER/REAL ones, and the swept
+/// parameters and metrics stored as INTEGER or REAL).
+std::set<std::string> numeric_result_columns(db::Database& db);
 /// The columns a results table shows by default: job_id, every swept parameter, and the paper's
 /// metrics (vc_m_s, apeak_m_s2, zstop_m, tstop_s, rebound) where the campaign has them.
 std::vector<std::string> summary_result_columns(db::Database& db);
