@@ -96,10 +96,50 @@ TEST_P(BackendVerbs, WhereIsTypedTheSameOnBothBackends) {
   EXPECT_NE(r.err.find("expected a number"), std::string::npos) << r.err;
 }
 
+TEST_P(BackendVerbs, EveryVerbReadingACampaignTakesItsLocation) {
+  json doc = {{"sweep", "v"},
+              {"base", json::parse(tiny_base())},
+              {"axes",
+               {{{"name", "impact_speed_m_s"},
+                 {"pointer", "/projectile/impact_speed_m_s"},
+                 {"values", {0.4, 0.5, 0.6, 0.7, 0.8, 0.9}}}}}};
+  write_text(dir.path / "spec.json", doc.dump());
+  ASSERT_EQ(cli({"submit", "spec.json"}).code, 0);
+  auto r = cli({"work", "--workers", "2", "--threads", "1", "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = cli({"export", "--out", "ds", "--rate-hz", "2000"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("6 drops exported"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(dir.path / "ds" / "trials.csv"));
+  r = db_only({"plot", "results", "--x", "impact_speed_m_s", "--y", "zstop_m", "--out", "z.png"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir.path / "z.png"));
+  r = read_input({"model", "fit"}, {"--model", "base", "--plot", "fall.png"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("6 trials"), std::string::npos) << r.err;
+  r = read_input({"report"}, {"--out", "rep", "--folds", "3"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir.path / "rep")) << r.out;
+}
+
 #ifdef GRAVSWEEP_QUEUE_TESTS_ON_POSTGRES
 INSTANTIATE_TEST_SUITE_P(Postgres, BackendVerbs, ::testing::Values(Store::postgres),
                          [](const auto& info) { return store_name(info.param); });
 
+TEST(BackendVerbs, AServerCampaignReadWithoutItsFilesRootIsRefused) {
+  TempDir d;
+  const CampaignStore store(Store::postgres, d.path);
+  if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
+  json doc = {{"sweep", "s"},
+              {"job", "noop"},
+              {"base", {{"i", 0}}},
+              {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"values", {1, 2}}}}}};
+  write_text(d.path / "spec.json", doc.dump());
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", store.location, "--files", store.files.string()}, d.path).code, 0);
+  const auto r = run_cli({"model", "fit", store.location}, d.path);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("--files"), std::string::npos) << r.err;
+}
 #else
 INSTANTIATE_TEST_SUITE_P(Sqlite, BackendVerbs, ::testing::Values(Store::sqlite),
                          [](const auto& info) { return store_name(info.param); });
