@@ -71,6 +71,21 @@ nlohmann::json row_of(const results::MeasuredTrial& t) {
   return j;
 }
 
+/// Refuses a trial whose numbers lie outside physical ranges (an imported file written before
+/// `measurements import` checked them, or edited since): a fit on it would be garbage or NaN.
+void refuse_unphysical(const std::string& path, const CampaignInput& in) {
+  for (const auto& t : in.campaign.trials)
+    for (const auto& f : results::trial_fields()) {
+      if (!f.number) continue;
+      const double v = t.info.*f.number;
+      if (const std::string expected = results::out_of_physical_range(f.key, v); !expected.empty())
+        throw UsageError(
+            fmt::format("{}: trial '{}': {} = {}, expected {} (a wrong unit or a corrupt number; fix the "
+                        "record and import it again)",
+                        path, t.info.trial_id, f.key, v, expected));
+    }
+}
+
 void filter_in_memory(const std::string& path, CampaignInput& in, const std::vector<std::string>& where) {
   if (where.empty()) return;
   auto& trials = in.campaign.trials;
@@ -95,7 +110,9 @@ CampaignInput load_campaign_input(const std::string& path, const std::vector<std
   try {
     if (db::is_postgres_url(path)) {
       db::Database db = queue::open_campaign(path, queue::OpenMode::read, files);  // refuses a non-campaign
-      return load_queue_campaign(path, db, where, files);
+      in = load_queue_campaign(path, db, where, files);
+      refuse_unphysical(path, in);
+      return in;
     }
     if (fs::is_directory(path)) {
       in.kind = "lab campaign folder";
@@ -107,7 +124,11 @@ CampaignInput load_campaign_input(const std::string& path, const std::vector<std
                         "campaign folder expected",
                         path));
       db::Database db(path, 30000, true);
-      if (has_table(db, "jobs") && has_table(db, "results")) return load_queue_campaign(path, db, where, files);
+      if (has_table(db, "jobs") && has_table(db, "results")) {
+        in = load_queue_campaign(path, db, where, files);
+        refuse_unphysical(path, in);
+        return in;
+      }
       if (!has_table(db, "trials"))
         throw UsageError(
             fmt::format("{}: neither a campaign database (tables jobs, results) nor an imported "
@@ -128,6 +149,7 @@ CampaignInput load_campaign_input(const std::string& path, const std::vector<std
   } catch (const std::runtime_error& e) {
     throw UsageError(e.what());
   }
+  refuse_unphysical(path, in);
   filter_in_memory(path, in, where);
   return in;
 }
