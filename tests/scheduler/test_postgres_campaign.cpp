@@ -161,7 +161,7 @@ TEST(PostgresCampaign, SlurmSubmitDryRunPrintsOneArrayOfPilotWorkers) {
   for (const std::string& line :
        {std::string("#SBATCH --array=1-3\n"), std::string("#SBATCH --cpus-per-task=2\n"),
         std::string("#SBATCH --partition=debug\n"), std::string("#SBATCH --time=00:10:00\n"),
-        "#SBATCH --output=" + (store.files / "slurm").string() + "/%A_%a.log\n",
+        "#SBATCH --output=\"" + (store.files / "slurm").string() + "/%A_%a.log\"\n",
         " work --db '" + store.location + "' --files '" + store.files.string() + "' --threads 2 --lease 60\n"})
     EXPECT_NE(r.out.find(line), std::string::npos) << line << " not in:\n" << r.out;
   EXPECT_FALSE(fs::exists(store.files / "slurm")) << "a dry run submits and writes nothing";
@@ -171,4 +171,41 @@ TEST(PostgresCampaign, SlurmSubmitDryRunPrintsOneArrayOfPilotWorkers) {
   r = run_cli({"slurm", "submit", "--db", "lite.db", "--dry-run"}, d.path);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("PostgreSQL"), std::string::npos) << r.err;
+}
+
+TEST(PostgresCampaign, SlurmSubmitRefusesOptionsOutsideSlurmSyntaxAndQuotesEveryPath) {
+  TempDir d;
+  const CampaignStore store(Store::postgres, d.path);
+  if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
+  const fs::path root = d.path / "my files";  // a space: must not cut the #SBATCH --output line
+  json doc = {{"sweep", "s"},
+              {"job", "noop"},
+              {"base", {{"i", 0}}},
+              {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"values", {1, 2}}}}}};
+  write_text(d.path / "spec.json", doc.dump());
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", store.location, "--files", root.string()}, d.path).code, 0);
+  const auto slurm = [&](const std::string& option, const std::string& value) {
+    return run_cli({"slurm", "submit", "--db", store.location, "--files", root.string(), option, value, "--dry-run"},
+                   d.path);
+  };
+  struct Bad {
+    const char *option, *value;
+  };
+  for (const Bad& b : {Bad{"--time", "00:10:00\n#SBATCH --wrap=id"}, Bad{"--time", "10 minutes"},
+                       Bad{"--time", "1:2:3:4"}, Bad{"--partition", "debug\nrm -rf ~"}, Bad{"--partition", "a b"},
+                       Bad{"--account", "proj;id"}, Bad{"--account", "a\n#SBATCH --uid=0"}}) {
+    const auto r = slurm(b.option, b.value);
+    EXPECT_EQ(r.code, 2) << b.option << " " << b.value << ":\n" << r.out << r.err;
+    EXPECT_NE(r.err.find(b.option), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find("#SBATCH"), std::string::npos) << r.out;
+  }
+  for (const char* t : {"30", "30:00", "04:00:00", "2-0", "2-12:00", "1-00:30:00", "UNLIMITED"})
+    EXPECT_EQ(slurm("--time", t).code, 0) << t;
+  EXPECT_EQ(slurm("--partition", "debug,long").code, 0);
+  const auto r = slurm("--account", "proj_1.a-b");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("#SBATCH --account=proj_1.a-b\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("#SBATCH --output=\"" + (root / "slurm").string() + "/%A_%a.log\"\n"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find(" --files '" + root.string() + "' "), std::string::npos) << r.out;
 }
