@@ -116,8 +116,14 @@ void write_file_synced(const fs::path& path, const std::string& text) {
     }
     off += static_cast<std::size_t>(n);
   }
-  ::fsync(fd);
-  ::close(fd);
+  // A full disk may show only here (delayed allocation): the data is not safe until fsync says so.
+  if (::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
+    throw std::runtime_error(fmt::format("cannot write '{}' (fsync): {}", path.string(), std::strerror(err)));
+  }
+  if (::close(fd) != 0)
+    throw std::runtime_error(fmt::format("cannot write '{}' (close): {}", path.string(), std::strerror(errno)));
 }
 
 Runner noop_runner() {
@@ -139,8 +145,8 @@ Runner noop_runner() {
     if (ctx.claim.attempt <= fail_attempts)
       throw std::runtime_error(
           fmt::format("noop job asked to fail on attempt {} (fail_attempts={})", ctx.claim.attempt, fail_attempts));
-    std::ofstream(ctx.output_tmp) << json{{"job_id", ctx.claim.job_id}, {"attempt", ctx.claim.attempt}}.dump();
-    // (the worker fsyncs the output before renaming it)
+    // A write error (a full disk, no file descriptor left) fails the attempt with its errno.
+    write_file_synced(ctx.output_tmp, json{{"job_id", ctx.claim.job_id}, {"attempt", ctx.claim.attempt}}.dump());
     RunOutput out;
     out.metrics["noop_value"] = s.contains("value") ? s["value"] : json(0);
     out.metrics["sleep_s"] = sleep_s;

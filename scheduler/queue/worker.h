@@ -66,7 +66,8 @@ struct WorkerReport {
 
 WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners);
 
-/// Writes `text` to `path` and fsyncs it (helper for runners).
+/// Writes `text` to `path` and fsyncs it (helper for runners); throws std::runtime_error naming the
+/// file and the errno text (ENOSPC, EMFILE, EIO) when open, write, fsync or close fails.
 void write_file_synced(const std::filesystem::path& path, const std::string& text);
 /// fsync of a file or directory (best effort on directories).
 void fsync_path(const std::filesystem::path& path);

@@ -7,6 +7,8 @@
 
 #include <cerrno>
 #include <cstring>
+#include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "db/database.h"
 #include "scheduler/queue/impact.h"
@@ -45,4 +47,40 @@ TEST(DiskFull, WorkerExitsOneCleanlyAndFinishedWorkStaysIntact) {
     ++done;
   }
   std::printf("disk full after %d finished job(s): exit %d\n", done, r.code);
+}
+
+// A noop job whose output cannot be written (the files root's disk is full) fails its attempt with
+// the errno's text; it is never recorded done with an empty output.
+TEST(DiskFull, ANoopJobOnAFullFilesRootFailsWithTheErrno) {
+  TempDir d;
+  const fs::path mnt = d.path / "small";
+  fs::create_directories(mnt);
+  if (::mount("tmpfs", mnt.c_str(), "tmpfs", 0, "size=256k") != 0)
+    GTEST_SKIP() << "cannot mount a 256 kB tmpfs here (" << std::strerror(errno)
+                 << "): needs root and CAP_SYS_ADMIN; the disk-full case is not tested";
+  struct Unmount {
+    fs::path p;
+    ~Unmount() { ::umount2(p.c_str(), MNT_DETACH); }
+  } unmount{mnt};
+  nlohmann::json doc = {{"sweep", "full"},
+                        {"job", "noop"},
+                        {"max_attempts", 1},
+                        {"base", {{"g", 1.0}}},
+                        {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {1, 2, 3, 4, 5}}}}}};
+  write_text(d.path / "spec.json", doc.dump());
+  const std::string root = (mnt / "files").string();
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db", "--files", root}, d.path).code, 0);
+  for (const char* dir : {"noop", "tmp", "beds", "traces"}) fs::create_directories(fs::path(root) / dir);
+  {  // fill the disk
+    std::ofstream fill(mnt / "fill", std::ios::binary);
+    const std::string block(4096, 'x');
+    while (fill.write(block.data(), static_cast<std::streamsize>(block.size())) && fill.flush()) {
+    }
+  }
+  const auto r = run_cli({"work", "--db", "c.db", "--files", root, "--quiet"}, d.path);
+  EXPECT_NE(r.code, 0) << r.err;
+  db::Database db((d.path / "c.db").string());
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), 0) << "done with an empty output";
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE error LIKE '%No space left on device%'"), 5)
+      << sql_text(db, "SELECT error FROM attempts LIMIT 1");
 }
