@@ -39,6 +39,7 @@ struct WorkOptions {
   double heartbeat_s = 0;
   double poll_s = 0.5;
   double backoff_s = 2.0;
+  int max_releases = queue::kDefaultMaxReleases;
   long max_jobs = -1;
   bool quiet = false;
   std::string bed_cache;  ///< --bed-cache: prepared beds shared between campaigns (pipeline/bed_cache.h)
@@ -68,7 +69,9 @@ int supervise(const WorkOptions& o, int threads) {
                                    "--poll",
                                    fmt::format("{}", o.poll_s),
                                    "--backoff",
-                                   fmt::format("{}", o.backoff_s)};
+                                   fmt::format("{}", o.backoff_s),
+                                   "--max-releases",
+                                   std::to_string(o.max_releases)};
   if (!o.files.empty()) args.insert(args.end(), {"--files", o.files});
   if (o.heartbeat_s > 0) args.insert(args.end(), {"--heartbeat", fmt::format("{}", o.heartbeat_s)});
   if (o.follow) args.push_back("--follow");
@@ -170,6 +173,7 @@ int run_work(const WorkOptions& o) {
   w.poll_s = o.poll_s;
   w.max_jobs = o.max_jobs;
   w.backoff_base_s = o.backoff_s;
+  w.max_releases = o.max_releases;
   w.code_version = pipeline::build_version();
   w.verbose = !o.quiet;
   w.bed_cache = o.bed_cache;
@@ -221,6 +225,11 @@ void setup_work(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--poll", opt->poll_s, "wait between claims when nothing is runnable, s")
       ->check(CLI::Range(0.01, 60.0))
+      ->capture_default_str();
+  sub->add_option("--max-releases", opt->max_releases,
+                  "a job whose attempts were interrupted (SIGINT/SIGTERM, a Slurm time limit) this many times "
+                  "is stopped (dead, with the reason) instead of looping; `resume --dead` runs it again")
+      ->check(CLI::Range(1, 1000000))
       ->capture_default_str();
   sub->add_option("--backoff", opt->backoff_s, "retry backoff base, s (base * 2^(attempt-1), capped at 300 s)")
       ->check(CLI::Range(0.0, 3600.0))

@@ -280,10 +280,12 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     }
     if (pipeline::stop_requested().load() && (!error.empty() || !fs::exists(tmp))) {
       remove_tmp_of(paths.tmp(), prefix);
-      release(db, *c, "interrupted by SIGINT/SIGTERM; lease released");
+      const std::string state = release(db, *c, "interrupted by SIGINT/SIGTERM; lease released", o.max_releases);
       ++rep.released;
       rep.interrupted = true;
-      if (o.verbose) std::fprintf(stderr, "worker %d: job %s released (interrupted)\n", who.pid, c->job_id.c_str());
+      if (o.verbose)
+        std::fprintf(stderr, "worker %d: job %s released (interrupted)%s\n", who.pid, c->job_id.c_str(),
+                     state == "dead" ? fmt::format("; stopped after {} releases", o.max_releases).c_str() : "");
       break;
     }
     if (error.empty() && !fs::exists(tmp)) {

@@ -54,6 +54,7 @@ struct WorkerOptions {
   double poll_s = 0.5;     ///< idle wait between claims when nothing is runnable
   long max_jobs = -1;      ///< stop after this many jobs (-1: no limit)
   double backoff_base_s = 2.0;
+  int max_releases = kDefaultMaxReleases;  ///< a job interrupted this many times is stopped (dead)
   std::string code_version = "unknown";
   bool verbose = true;
   std::filesystem::path bed_cache;  ///< `work --bed-cache`: passed to the runners (RunContext)
