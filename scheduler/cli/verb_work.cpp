@@ -40,6 +40,7 @@ struct WorkOptions {
   double poll_s = 0.5;
   double backoff_s = 2.0;
   int max_releases = queue::kDefaultMaxReleases;
+  double db_outage_s = 300;
   long max_jobs = -1;
   bool quiet = false;
   std::string bed_cache;  ///< --bed-cache: prepared beds shared between campaigns (pipeline/bed_cache.h)
@@ -71,7 +72,9 @@ int supervise(const WorkOptions& o, int threads) {
                                    "--backoff",
                                    fmt::format("{}", o.backoff_s),
                                    "--max-releases",
-                                   std::to_string(o.max_releases)};
+                                   std::to_string(o.max_releases),
+                                   "--db-outage",
+                                   fmt::format("{}", o.db_outage_s)};
   if (!o.files.empty()) args.insert(args.end(), {"--files", o.files});
   if (o.heartbeat_s > 0) args.insert(args.end(), {"--heartbeat", fmt::format("{}", o.heartbeat_s)});
   if (o.follow) args.push_back("--follow");
@@ -174,6 +177,7 @@ int run_work(const WorkOptions& o) {
   w.max_jobs = o.max_jobs;
   w.backoff_base_s = o.backoff_s;
   w.max_releases = o.max_releases;
+  w.db_outage_s = o.db_outage_s;
   w.code_version = pipeline::build_version();
   w.verbose = !o.quiet;
   w.bed_cache = o.bed_cache;
@@ -225,6 +229,11 @@ void setup_work(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--poll", opt->poll_s, "wait between claims when nothing is runnable, s")
       ->check(CLI::Range(0.01, 60.0))
+      ->capture_default_str();
+  sub->add_option("--db-outage", opt->db_outage_s,
+                  "seconds a worker keeps reconnecting, with backoff, to a PostgreSQL server that restarted or "
+                  "went away before it gives up; its running job goes on meanwhile")
+      ->check(CLI::Range(0.0, 86400.0))
       ->capture_default_str();
   sub->add_option("--max-releases", opt->max_releases,
                   "a job whose attempts were interrupted (SIGINT/SIGTERM, a Slurm time limit) this many times "

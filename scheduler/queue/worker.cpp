@@ -43,6 +43,62 @@ void sleep_interruptible(double seconds) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
 }
 
+/// The worker's connection, made again when a PostgreSQL server restarts or is away for a while: a
+/// call that fails because the connection is gone is run again on a new connection, reconnecting
+/// with backoff (0.2 s doubling to 5 s) for up to `outage_s`; then the error stands. Every call
+/// re-prepares its statements, so none outlives the connection it was made on.
+class Reconnecting {
+ public:
+  Reconnecting(db::Database& db, std::string location, double outage_s)
+      : db_(db), location_(std::move(location)), outage_s_(outage_s) {}
+  template <class Fn>
+  auto operator()(Fn&& fn) {
+    const auto give_up =
+        std::chrono::steady_clock::now() +
+        std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(outage_s_));
+    double wait_s = 0.2;
+    for (;;) {
+      try {
+        return fn();
+      } catch (const db::DbError& e) {
+        if (!e.connection_lost()) throw;
+        reconnect(e, give_up, wait_s);
+      }
+    }
+  }
+
+ private:
+  db::Database& db_;
+  std::string location_;
+  double outage_s_;
+
+  void reconnect(const db::DbError& lost, std::chrono::steady_clock::time_point give_up, double& wait_s) {
+    std::fprintf(stderr, "worker %d: database connection lost (%s); reconnecting for up to %.0f s\n",
+                 static_cast<int>(getpid()), lost.what(), outage_s_);
+    for (;;) {
+      if (std::chrono::steady_clock::now() >= give_up || pipeline::stop_requested().load()) throw lost;
+      sleep_interruptible(wait_s);
+      wait_s = std::min(2 * wait_s, 5.0);
+      try {
+        db_ = db::Database(location_);
+        std::fprintf(stderr, "worker %d: reconnected to the database\n", static_cast<int>(getpid()));
+        return;
+      } catch (const db::DbError& e) {
+        if (!e.connection_lost()) throw;
+      }
+    }
+  }
+};
+
+/// True when the job is done with the output of this attempt: a completion whose commit was
+/// acknowledged by nobody (the connection broke) but went through.
+bool completed_already(db::Database& db, const Claim& c) {
+  db::Statement st(db, "SELECT count(*) FROM jobs WHERE job_id=? AND state='done' AND output_path=?");
+  st.bind(1, c.job_id).bind(2, c.output_rel);
+  st.step();
+  return st.get_int(0) > 0;
+}
+
 /// Shared between the job and its heartbeat thread.
 struct JobSignals {
   std::mutex m;
@@ -75,6 +131,10 @@ void heartbeat_loop(const WorkerOptions& o, const Claim& c, JobSignals& sig, dou
                        static_cast<int>(getpid()), c.job_id.c_str());
         }
       } catch (const std::exception& e) {
+        // A lost connection (server restarted) is made again at the next beat; the lease is fenced,
+        // so a beat after the lease expired is refused as lost.
+        const auto* dbe = dynamic_cast<const db::DbError*>(&e);
+        if (dbe && dbe->connection_lost()) db.reset();
         std::fprintf(stderr, "worker %d: heartbeat failed (will retry): %s\n", static_cast<int>(getpid()), e.what());
       }
       lock.lock();
@@ -165,6 +225,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
   std::error_code ec;
   for (const char* d : kOutputFolders) fs::create_directories(paths.root / d, ec);
   std::unique_ptr<db::Database> beat_db;  // the heartbeat thread's own connection, kept across jobs
+  Reconnecting with_db(db, o.db_path.string(), o.db_outage_s);
   long ran = 0;
   while (!pipeline::stop_requested().load() && (o.max_jobs < 0 || ran < o.max_jobs)) {
     if (supervisor_gone()) {
@@ -175,7 +236,10 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     Reclaimed lost;
     std::optional<Claim> c;
     try {
-      c = claim(db, who, paths, o.lease_s, &lost);
+      c = with_db([&] {
+        lost = Reclaimed{};
+        return claim(db, who, paths, o.lease_s, &lost);
+      });
     } catch (const db::DbError& e) {
       if (!e.busy()) throw;
       sleep_interruptible(0.05 + 0.1 * (getpid() % 7) / 7.0);  // busy beyond the timeout: retry with jitter
@@ -189,7 +253,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
                      lost.dead);
     }
     if (!c) {
-      if (!o.follow && !work_remains(db)) break;
+      if (!o.follow && !with_db([&] { return work_remains(db); })) break;
       sleep_interruptible(o.poll_s);
       continue;
     }
@@ -227,7 +291,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
             "bed is rebuilt and the drop waits for it",
             bed.string(), c->dep_job_id, found, c->dep_sha256);
         std::fprintf(stderr, "worker %d: job %s: %s\n", who.pid, c->job_id.c_str(), why.c_str());
-        if (bed_mismatch(db, *c, why))
+        if (with_db([&] { return bed_mismatch(db, *c, why); }))
           ++rep.failed;
         else
           ++rep.fenced_out;
@@ -236,7 +300,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     }
     int threads = o.threads;
     try {
-      threads = threads_for_claim(db, *c, o.threads, o.pool_threads);
+      threads = with_db([&] { return threads_for_claim(db, *c, o.threads, o.pool_threads); });
       if (threads != o.threads && o.verbose)
         std::fprintf(stderr, "worker %d: bed job %s runs alone: %d threads\n", who.pid, c->job_id.c_str(), threads);
     } catch (const db::DbError& e) {
@@ -280,7 +344,8 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     }
     if (pipeline::stop_requested().load() && (!error.empty() || !fs::exists(tmp))) {
       remove_tmp_of(paths.tmp(), prefix);
-      const std::string state = release(db, *c, "interrupted by SIGINT/SIGTERM; lease released", o.max_releases);
+      const std::string state =
+          with_db([&] { return release(db, *c, "interrupted by SIGINT/SIGTERM; lease released", o.max_releases); });
       ++rep.released;
       rep.interrupted = true;
       if (o.verbose)
@@ -294,7 +359,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     }
     if (!error.empty()) {
       remove_tmp_of(paths.tmp(), prefix);
-      const std::string state = fail(db, *c, error, exit_code, permanent, o.backoff_base_s);
+      const std::string state = with_db([&] { return fail(db, *c, error, exit_code, permanent, o.backoff_base_s); });
       if (state == "dead")
         ++rep.dead;
       else if (state == "failed")
@@ -323,7 +388,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
       fs::remove(final_path, ec);
       const std::string why =
           fmt::format("job {}: cannot store its output at '{}': {}", c->job_id, final_path.string(), e.what());
-      const std::string state = fail(db, *c, why, 1, false, o.backoff_base_s);
+      const std::string state = with_db([&] { return fail(db, *c, why, 1, false, o.backoff_base_s); });
       ++(state == "dead" ? rep.dead : state == "failed" ? rep.failed : rep.fenced_out);
       std::fprintf(stderr, "worker %d: %s\n", who.pid, why.c_str());
       continue;
@@ -332,7 +397,13 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     done.report = out.report;
     done.report["wall_s"] = secs;
     done.report["threads"] = threads;
-    if (complete(db, *c, done)) {
+    bool retried = false;  // after a lost connection the completion may have gone through
+    const bool completed = with_db([&] {
+      if (retried && completed_already(db, *c)) return true;
+      retried = true;
+      return complete(db, *c, done);
+    });
+    if (completed) {
       ++rep.done;
       if (o.verbose) std::fprintf(stderr, "worker %d: job %s done in %.2f s\n", who.pid, c->job_id.c_str(), secs);
     } else {

@@ -55,6 +55,9 @@ struct WorkerOptions {
   long max_jobs = -1;      ///< stop after this many jobs (-1: no limit)
   double backoff_base_s = 2.0;
   int max_releases = kDefaultMaxReleases;  ///< a job interrupted this many times is stopped (dead)
+  /// How long a worker keeps reconnecting to a PostgreSQL server that restarted or went away,
+  /// with backoff, before it gives up (its running job goes on meanwhile; its lease is fenced).
+  double db_outage_s = 300;
   std::string code_version = "unknown";
   bool verbose = true;
   std::filesystem::path bed_cache;  ///< `work --bed-cache`: passed to the runners (RunContext)
