@@ -161,4 +161,21 @@ std::string release(Database& db, const Claim& c, const std::string& why, int ma
   return state;
 }
 
+bool give_back(Database& db, const Claim& c, const std::string& why) {
+  const double now = clock_s(db);
+  Transaction tx(db);
+  {
+    Statement st(db,
+                 "UPDATE jobs SET state='queued', attempts=CASE WHEN attempts>0 THEN attempts-1 ELSE 0 END, "
+                 "last_error=?1, lease_owner=NULL, lease_expires=NULL, progress=NULL, phase=NULL, detail=NULL "
+                 "WHERE job_id=?2 AND lease_token=?3 AND state='running'");
+    st.bind(1, why).bind(2, c.job_id).bind(3, c.token);
+    st.run();
+    if (db.changes() != 1) return false;
+  }
+  end_attempt(db, c, "released", now, kExitFailure, why);
+  tx.commit();
+  return true;
+}
+
 }  // namespace gravsweep::queue

@@ -140,6 +140,11 @@ inline constexpr int kDefaultMaxReleases = 5;
 /// when fenced out.
 std::string release(db::Database& db, const Claim& c, const std::string& why, int max_releases = kDefaultMaxReleases);
 
+/// Gives the job back after an environmental failure (the files root's disk full): queued again,
+/// the attempt closed as released with `why`, counted neither against the retry budget nor as a
+/// release (the job did nothing wrong). false = fenced out.
+bool give_back(db::Database& db, const Claim& c, const std::string& why);
+
 /// True while some job may still become runnable (queued, waiting, failed, running).
 bool work_remains(db::Database& db);
 

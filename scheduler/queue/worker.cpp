@@ -1,6 +1,7 @@
 #include "scheduler/queue/worker.h"
 
 #include <fcntl.h>
+#include <sys/statvfs.h>
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -97,6 +98,38 @@ bool completed_already(db::Database& db, const Claim& c) {
   st.bind(1, c.job_id).bind(2, c.output_rel);
   st.step();
   return st.get_int(0) > 0;
+}
+
+/// Free bytes of the filesystem holding `dir` for an unprivileged writer; -1 when unknown.
+std::int64_t free_bytes(const fs::path& dir) {
+  struct statvfs st {};
+  if (::statvfs(dir.c_str(), &st) != 0) return -1;
+  return static_cast<std::int64_t>(st.f_bavail) * static_cast<std::int64_t>(st.f_frsize);
+}
+
+/// Empty while the files root has room for the next output (`min_free` plus the largest output
+/// seen); otherwise why not.
+std::string disk_full(const CampaignPaths& paths, std::int64_t min_free, std::int64_t largest_output) {
+  const std::int64_t free = free_bytes(paths.root), need = min_free + largest_output;
+  if (free < 0 || free >= need) return {};
+  return fmt::format(
+      "files root '{}': disk is full: {} bytes free, {} needed ({} kept free + {}, the largest output so far); "
+      "jobs stay queued, nothing counted against them: free space (or lower --min-free-mb) and run work again",
+      paths.root.string(), free, need, min_free, largest_output);
+}
+
+/// The largest output of a done job: what the next output is expected to need.
+std::int64_t largest_output(db::Database& db) {
+  db::Statement st(db, "SELECT coalesce(max(output_bytes), 0) FROM jobs WHERE state='done'");
+  st.step();
+  return st.get_int(0);
+}
+
+/// True when a failed attempt failed because of its environment, not of the job: the disk of the
+/// files root is full now, or the error says so.
+bool environmental(const std::string& error, const std::string& full) {
+  return !full.empty() || error.find(std::strerror(ENOSPC)) != std::string::npos ||
+         error.find("disk is full") != std::string::npos;
 }
 
 /// Shared between the job and its heartbeat thread.
@@ -226,12 +259,31 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
   for (const char* d : kOutputFolders) fs::create_directories(paths.root / d, ec);
   std::unique_ptr<db::Database> beat_db;  // the heartbeat thread's own connection, kept across jobs
   Reconnecting with_db(db, o.db_path.string(), o.db_outage_s);
+  std::int64_t largest = with_db([&] { return largest_output(db); });
+  // An attempt that failed for its environment goes back uncounted; the worker stops claiming.
+  const auto give_back_env = [&](const Claim& c, const std::string& error, std::string full) {
+    with_db([&] { return give_back(db, c, "environmental, not counted: " + error); });
+    ++rep.released;
+    rep.disk_full = full.empty() ? error : full;
+    std::fprintf(stderr, "worker %d: job %s given back, not counted: %s\n", who.pid, c.job_id.c_str(),
+                 rep.disk_full.c_str());
+  };
   long ran = 0;
   while (!pipeline::stop_requested().load() && (o.max_jobs < 0 || ran < o.max_jobs)) {
     if (supervisor_gone()) {
       std::fprintf(stderr, "worker %d: its supervisor is gone; stopping\n", who.pid);
       pipeline::stop_requested().store(true);
       break;
+    }
+    if (const std::string full = disk_full(paths, o.min_free_bytes, largest); !full.empty() || !rep.disk_full.empty()) {
+      if (!o.follow) {
+        if (rep.disk_full.empty()) rep.disk_full = full;
+        std::fprintf(stderr, "worker %d: %s\n", who.pid, rep.disk_full.c_str());
+        break;
+      }
+      rep.disk_full.clear();  // --follow: wait for space
+      sleep_interruptible(std::max(o.poll_s, 1.0));
+      if (!full.empty()) continue;
     }
     Reclaimed lost;
     std::optional<Claim> c;
@@ -357,6 +409,11 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
       error = fmt::format("job {} finished but wrote no output at '{}'", c->job_id, tmp.string());
       exit_code = kExitFailure;
     }
+    if (!error.empty() && environmental(error, disk_full(paths, o.min_free_bytes, largest))) {
+      remove_tmp_of(paths.tmp(), prefix);
+      give_back_env(*c, error, disk_full(paths, o.min_free_bytes, largest));
+      continue;
+    }
     if (!error.empty()) {
       remove_tmp_of(paths.tmp(), prefix);
       const std::string state = with_db([&] { return fail(db, *c, error, exit_code, permanent, o.backoff_base_s); });
@@ -388,6 +445,10 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
       fs::remove(final_path, ec);
       const std::string why =
           fmt::format("job {}: cannot store its output at '{}': {}", c->job_id, final_path.string(), e.what());
+      if (environmental(why, disk_full(paths, o.min_free_bytes, largest))) {
+        give_back_env(*c, why, disk_full(paths, o.min_free_bytes, largest));
+        continue;
+      }
       const std::string state = with_db([&] { return fail(db, *c, why, 1, false, o.backoff_base_s); });
       ++(state == "dead" ? rep.dead : state == "failed" ? rep.failed : rep.fenced_out);
       std::fprintf(stderr, "worker %d: %s\n", who.pid, why.c_str());
@@ -405,6 +466,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     });
     if (completed) {
       ++rep.done;
+      largest = std::max(largest, done.bytes);
       if (o.verbose) std::fprintf(stderr, "worker %d: job %s done in %.2f s\n", who.pid, c->job_id.c_str(), secs);
     } else {
       fs::remove(final_path, ec);

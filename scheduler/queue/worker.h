@@ -6,6 +6,7 @@
 // lease back (the attempt does not count against the retry budget).
 #pragma once
 #include <atomic>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -58,6 +59,9 @@ struct WorkerOptions {
   /// How long a worker keeps reconnecting to a PostgreSQL server that restarted or went away,
   /// with backoff, before it gives up (its running job goes on meanwhile; its lease is fenced).
   double db_outage_s = 300;
+  /// Free space the files root must keep beyond the largest output seen (`work --min-free-mb`): below
+  /// it the worker claims nothing (the disk is full), and a failed attempt is not counted.
+  std::int64_t min_free_bytes = 64ll << 20;
   std::string code_version = "unknown";
   bool verbose = true;
   std::filesystem::path bed_cache;  ///< `work --bed-cache`: passed to the runners (RunContext)
@@ -66,6 +70,7 @@ struct WorkerOptions {
 struct WorkerReport {
   long done = 0, failed = 0, dead = 0, released = 0, fenced_out = 0, reclaimed = 0;
   bool interrupted = false;
+  std::string disk_full;  ///< why the worker stopped claiming: the files root's disk is full (empty: it is not)
 };
 
 WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners);
