@@ -16,6 +16,7 @@ Database::Database(const std::string& location, int busy_timeout_ms, bool read_o
 
 Database::~Database() = default;
 Database::Database(Database&& o) noexcept = default;
+Database& Database::operator=(Database&& o) noexcept = default;
 
 void Database::exec(std::string_view sql) { conn_->exec(sql); }
 

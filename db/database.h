@@ -20,13 +20,15 @@ class DbError : public std::runtime_error {
  public:
   enum class Kind {
     other,
-    busy,            ///< locked or a serialisation conflict: retry the transaction
-    not_a_database,  ///< the file is not SQLite (or is corrupt)
+    busy,             ///< locked or a serialisation conflict: retry the transaction
+    not_a_database,   ///< the file is not SQLite (or is corrupt)
+    connection_lost,  ///< the server closed the connection or cannot be reached (a restart, an outage)
   };
   explicit DbError(const std::string& what, Kind kind = Kind::other) : std::runtime_error(what), kind_(kind) {}
   [[nodiscard]] Kind kind() const { return kind_; }
   [[nodiscard]] bool busy() const { return kind_ == Kind::busy; }
   [[nodiscard]] bool not_a_database() const { return kind_ == Kind::not_a_database; }
+  [[nodiscard]] bool connection_lost() const { return kind_ == Kind::connection_lost; }
 
  private:
   Kind kind_;
@@ -83,6 +85,7 @@ class Database {
   Database(const Database&) = delete;
   Database& operator=(const Database&) = delete;
   Database(Database&& o) noexcept;
+  Database& operator=(Database&& o) noexcept;  ///< (a worker's reconnection replaces its connection)
 
   /// Runs one or more statements without results.
   void exec(std::string_view sql);

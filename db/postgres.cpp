@@ -31,6 +31,14 @@ bool retryable(const char* sqlstate) {
   return s == "40001" || s == "40P01" || s == "55P03";
 }
 
+/// The connection is gone (class 08: connection exception; 57P01-57P03: the server shuts down,
+/// crashed or is starting): a new connection may succeed once the server is back.
+bool connection_gone(const char* sqlstate) {
+  if (!sqlstate) return false;
+  const std::string s(sqlstate);
+  return s.rfind("08", 0) == 0 || s == "57P01" || s == "57P02" || s == "57P03";
+}
+
 void no_notices(void*, const char*) {}
 
 class PgConnection;
@@ -132,7 +140,8 @@ class PgConnection final : public detail::Connection {
     conn_.reset(PQconnectdb(url.c_str()));
     if (!conn_ || PQstatus(conn_.get()) != CONNECTION_OK)
       throw DbError(fmt::format("cannot connect to PostgreSQL at '{}': {}", url,
-                                conn_ ? trimmed(PQerrorMessage(conn_.get())) : std::string("out of memory")));
+                                conn_ ? trimmed(PQerrorMessage(conn_.get())) : std::string("out of memory")),
+                    DbError::Kind::connection_lost);
     PQsetNoticeProcessor(conn_.get(), no_notices, nullptr);
     exec(fmt::format("SET lock_timeout = {}; SET client_min_messages = warning{}", lock_timeout_ms,
                      read_only ? "; SET default_transaction_read_only = on" : ""));
@@ -185,9 +194,12 @@ class PgConnection final : public detail::Connection {
     if (st == PGRES_COMMAND_OK || st == PGRES_TUPLES_OK || st == PGRES_EMPTY_QUERY) return;
     const char* state = r ? PQresultErrorField(r, PG_DIAG_SQLSTATE) : nullptr;
     const std::string msg = trimmed(r ? PQresultErrorMessage(r) : PQerrorMessage(conn_.get()));
+    const bool gone = PQstatus(conn_.get()) == CONNECTION_BAD || connection_gone(state);
     throw DbError(
         fmt::format("database '{}': {} [SQLSTATE {}] (in: {})", url_, msg, state ? state : "none", sql.substr(0, 200)),
-        retryable(state) ? DbError::Kind::busy : DbError::Kind::other);
+        gone               ? DbError::Kind::connection_lost
+        : retryable(state) ? DbError::Kind::busy
+                           : DbError::Kind::other);
   }
 };
 

@@ -2,9 +2,70 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "engine/core/error.h"
 #include "results/io/hdf5.h"
 
 namespace gravsweep::results {
+
+namespace {
+
+// Physical ranges of a bed's grains, wide enough for any real bed (sand to boulders, aerogel to
+// tungsten) and narrow enough to catch a corrupt number (a flipped exponent bit scales a value by
+// 2^64 or more) before it becomes a numerical failure at step 0 without a name.
+constexpr double kMaxGrainRadius_m = 1.0;
+constexpr double kMaxGrainMass_kg = 1000.0;
+constexpr double kMinGrainDensity_kg_m3 = 10.0;
+constexpr double kMaxGrainDensity_kg_m3 = 1e5;
+constexpr double kMaxGrainSpeed_m_s = 1000.0;
+constexpr double kMaxGrainSpin_rad_s = 1e7;
+constexpr double kContainerMargin = 10.0;  ///< container diameters a grain may lie outside it
+
+[[noreturn]] void out_of_range(const std::filesystem::path& path, std::size_t grain, const std::string& what,
+                               const std::string& expected) {
+  throw ConfigError(fmt::format("bed {}: grain {}: {}, expected {}; the file is corrupt (or not a bed of real grains)",
+                                path.string(), grain, what, expected));
+}
+
+/// Refuses a grain outside the physical ranges (ConfigError naming the file, the grain, the value).
+void check_grain(const std::filesystem::path& path, const BedData& b, std::size_t i) {
+  const double r = b.radius_m[i], m = b.mass_kg[i];
+  if (!(r > 0 && r <= kMaxGrainRadius_m))
+    out_of_range(path, i, fmt::format("radius_m {}", r), fmt::format("0 < radius <= {} m", kMaxGrainRadius_m));
+  if (!(m > 0 && m <= kMaxGrainMass_kg))
+    out_of_range(path, i, fmt::format("mass_kg {}", m), fmt::format("0 < mass <= {} kg", kMaxGrainMass_kg));
+  const double density = m / (4.0 / 3.0 * std::numbers::pi * r * r * r);
+  if (!(density >= kMinGrainDensity_kg_m3 && density <= kMaxGrainDensity_kg_m3))
+    out_of_range(path, i, fmt::format("mass_kg {} and radius_m {} make a density of {:.4g} kg/m3", m, r, density),
+                 fmt::format("{} to {} kg/m3", kMinGrainDensity_kg_m3, kMaxGrainDensity_kg_m3));
+  const double* p = &b.position_m[3 * i];
+  const double* v = &b.velocity_m_s[3 * i];
+  const double* w = &b.omega_rad_s[3 * i];
+  // Near the container, with a wide margin (a corrupt exponent scales a coordinate by 2^64, a real
+  // grain is inside): radially within ten diameters, vertically from ten diameters below the floor
+  // to ten above the highest of wall, fill and surface.
+  const double d = b.container_diameter_m;
+  const double margin_m = kContainerMargin * d;
+  const double top_m = std::max({b.wall_height_m, b.fill_height_m, b.surface_height_m}) + margin_m;
+  const bool inside = d > 0 ? std::hypot(p[0], p[1]) <= margin_m && p[2] >= -margin_m && p[2] <= top_m
+                            : std::abs(p[0]) <= 1e3 && std::abs(p[1]) <= 1e3 && std::abs(p[2]) <= 1e3;
+  if (!inside || !std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+    out_of_range(path, i, fmt::format("position_m ({}, {}, {})", p[0], p[1], p[2]),
+                 d > 0
+                     ? fmt::format("a point within {} container diameters ({} m) of the container", kContainerMargin, d)
+                     : std::string("a finite point within 1 km"));
+  if (!(std::hypot(v[0], v[1], v[2]) <= kMaxGrainSpeed_m_s))
+    out_of_range(path, i, fmt::format("velocity_m_s ({}, {}, {})", v[0], v[1], v[2]),
+                 fmt::format("a speed <= {} m/s", kMaxGrainSpeed_m_s));
+  if (!(std::hypot(w[0], w[1], w[2]) <= kMaxGrainSpin_rad_s))
+    out_of_range(path, i, fmt::format("omega_rad_s ({}, {}, {})", w[0], w[1], w[2]),
+                 fmt::format("a spin <= {:g} rad/s", kMaxGrainSpin_rad_s));
+}
+
+}  // namespace
 
 void write_bed(const std::filesystem::path& path, const BedData& b) {
   const std::size_t n = b.size();
@@ -79,6 +140,7 @@ BedData read_bed(const std::filesystem::path& path) {
   if (b.velocity_m_s.size() != 3 * n || b.omega_rad_s.size() != 3 * n || b.radius_m.size() != n ||
       b.mass_kg.size() != n || b.material.size() != n)
     throw h5::H5Error(fmt::format("bed {}: the /grains datasets do not all hold {} grains", path.string(), n));
+  for (std::size_t i = 0; i < n; ++i) check_grain(path, b, i);
   return b;
 }
 

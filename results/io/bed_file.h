@@ -47,7 +47,9 @@ inline constexpr long long kBedFormatVersion = 1;
 
 /// Writes under a temporary name, then renames into place.
 void write_bed(const std::filesystem::path& path, const BedData& bed);
-/// Reads and checks the layout; throws h5::H5Error naming the file and the missing piece.
+/// Reads and checks the layout; throws h5::H5Error naming the file and the missing piece, and
+/// ConfigError naming the file and the grain whose radius, mass (density), position, velocity or
+/// spin lies outside any real bed's range (a corrupt number).
 BedData read_bed(const std::filesystem::path& path);
 
 }  // namespace gravsweep::results

@@ -165,6 +165,8 @@ MeasuredTrial read_row(const fs::path& dir, const std::map<std::string, int>& co
           {"trials.csv", ln, i + 1, fmt::format("column '{}': expected a finite number, got '{}'", name, s)}};
     if (positive && !(v > 0))
       throw ParseError{{"trials.csv", ln, i + 1, fmt::format("column '{}': expected a value > 0, got {}", name, v)}};
+    if (const std::string expected = out_of_physical_range(name, v); !expected.empty())
+      throw ParseError{{"trials.csv", ln, i + 1, fmt::format("column '{}': found {}, expected {}", name, s, expected)}};
     return v;
   };
   MeasuredTrial t;

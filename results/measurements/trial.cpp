@@ -32,6 +32,49 @@ const std::vector<TrialField>& trial_fields() {
   return fields;
 }
 
+namespace {
+
+/// The physical range of a numeric field: min < value <= max (min <= value when min_inclusive).
+struct PhysicalRange {
+  const char* key;
+  double min, max;
+  bool min_inclusive;
+  const char* what;
+};
+
+// Wide on purpose: a wrong unit (g in kg, mm in m) or a corrupt number (1e308) is refused, no
+// real drop is (milligravity asteroid surfaces to 100 g centrifuges, grains to boulders).
+constexpr PhysicalRange kPhysicalRanges[] = {
+    {"gravity_m_s2", 0, 1000, false, "a gravity"},
+    {"impact_velocity_m_s", 0, 1000, false, "an impact speed"},
+    {"fill_height_m", 0, 100, false, "a bed depth"},
+    {"projectile_mass_kg", 0, 1000, false, "a projectile mass"},
+    {"projectile_diameter_m", 0, 10, false, "a projectile diameter"},
+    {"grain_diameter_m", 0, 1, false, "a grain diameter"},
+    {"bulk_density_kg_m3", 0, 25000, true, "a bulk density (0: not measured)"},
+    {"sample_rate_hz", 0, 1e9, false, "a sample rate"},
+    {"drop_height_m", 0, 1000, true, "a drop height"},
+    {"filter_cutoff_hz", 0, 1e9, false, "a filter cut-off"},
+    {"end_threshold_g", 0, 100, false, "an end threshold in g"},
+    {"end_speed_fraction", 0, 1, false, "a fraction of the impact speed"},
+};
+
+}  // namespace
+
+std::string out_of_physical_range(const std::string& key, double value) {
+  for (const auto& r : kPhysicalRanges) {
+    if (key != r.key) continue;
+    const bool above_min = r.min_inclusive ? value >= r.min : value > r.min;
+    if (std::isfinite(value) && above_min && value <= r.max) return {};
+    const auto f =
+        std::find_if(trial_fields().begin(), trial_fields().end(), [&](const TrialField& fd) { return key == fd.key; });
+    return fmt::format("{} {} value <= {:g} {}", r.what,
+                       r.min_inclusive ? fmt::format("{:g} <=", r.min) : fmt::format("{:g} <", r.min), r.max,
+                       f != trial_fields().end() ? f->unit : "");
+  }
+  return std::isfinite(value) ? std::string() : "a finite number";
+}
+
 void to_json(nlohmann::json& j, const Trial& t) {
   j = nlohmann::json::object();
   j["source"] = to_string(t.source);

@@ -64,6 +64,12 @@ struct TrialField {
 /// The table, in the order of trials.csv's required columns first.
 const std::vector<TrialField>& trial_fields();
 
+/// Empty when `value` lies in the physical range of the numeric trial field `key` (a field
+/// without a range accepts any finite value), else what was expected, e.g. "a mass 0 < m <= 1000 kg".
+/// The ranges are wide (asteroid to centrifuge gravity, grains of sand to boulders): they catch a
+/// wrong unit or a corrupt number, never a real experiment.
+std::string out_of_physical_range(const std::string& key, double value);
+
 void to_json(nlohmann::json& j, const Trial& t);
 void from_json(const nlohmann::json& j, Trial& t);
 

@@ -15,6 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "engine/core/error.h"
 #include "spec/json_text.h"
 #include "spec/schemas.h"
 
@@ -258,7 +259,12 @@ FittedModel fit_model(const ModelSpec& spec, const Campaign& c) {
   return fit_model(spec, c, std::vector<bool>(c.trials.size(), true));
 }
 
-FittedModel fit_model(const ModelSpec& spec, const Campaign& c, const std::vector<bool>& mask) {
+namespace {
+
+/// The least-squares fit of fit_model, unchecked; `not_finite` gets the trials whose rows of the
+/// problem (features or m (a_up + g)) hold a value that is not finite.
+FittedModel fit_unchecked(const ModelSpec& spec, const Campaign& c, const std::vector<bool>& mask,
+                          std::vector<int>& not_finite) {
   FittedModel m;
   m.spec = spec;
   m.gravity_levels = c.gravity_levels();
@@ -297,6 +303,8 @@ FittedModel fit_model(const ModelSpec& spec, const Campaign& c, const std::vecto
       feature_row(spec, L, gi, ctx, row.data());
       for (int j = 0; j < L.cols; ++j) X(r, j) = row[static_cast<std::size_t>(j)];
       y(r) = t.info.projectile_mass_kg * (t.processed.accel_up_m_s2[k] + t.info.gravity_m_s2);
+      if ((!std::isfinite(y(r)) || !X.row(r).allFinite()) && (not_finite.empty() || not_finite.back() != ti))
+        not_finite.push_back(ti);
       w(r) = wt;
       cluster[static_cast<std::size_t>(r)] = ti;
     }
@@ -332,6 +340,44 @@ FittedModel fit_model(const ModelSpec& spec, const Campaign& c, const std::vecto
   const Eigen::MatrixXd Sinv = scale.cwiseInverse().asDiagonal();
   m.cov = Sinv * covs * Sinv;
   return m;
+}
+
+/// The trials a non-finite fit comes from: those with non-finite rows, else each trial whose
+/// leaving-out makes the fit finite.
+std::vector<int> trials_behind(const ModelSpec& spec, const Campaign& c, const std::vector<bool>& mask,
+                               std::vector<int> not_finite) {
+  if (!not_finite.empty()) return not_finite;
+  std::vector<int> out;
+  for (std::size_t ti = 0; ti < c.trials.size(); ++ti) {
+    if (!mask[ti]) continue;
+    std::vector<bool> without = mask;
+    without[ti] = false;
+    std::vector<int> ignored;
+    if (fit_unchecked(spec, c, without, ignored).coef.allFinite()) out.push_back(static_cast<int>(ti));
+  }
+  return out;
+}
+
+}  // namespace
+
+FittedModel fit_model(const ModelSpec& spec, const Campaign& c, const std::vector<bool>& mask) {
+  std::vector<int> not_finite;
+  FittedModel m = fit_unchecked(spec, c, mask, not_finite);
+  if (m.coef.allFinite()) return m;
+  std::string params, trials;
+  for (Eigen::Index j = 0; j < m.coef.size(); ++j)
+    if (!std::isfinite(m.coef(j))) params += (params.empty() ? "" : ", ") + m.column_names[static_cast<std::size_t>(j)];
+  for (int ti : trials_behind(spec, c, mask, not_finite)) {
+    const Trial& t = c.trials[static_cast<std::size_t>(ti)].info;
+    trials += fmt::format("{}{} (mass {} kg, projectile diameter {} m, grain diameter {} m, gravity {} m/s2)",
+                          trials.empty() ? "" : "; ", t.trial_id, t.projectile_mass_kg, t.projectile_diameter_m,
+                          t.grain_diameter_m, t.gravity_m_s2);
+  }
+  throw NumericalFailure(
+      fmt::format("model fit '{}': parameter(s) not finite: {}; {}", spec.name(), params,
+                  trials.empty() ? "no single trial is responsible (several trials together, or the model)"
+                                 : "the trial(s) responsible: " + trials),
+      -1, -1);
 }
 
 double trial_trace_mse(const FittedModel& m, const MeasuredTrial& t) {

@@ -9,6 +9,7 @@
 
 #include "db/database.h"
 #include "scheduler/cli/exit_codes.h"
+#include "scheduler/queue/campaign.h"
 #include "scheduler/queue/filter.h"
 #include "scheduler/queue/queue.h"
 
@@ -25,7 +26,8 @@ bool has_table(db::Database& db, const char* name) {
 }
 
 /// Every finished drop of a campaign database (filtered on its results table) as a DEM trial.
-CampaignInput load_queue_campaign(const std::string& path, db::Database& db, const std::vector<std::string>& where) {
+CampaignInput load_queue_campaign(const std::string& path, db::Database& db, const std::vector<std::string>& where,
+                                  const std::string& files) {
   CampaignInput in;
   in.kind = "campaign database (submit/work)";
   queue::ResultsQuery q;
@@ -37,7 +39,7 @@ CampaignInput load_queue_campaign(const std::string& path, db::Database& db, con
   } catch (const std::invalid_argument& e) {
     throw UsageError(fmt::format("{}: {}", path, e.what()));
   }
-  const queue::CampaignPaths paths(path);
+  const queue::CampaignPaths paths(path, files);
   std::vector<results::DemTraceRef> refs;
   for (const auto& r : t.rows) {
     if (r[1] != "drop" || !r[2].is_string()) continue;
@@ -69,6 +71,21 @@ nlohmann::json row_of(const results::MeasuredTrial& t) {
   return j;
 }
 
+/// Refuses a trial whose numbers lie outside physical ranges (an imported file written before
+/// `measurements import` checked them, or edited since): a fit on it would be garbage or NaN.
+void refuse_unphysical(const std::string& path, const CampaignInput& in) {
+  for (const auto& t : in.campaign.trials)
+    for (const auto& f : results::trial_fields()) {
+      if (!f.number) continue;
+      const double v = t.info.*f.number;
+      if (const std::string expected = results::out_of_physical_range(f.key, v); !expected.empty())
+        throw UsageError(
+            fmt::format("{}: trial '{}': {} = {}, expected {} (a wrong unit or a corrupt number; fix the "
+                        "record and import it again)",
+                        path, t.info.trial_id, f.key, v, expected));
+    }
+}
+
 void filter_in_memory(const std::string& path, CampaignInput& in, const std::vector<std::string>& where) {
   if (where.empty()) return;
   auto& trials = in.campaign.trials;
@@ -87,9 +104,16 @@ void filter_in_memory(const std::string& path, CampaignInput& in, const std::vec
 
 }  // namespace
 
-CampaignInput load_campaign_input(const std::string& path, const std::vector<std::string>& where, double cutoff_hz) {
+CampaignInput load_campaign_input(const std::string& path, const std::vector<std::string>& where, double cutoff_hz,
+                                  const std::string& files) {
   CampaignInput in;
   try {
+    if (db::is_postgres_url(path)) {
+      db::Database db = queue::open_campaign(path, queue::OpenMode::read, files);  // refuses a non-campaign
+      in = load_queue_campaign(path, db, where, files);
+      refuse_unphysical(path, in);
+      return in;
+    }
     if (fs::is_directory(path)) {
       in.kind = "lab campaign folder";
       in.campaign = results::load_campaign(path, cutoff_hz);
@@ -100,7 +124,11 @@ CampaignInput load_campaign_input(const std::string& path, const std::vector<std
                         "campaign folder expected",
                         path));
       db::Database db(path, 30000, true);
-      if (has_table(db, "jobs") && has_table(db, "results")) return load_queue_campaign(path, db, where);
+      if (has_table(db, "jobs") && has_table(db, "results")) {
+        in = load_queue_campaign(path, db, where, files);
+        refuse_unphysical(path, in);
+        return in;
+      }
       if (!has_table(db, "trials"))
         throw UsageError(
             fmt::format("{}: neither a campaign database (tables jobs, results) nor an imported "
@@ -117,25 +145,26 @@ CampaignInput load_campaign_input(const std::string& path, const std::vector<std
   } catch (const UsageError&) {
     throw;
   } catch (const db::DbError& e) {
-    throw UsageError(fmt::format("{}: not an SQLite campaign ({})", path, e.what()));
+    throw UsageError(fmt::format("{}: not a readable campaign ({})", path, e.what()));
   } catch (const std::runtime_error& e) {
     throw UsageError(e.what());
   }
+  refuse_unphysical(path, in);
   filter_in_memory(path, in, where);
   return in;
 }
 
 CampaignInput load_campaign_inputs(const std::vector<std::string>& paths, const std::vector<std::string>& where,
-                                   double cutoff_hz) {
+                                   double cutoff_hz, const std::string& files) {
   if (paths.size() == 1) {
-    auto in = load_campaign_input(paths.front(), where, cutoff_hz);
+    auto in = load_campaign_input(paths.front(), where, cutoff_hz, files);
     describe_input(paths.front(), in);
     return in;
   }
   CampaignInput all;
   std::set<std::string> kinds, ids;
   for (const auto& p : paths) {
-    auto in = load_campaign_input(p, where, cutoff_hz);
+    auto in = load_campaign_input(p, where, cutoff_hz, files);
     describe_input(p, in);
     for (auto& t : in.campaign.trials) {
       if (!ids.insert(t.info.trial_id).second)

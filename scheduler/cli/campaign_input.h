@@ -5,6 +5,8 @@
 // results` (scheduler/queue/filter.h): on the results table of a campaign database, on the trial
 // fields (results/measurements/trial.h) and metrics otherwise.
 #pragma once
+#include <CLI/CLI.hpp>
+
 #include <string>
 #include <vector>
 
@@ -19,15 +21,23 @@ struct CampaignInput {
   std::string note;              ///< e.g. drop jobs not finished
 };
 
-/// Reads `path`; throws UsageError for what is not a campaign or a bad --where.
+/// Reads `path` (a file, a folder, or a `postgresql://` campaign whose traces are under `files`,
+/// its files root); throws UsageError for what is not a campaign or a bad --where.
 CampaignInput load_campaign_input(const std::string& path, const std::vector<std::string>& where,
-                                  double cutoff_hz = 500.0);
+                                  double cutoff_hz = 500.0, const std::string& files = {});
 
 /// Reads several inputs (e.g. one exported dataset per gravity level) into one campaign: each is
 /// read and described (describe_input) in turn, the trials and issues concatenated, `--where`
 /// applied to each. Throws UsageError when a trial id appears in two inputs.
 CampaignInput load_campaign_inputs(const std::vector<std::string>& paths, const std::vector<std::string>& where,
-                                   double cutoff_hz = 500.0);
+                                   double cutoff_hz = 500.0, const std::string& files = {});
+
+/// Adds --files: the files root of an input given as a `postgresql://` URL (where its traces are).
+inline void add_input_files_option(CLI::App* sub, std::string& files) {
+  sub->add_option("--files", files,
+                  "the files root of a campaign given as postgresql://user@host:port/dbname (its traces are "
+                  "read there; default for an SQLite campaign: <db stem>.files/ beside it)");
+}
 
 /// Prints to stderr what was read ("<path>: <kind>, n trials") and every trial left out with its
 /// reason (unmeasurable or bad input).

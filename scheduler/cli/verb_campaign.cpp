@@ -23,6 +23,9 @@ void run_copy(const CopyOptions& o) {
   db::Database dst = queue::open_campaign(o.dst, queue::OpenMode::create, o.dst_files);
   const queue::CampaignPaths dst_paths(o.dst, o.dst_files);
   const auto rep = queue::copy_campaign(src, src_paths, dst, dst_paths);
+  // The copy is the same campaign: its identity, and its files root's marker.
+  queue::set_campaign_id(dst, queue::campaign_id(src));
+  queue::bind_files_root(dst, dst_paths);
   fmt::print(
       "copied {} -> {}: {} jobs, {} attempts, {} results rows ({} parameter and metric columns); {} files "
       "copied to {}\n",

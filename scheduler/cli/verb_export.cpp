@@ -124,7 +124,6 @@ void write_text_file(const fs::path& p, const std::string& text) {
 }
 
 void run_export(const ExportOptions& o) {
-  if (!fs::exists(o.db)) throw UsageError(fmt::format("--db: no campaign database at '{}'", o.db));
   if (!(o.rate_hz > 0)) throw UsageError(fmt::format("--rate-hz: expected a rate > 0 Hz, found {}", o.rate_hz));
   db::Database db = queue::open_campaign(o.db, queue::OpenMode::read, o.files);  // refuses a non-campaign
   const queue::CampaignPaths paths(o.db, o.files);

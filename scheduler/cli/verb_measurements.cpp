@@ -27,6 +27,7 @@ struct ImportOptions {
   std::string format = "table";
   std::vector<std::string> where;
   double cutoff_hz = 500.0;
+  std::string files;  ///< files root of a postgresql:// input
   bool keep_going = false;
 };
 
@@ -61,6 +62,7 @@ void setup_measurements(CLI::App& app) {
   imp->add_flag("--keep-going", o->keep_going, "store the good trials even when some are bad input (exit code 4)");
   imp->add_option("--db", o->db, "SQLite file to store into (created if missing)")->capture_default_str();
   imp->add_option("--cutoff", o->cutoff_hz, "low-pass cut-off, Hz")->capture_default_str();
+  add_input_files_option(imp, o->files);
   add_format_option(imp, o->format);
   auto runs = std::make_shared<std::vector<std::string>>();
   auto runs_out = std::make_shared<std::string>();
@@ -91,7 +93,7 @@ void setup_measurements(CLI::App& app) {
     std::error_code ec;
     if (fs::exists(o->db) && fs::equivalent(o->db, o->dir, ec))
       throw UsageError(fmt::format("--db '{}': the campaign read; another file expected", o->db));
-    auto in = load_campaign_input(o->dir, o->where, o->cutoff_hz);
+    auto in = load_campaign_input(o->dir, o->where, o->cutoff_hz, o->files);
     describe_input(o->dir, in);
     const results::Campaign& c = in.campaign;
     std::size_t bad = 0;

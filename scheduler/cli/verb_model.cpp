@@ -28,8 +28,9 @@ namespace {
 using results::num;
 
 constexpr const char* kDirHelp =
-    "campaign database from `submit`/`work` (every finished drop is a trial), SQLite file from "
-    "`measurements import`, or lab campaign folder; several are read as one campaign (e.g. one "
+    "campaign database from `submit`/`work` (an SQLite file, or postgresql://user@host:port/dbname with "
+    "--files; every finished drop is a trial), SQLite file from `measurements import`, or lab campaign folder; several "
+    "are read as one campaign (e.g. one "
     "exported dataset per gravity level)";
 constexpr const char* kWhereHelp =
     "filter the trials, grammar of `gravsweep results` (e.g. 'gravity_m_s2<1'); repeatable";
@@ -41,13 +42,15 @@ struct ModelOptions {
   std::string format = "table";
   std::string plot;
   std::vector<std::string> where;
+  std::string files;  ///< files root of a postgresql:// input
   int folds = 6;
   double alpha = 0.01;
   double min_improvement = 0.03;
 };
 
-results::Campaign load(const std::vector<std::string>& dir, const std::vector<std::string>& where) {
-  auto in = load_campaign_inputs(dir, where);
+results::Campaign load(const std::vector<std::string>& dir, const std::vector<std::string>& where,
+                       const std::string& files) {
+  auto in = load_campaign_inputs(dir, where, 500.0, files);
   if (in.campaign.trials.size() < 6)
     throw UsageError(fmt::format("{}: only {} usable trials; at least 6 are needed", fmt::join(dir, " + "),
                                  in.campaign.trials.size()));
@@ -196,9 +199,10 @@ void setup_model(CLI::App& app) {
       "  gravsweep model table3 campaign.db --where 'impact_speed_m_s>=0.5'");
   t3->add_option("dir", o3->dir, kDirHelp)->required();
   t3->add_option("--where", o3->where, kWhereHelp);
+  add_input_files_option(t3, o3->files);
   add_format_option(t3, o3->format);
   t3->callback([o3]() {
-    const auto c = load(o3->dir, o3->where);
+    const auto c = load(o3->dir, o3->where, o3->files);
     results::Table t({"gravity_m_s2", "trials", "f0_N", "f0_se_N", "f0_boot_se_N", "inv_d1_1_m", "inv_d1_se_1_m",
                       "inv_d1_boot_se_1_m", "vt_m_s", "vt_se_m_s", "alpha", "alpha_se", "note"});
     for (const auto& r : results::table3(c))
@@ -221,6 +225,7 @@ void setup_model(CLI::App& app) {
       "The figure of the error falling is written to --plot (default error_falls.png).");
   fit->add_option("dir", of->dir, kDirHelp)->required();
   fit->add_option("--where", of->where, kWhereHelp);
+  add_input_files_option(fit, of->files);
   fit->add_option("--model", of->model, "model: 'base+depth_friction' or a JSON spec file")->capture_default_str();
   fit->add_option("--baseline", of->baseline, "the 'before' model")->capture_default_str();
   fit->add_option("--folds", of->folds, "cross-validation folds (whole trials)")
@@ -233,7 +238,7 @@ void setup_model(CLI::App& app) {
   add_format_option(fit, of->format);
   fit->callback([of, no_plot]() {
     if (*no_plot) of->plot.clear();
-    const auto c = load(of->dir, of->where);
+    const auto c = load(of->dir, of->where, of->files);
     const auto base = spec_of(of->baseline);
     const auto spec = spec_of(of->model);
     const auto fm = results::fit_model(spec, c);
@@ -278,10 +283,11 @@ void setup_model(CLI::App& app) {
       "Example:\n  gravsweep model residuals ../shared/data/measurements/depth-friction-dev --model base");
   res->add_option("dir", ores->dir, kDirHelp)->required();
   res->add_option("--where", ores->where, kWhereHelp);
+  add_input_files_option(res, ores->files);
   res->add_option("--model", ores->model, "model: 'base' or a JSON spec file")->capture_default_str();
   add_format_option(res, ores->format);
   res->callback([ores]() {
-    const auto c = load(ores->dir, ores->where);
+    const auto c = load(ores->dir, ores->where, ores->files);
     const auto fm = results::fit_model(spec_of(ores->model), c);
     results::Table t({"trial_id", "gravity_m_s2", "vc_m_s", "fill_height_m", "trace_rms_m_s2", "dzstop_mm", "dtstop_ms",
                       "dapeak_m_s2"});
@@ -388,6 +394,7 @@ void setup_model(CLI::App& app) {
   rank->alias("discover");
   rank->add_option("dir", orank->dir, kDirHelp)->required();
   rank->add_option("--where", orank->where, kWhereHelp);
+  add_input_files_option(rank, orank->files);
   rank->add_option("--baseline", orank->baseline, "starting model")->capture_default_str();
   rank->add_option("--folds", orank->folds, "cross-validation folds")->check(CLI::Range(2, 100))->capture_default_str();
   rank->add_option("--alpha", orank->alpha, "family-wise significance level")->capture_default_str();
@@ -395,7 +402,7 @@ void setup_model(CLI::App& app) {
       ->capture_default_str();
   add_format_option(rank, orank->format);
   rank->callback([orank]() {
-    const auto c = load(orank->dir, orank->where);
+    const auto c = load(orank->dir, orank->where, orank->files);
     const auto base = spec_of(orank->baseline);
     const auto d = results::discover(c, base, orank->folds, orank->alpha, orank->min_improvement);
     if (orank->format == "table") fmt::print("Where {} fails (residual a_meas - a_model in units of g):\n", d.baseline);

@@ -23,10 +23,11 @@ struct CollapseOptions {
   std::vector<std::string> where;
   std::string format = "table";
   std::string plot;
+  std::string files;
 };
 
 void run_collapse(const CollapseOptions& o) {
-  const auto in = load_campaign_inputs(o.inputs, o.where);
+  const auto in = load_campaign_inputs(o.inputs, o.where, 500.0, o.files);
   const auto& c = in.campaign;
   if (c.gravity_levels().size() < 2)
     throw UsageError(fmt::format("{} trials on {} gravity level(s): a collapse needs at least two levels",
@@ -64,6 +65,7 @@ void setup_model_collapse(CLI::App& model) {
                   "campaign database, imported SQLite file or lab campaign folder; several are read as one")
       ->required();
   sub->add_option("--where", o->where, "filter the trials, grammar of `gravsweep results`; repeatable");
+  add_input_files_option(sub, o->files);
   sub->add_option("--plot", o->plot, "also draw the three scaled metrics against Fr, coloured by g (PNG)");
   add_format_option(sub, o->format);
   sub->callback([o]() { run_collapse(*o); });

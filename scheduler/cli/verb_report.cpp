@@ -25,6 +25,7 @@ struct ReportOptions {
   std::vector<std::string> dirs;
   std::string out = "report", baseline = "base", model;
   std::vector<std::string> where;
+  std::string files;  ///< files root of a postgresql:// input
   int folds = 6;
 };
 /// The figures of a report, each with its one-line caption.
@@ -128,18 +129,20 @@ void setup_report(CLI::App& app) {
       "  gravsweep report campaign.db --out report-sweep    # the drops of `submit` + `work`\n"
       "  gravsweep report data/reproduction/chrono_1g data/reproduction/chrono_0.1g --out r  # both gravity levels");
   sub->add_option("dir", o->dirs,
-                  "campaign database from `submit`/`work` (every finished drop is a trial), SQLite file from "
+                  "campaign database from `submit`/`work` (an SQLite file, or postgresql://user@host:port/dbname "
+                  "with --files; every finished drop is a trial), SQLite file from "
                   "`measurements import`, or lab campaign folder; several are read as one campaign (e.g. one "
                   "exported dataset per gravity level: Figs. 9 and 10 then show both)")
       ->required();
   sub->add_option("--where", o->where, "filter the trials, grammar of `gravsweep results` (e.g. 'gravity_m_s2<1')");
+  add_input_files_option(sub, o->files);
   sub->add_option("--out", o->out, "report folder")->capture_default_str();
   sub->add_option("--baseline", o->baseline, "the 'before' model")->capture_default_str();
   sub->add_option("--model", o->model, "the 'after' model (default: baseline + discovered terms)");
   sub->add_option("--folds", o->folds, "cross-validation folds")->check(CLI::Range(2, 100))->capture_default_str();
   sub->callback([o]() {
     const std::string inputs = fmt::format("{}", fmt::join(o->dirs, " + "));
-    auto in = load_campaign_inputs(o->dirs, o->where);
+    auto in = load_campaign_inputs(o->dirs, o->where, 500.0, o->files);
     const results::Campaign& c = in.campaign;
     if (c.trials.size() < 6) throw UsageError(fmt::format("{}: only {} usable trials", inputs, c.trials.size()));
     results::ModelSpec base, after;

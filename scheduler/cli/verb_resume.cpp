@@ -31,7 +31,9 @@ void run_resume(const ResumeCliOptions& o) {
   r.extra_attempts = o.extra_attempts;
   r.remove_orphans = !o.keep_orphans;
   r.dry_run = o.dry_run;
-  const auto rep = queue::resume(db, queue::CampaignPaths(o.db, o.files), r);
+  const queue::CampaignPaths paths(o.db, o.files);
+  queue::bind_files_root(db, paths, /*write=*/!o.dry_run);  // before anything in it moves
+  const auto rep = queue::resume(db, paths, r);
   fmt::print("expired leases: {} requeued{}, {} dead (retry budget spent)\n", rep.expired_requeued,
              o.dry_run ? " (dry run)" : "", rep.expired_dead);
   fmt::print("failed jobs requeued without waiting for their backoff: {}\n", rep.failed_requeued);
@@ -57,8 +59,9 @@ void setup_resume(CLI::App& app) {
       "quarantine/; the next resume deletes what an earlier one quarantined. Only files unknown to\n"
       "the database (one consistent snapshot) and older than it by 5 s move. Safe while workers run:\n"
       "done outputs, live leases and their files are left alone. Refuses (exit 2) a database that is\n"
-      "not a campaign, or whose files folder misses most of its outputs (a renamed copy without its\n"
-      "folder). Then run `gravsweep work` again.\n\n"
+      "not a campaign, whose files folder misses most of its outputs (a renamed copy without its\n"
+      "folder), or whose files folder is another campaign's (its gravsweep-campaign.json names\n"
+      "another) or, unmarked, holds files the campaign did not write. Then run `gravsweep work` again.\n\n"
       "Examples:\n"
       "  gravsweep resume --db campaign.db\n"
       "  gravsweep resume --db campaign.db --dead --extra-attempts 2   # also retry dead jobs\n"
@@ -69,7 +72,8 @@ void setup_resume(CLI::App& app) {
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
   sub->add_flag("--keep-orphans", opt->keep_orphans,
-                "do not look for orphaned files (nor check that the folder belongs to the database)");
+                "do not look for orphaned files (nor check that most done outputs are there; the folder's marker "
+                "is still checked)");
   sub->add_flag("--dry-run", opt->dry_run, "report only");
   sub->callback([opt]() { run_resume(*opt); });
 }

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <regex>
 #include <set>
 #include <string>
 
@@ -39,13 +40,44 @@ std::string sh_quote(const std::string& s) {
   return out + "'";
 }
 
+/// Double-quoted for an `#SBATCH` line (sbatch reads `"` as grouping and `\` as escape there); a
+/// line break cannot be written in one, so it is refused.
+std::string sbatch_quote(const std::string& what, const std::string& s) {
+  if (s.find_first_of("\n\r") != std::string::npos)
+    throw UsageError(fmt::format("{} '{}': holds a line break, which an #SBATCH line cannot carry", what, s));
+  std::string out = "\"";
+  for (char c : s) out += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
+  return out + "\"";
+}
+
+/// Refuses --time, --partition and --account that are not in Slurm's syntax (sbatch(1)): each is
+/// written into an `#SBATCH` line, where a line break or a space would inject or cut an option.
+void check_slurm_syntax(const SlurmOptions& o) {
+  static const std::regex time_re(
+      R"(^(\d+|\d+:\d+|\d+:\d+:\d+|\d+-\d+|\d+-\d+:\d+|\d+-\d+:\d+:\d+|UNLIMITED|INFINITE)$)", std::regex::icase);
+  static const std::regex name_re(R"(^[A-Za-z0-9_.-]+$)");
+  static const std::regex names_re(R"(^[A-Za-z0-9_.-]+(,[A-Za-z0-9_.-]+)*$)");
+  if (!o.time_limit.empty() && !std::regex_match(o.time_limit, time_re))
+    throw UsageError(fmt::format(
+        "--time '{}': expected a Slurm time limit: minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM, D-HH:MM:SS or UNLIMITED",
+        o.time_limit));
+  if (!o.partition.empty() && !std::regex_match(o.partition, names_re))
+    throw UsageError(fmt::format(
+        "--partition '{}': expected a Slurm partition name or a comma-separated list of them (letters, digits, "
+        "'_', '-', '.')",
+        o.partition));
+  if (!o.account.empty() && !std::regex_match(o.account, name_re))
+    throw UsageError(
+        fmt::format("--account '{}': expected a Slurm account name (letters, digits, '_', '-', '.')", o.account));
+}
+
 std::string sbatch_script(const SlurmOptions& o, const std::string& exe, const fs::path& logs) {
   std::string s = "#!/bin/sh\n";
   s += "#SBATCH --job-name=gravsweep-work\n";
   s += fmt::format("#SBATCH --array=1-{}\n", o.workers);
   s += fmt::format("#SBATCH --cpus-per-task={}\n", o.threads);
   s += "#SBATCH --ntasks=1\n";
-  s += fmt::format("#SBATCH --output={}/%A_%a.log\n", logs.string());
+  s += fmt::format("#SBATCH --output={}\n", sbatch_quote("--files", (logs / "%A_%a.log").string()));
   if (!o.partition.empty()) s += fmt::format("#SBATCH --partition={}\n", o.partition);
   if (!o.time_limit.empty()) s += fmt::format("#SBATCH --time={}\n", o.time_limit);
   if (!o.account.empty()) s += fmt::format("#SBATCH --account={}\n", o.account);
@@ -70,6 +102,7 @@ std::string run_capture(const std::string& cmd) {
 }
 
 void run_submit(const SlurmOptions& o) {
+  check_slurm_syntax(o);
   if (!db::is_postgres_url(o.db))
     throw UsageError(
         fmt::format("--db '{}': Slurm workers on a cluster need a PostgreSQL campaign "
@@ -130,7 +163,8 @@ void setup_slurm(CLI::App& app) {
       "Submit --workers pilot workers as one sbatch job array: each task runs `gravsweep work` with\n"
       "--threads engine threads (cpus-per-task) until no job is left; logs in <files>/slurm/. Needs a\n"
       "PostgreSQL campaign and a files root every node mounts at the same path. --dry-run prints the\n"
-      "script. Workers stopped by the time limit or scancel lose nothing.\n\n"
+      "script. Workers stopped by the time limit or scancel lose nothing. --time, --partition and\n"
+      "--account are checked against Slurm's syntax (exit 2 otherwise); every path is quoted.\n\n"
       "Example:\n"
       "  gravsweep slurm submit --db postgresql://me@dbhost:5432/sweep --files /shared/sweep \\\n"
       "      --workers 16 --threads 4 --partition small --time 04:00:00");
@@ -141,8 +175,8 @@ void setup_slurm(CLI::App& app) {
   sub->add_option("--threads", o->threads, "engine threads per worker (= cpus-per-task)")
       ->check(CLI::Range(1, 1024))
       ->capture_default_str();
-  sub->add_option("--partition", o->partition, "Slurm partition");
-  sub->add_option("--time", o->time_limit, "time limit per task, HH:MM:SS");
+  sub->add_option("--partition", o->partition, "Slurm partition (or a comma-separated list)");
+  sub->add_option("--time", o->time_limit, "time limit per task: minutes, HH:MM:SS or D-HH:MM:SS (Slurm's syntax)");
   sub->add_option("--account", o->account, "Slurm account");
   sub->add_option("--lease", o->lease_s, "lease length, s, passed to the workers")
       ->check(CLI::Range(0.5, 86400.0))

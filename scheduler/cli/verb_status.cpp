@@ -79,6 +79,11 @@ std::string render_status(const queue::Status& s, const std::string& db, double 
                : "\nETA unknown: no job of some remaining kind has finished yet\n";
   }
   if (s.blocked > 0) out += fmt::format("{} job(s) dead because a bed they need is dead\n", s.blocked);
+  if (s.released_attempts > 0)
+    out += fmt::format(
+        "{} attempt(s) released (interrupted: SIGINT/SIGTERM, a Slurm time limit; not counted against the retry "
+        "budget), {} unfinished job(s) among them; {} job(s) stopped after too many releases\n",
+        s.released_attempts, s.released_jobs, s.stopped_by_releases);
   if (!s.recent_errors.empty()) {
     out += "\ndead jobs (latest):\n";
     for (const auto& [id, err] : s.recent_errors) out += fmt::format("  {}  {}\n", id, err.substr(0, 160));
@@ -118,6 +123,9 @@ nlohmann::json status_json(const queue::Status& s) {
                             {"lease_expires", r.lease_expires},
                             {"stale", r.stale}});
   j["stale_leases"] = s.stale_leases;
+  j["released_attempts"] = s.released_attempts;
+  j["released_jobs"] = s.released_jobs;
+  j["stopped_by_releases"] = s.stopped_by_releases;
   j["active_workers"] = s.active_workers;
   j["eta_s"] = s.eta_s >= 0 ? json(s.eta_s) : json(nullptr);
   j["runtimes"] = json::array();

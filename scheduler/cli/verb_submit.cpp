@@ -88,6 +88,7 @@ void run_submit(const SubmitOptions& o) {
     return;
   }
   db::Database db = queue::open_campaign(o.db, queue::OpenMode::create, o.files);
+  queue::bind_files_root(db, queue::CampaignPaths(o.db, o.files));  // the marker naming this campaign
   for (const auto& p : planned) {
     const auto r = queue::submit(db, p.spec, p.jobs);
     fmt::print("sweep {} ({}): {} jobs planned ({} bed, {} {}): {} new, {} already present\n", r.sweep,

@@ -39,6 +39,9 @@ struct WorkOptions {
   double heartbeat_s = 0;
   double poll_s = 0.5;
   double backoff_s = 2.0;
+  int max_releases = queue::kDefaultMaxReleases;
+  double db_outage_s = 300;
+  double min_free_mb = 64;
   long max_jobs = -1;
   bool quiet = false;
   std::string bed_cache;  ///< --bed-cache: prepared beds shared between campaigns (pipeline/bed_cache.h)
@@ -68,7 +71,13 @@ int supervise(const WorkOptions& o, int threads) {
                                    "--poll",
                                    fmt::format("{}", o.poll_s),
                                    "--backoff",
-                                   fmt::format("{}", o.backoff_s)};
+                                   fmt::format("{}", o.backoff_s),
+                                   "--max-releases",
+                                   std::to_string(o.max_releases),
+                                   "--db-outage",
+                                   fmt::format("{}", o.db_outage_s),
+                                   "--min-free-mb",
+                                   fmt::format("{}", o.min_free_mb)};
   if (!o.files.empty()) args.insert(args.end(), {"--files", o.files});
   if (o.heartbeat_s > 0) args.insert(args.end(), {"--heartbeat", fmt::format("{}", o.heartbeat_s)});
   if (o.follow) args.push_back("--follow");
@@ -145,7 +154,11 @@ int supervise(const WorkOptions& o, int threads) {
 
 int run_work(const WorkOptions& o) {
   // Refuses what is not a campaign before any worker starts (migrates a version-1 campaign).
-  { db::Database db = queue::open_campaign(o.db, queue::OpenMode::write, o.files); }
+  // Refuses a files root of another campaign before any worker deletes a file in it.
+  {
+    db::Database db = queue::open_campaign(o.db, queue::OpenMode::write, o.files);
+    queue::bind_files_root(db, queue::CampaignPaths(o.db, o.files));
+  }
   if (o.heartbeat_s > 0 && o.heartbeat_s * 2 > o.lease_s)
     throw UsageError(
         fmt::format("--heartbeat: found {} s, expected at most half of --lease ({} s), or the lease "
@@ -166,6 +179,9 @@ int run_work(const WorkOptions& o) {
   w.poll_s = o.poll_s;
   w.max_jobs = o.max_jobs;
   w.backoff_base_s = o.backoff_s;
+  w.max_releases = o.max_releases;
+  w.db_outage_s = o.db_outage_s;
+  w.min_free_bytes = static_cast<std::int64_t>(o.min_free_mb * 1024 * 1024);
   w.code_version = pipeline::build_version();
   w.verbose = !o.quiet;
   w.bed_cache = o.bed_cache;
@@ -176,6 +192,7 @@ int run_work(const WorkOptions& o) {
                "reclaimed\n",
                getpid(), rep.done, rep.failed, rep.dead, rep.released, rep.fenced_out, rep.reclaimed);
   if (rep.interrupted) return kExitInterrupted;
+  if (!rep.disk_full.empty()) return kExitFailure;  // the reason was printed when the worker stopped
   return final_code(o.db);
 }
 
@@ -191,6 +208,9 @@ void setup_work(CLI::App& app) {
       "stop when no job is left (--follow: keep waiting for new ones). A worker killed in any way\n"
       "loses its lease after --lease seconds and another worker takes the job over. SIGINT/SIGTERM\n"
       "stop the current job and give its lease back (exit 130). Exit 4 if some job is dead.\n"
+      "A files root with less free space than --min-free-mb plus the largest output so far is full:\n"
+      "the worker claims nothing and stops (exit 1), and an attempt that failed on a full disk goes\n"
+      "back to the queue without being counted against the job.\n"
       "A bed job that runs alone (nothing else running or claimable: its drops wait for it) gets the\n"
       "threads of all the workers (--workers x --threads), so no core idles while it runs.\n\n"
       "Examples:\n"
@@ -217,6 +237,22 @@ void setup_work(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--poll", opt->poll_s, "wait between claims when nothing is runnable, s")
       ->check(CLI::Range(0.01, 60.0))
+      ->capture_default_str();
+  sub->add_option("--min-free-mb", opt->min_free_mb,
+                  "free space, MB, the files root must keep beyond the largest output so far: below it the "
+                  "worker claims nothing and stops (exit 1; --follow: waits), and an attempt that failed on a "
+                  "full disk goes back without being counted")
+      ->check(CLI::Range(0.0, 1e9))
+      ->capture_default_str();
+  sub->add_option("--db-outage", opt->db_outage_s,
+                  "seconds a worker keeps reconnecting, with backoff, to a PostgreSQL server that restarted or "
+                  "went away before it gives up; its running job goes on meanwhile")
+      ->check(CLI::Range(0.0, 86400.0))
+      ->capture_default_str();
+  sub->add_option("--max-releases", opt->max_releases,
+                  "a job whose attempts were interrupted (SIGINT/SIGTERM, a Slurm time limit) this many times "
+                  "is stopped (dead, with the reason) instead of looping; `resume --dead` runs it again")
+      ->check(CLI::Range(1, 1000000))
       ->capture_default_str();
   sub->add_option("--backoff", opt->backoff_s, "retry backoff base, s (base * 2^(attempt-1), capped at 300 s)")
       ->check(CLI::Range(0.0, 3600.0))

@@ -53,28 +53,56 @@ bool move_file(const fs::path& from, const fs::path& to) {
   return !ec;
 }
 
-/// Removes (or, when referenced again, puts back) what earlier resumes quarantined.
+/// True for the name of a batch `quarantine_orphans` makes: "<milliseconds>-<pid>".
+bool is_batch_name(const std::string& name) {
+  const auto dash = name.find('-');
+  if (dash == std::string::npos || dash == 0 || dash + 1 == name.size()) return false;
+  for (std::size_t i = 0; i < name.size(); ++i)
+    if (i != dash && (name[i] < '0' || name[i] > '9')) return false;
+  return true;
+}
+
+/// A real folder (not a symbolic link to one, not a file).
+bool real_directory(const fs::path& p) {
+  std::error_code ec;
+  return fs::symlink_status(p, ec).type() == fs::file_type::directory;
+}
+
+/// Regular files under `p` (the entry itself when it is one), never through a symbolic link.
+std::size_t own_files(const fs::path& p) {
+  std::error_code ec;
+  const auto type = fs::symlink_status(p, ec).type();
+  if (type == fs::file_type::regular) return 1;
+  return type == fs::file_type::directory ? count_files(p) : 0;
+}
+
+/// Removes (or, when referenced again, puts back) what earlier resumes quarantined: only the
+/// entries of the output folders of gravsweep's own batches (`<ms>-<pid>/{beds,traces,noop,tmp}/`),
+/// each a real folder; a symbolic link is removed as a link, never followed. Anything else a user
+/// put under `quarantine/` stays, and so does a batch folder that still holds it.
 void purge_quarantine(Database& db, const CampaignPaths& paths, OrphanReport& rep) {
   const fs::path qroot = paths.root / "quarantine";
   std::error_code ec;
-  if (!fs::is_directory(qroot, ec)) return;
+  if (!real_directory(qroot)) return;  // check_quarantine_folder refused a link before
   const Referenced ref = referenced_files(db);
   for (const auto& batch : fs::directory_iterator(qroot, ec)) {
+    if (!is_batch_name(batch.path().filename().string()) || !real_directory(batch.path())) continue;
     for (const char* dir : kOutputFolders) {
       const fs::path d = batch.path() / dir;
-      if (!fs::is_directory(d, ec)) continue;
+      if (!real_directory(d)) continue;
       for (const auto& e : fs::directory_iterator(d, ec)) {
         const std::string rel = (fs::path(dir) / e.path().filename()).string();
         const fs::path home = paths.root / rel;
-        if (ref.refers_to(rel) && !fs::exists(home, ec) && move_file(e.path(), home)) {
+        if (ref.refers_to(rel) && !fs::exists(fs::symlink_status(home, ec)) && move_file(e.path(), home)) {
           rep.restored.push_back(rel);
           continue;
         }
-        rep.purged += count_files(e.path()) + (fs::is_regular_file(e.path(), ec) ? 1 : 0);
-        fs::remove_all(e.path(), ec);
+        rep.purged += own_files(e.path());
+        fs::remove_all(e.path(), ec);  // removes a symbolic link itself, never its target
       }
+      fs::remove(d, ec);  // only when empty
     }
-    fs::remove_all(batch.path(), ec);
+    fs::remove(batch.path(), ec);  // only when empty: a user's file in it stays
   }
 }
 
@@ -245,8 +273,21 @@ void check_files_belong(Database& db, const CampaignPaths& paths) {
         db.path(), paths.root.string(), missing, total, first));
 }
 
+void check_quarantine_folder(const CampaignPaths& paths) {
+  const fs::path qroot = paths.root / "quarantine";
+  std::error_code ec;
+  const auto st = fs::symlink_status(qroot, ec);
+  if (!fs::exists(st) || st.type() == fs::file_type::directory) return;
+  throw ConfigError(fmt::format(
+      "'{}' is {}, expected the campaign's own quarantine folder: resume moves orphans into it and deletes what "
+      "it put there, and never does either through a link; nothing was moved or removed (remove the link, or "
+      "pass --keep-orphans)",
+      qroot.string(), st.type() == fs::file_type::symlink ? "a symbolic link" : "not a folder"));
+}
+
 OrphanReport quarantine_orphans(Database& db, const CampaignPaths& paths, bool dry_run, double min_age_s) {
   OrphanReport rep;
+  check_quarantine_folder(paths);
   if (!dry_run) purge_quarantine(db, paths, rep);
   struct Candidate {
     fs::path path;

@@ -47,6 +47,27 @@ void migrate_paths(db::Database& db);
 /// the earlier message form once), in one transaction. Schema version 2 either way.
 void add_missing_columns(db::Database& db);
 
+// ---- the files root's marker ---------------------------------------------------------------------
+
+/// The file in a files root naming the campaign it belongs to: {"campaign_id", "database"}.
+inline constexpr const char* kFilesMarker = "gravsweep-campaign.json";
+
+/// The campaign's identity (`queue_meta` key `campaign_id`, random), created on first use. A copy
+/// of the database (`.backup`, `campaign copy`) keeps it, so its copied folder still belongs.
+std::string campaign_id(db::Database& db);
+
+/// Sets the campaign's identity (`campaign copy`: the destination is the same campaign).
+void set_campaign_id(db::Database& db, const std::string& id);
+
+/// Proves that `paths.root` belongs to the campaign of `db` before anything in it is moved or
+/// deleted; ConfigError (exit 2, naming both) otherwise. Its marker must name this campaign. A
+/// root without a marker (a campaign of an earlier gravsweep) is accepted when it is the default
+/// root beside an SQLite database (`<stem>.files/`), or when it holds nothing foreign: no entry at
+/// its top but gravsweep's folders, no file in `beds/`, `traces/`, `noop/`, `tmp/` that the
+/// database does not refer to, no file in `quarantine/` or `snapshots/`. With `write`, an accepted
+/// root gets its marker (nothing is written otherwise: a dry run).
+void bind_files_root(db::Database& db, const CampaignPaths& paths, bool write = true);
+
 /// Regular files under `dir`, recursively (0 when it does not exist).
 std::size_t count_files(const std::filesystem::path& dir);
 
@@ -66,6 +87,10 @@ Referenced referenced_files(db::Database& db);
 /// folder beside it do not belong together, and removing "orphans" would destroy the wrong data.
 void check_files_belong(db::Database& db, const CampaignPaths& paths);
 
+/// Throws ConfigError when `<root>/quarantine` exists and is not a real folder (a symbolic link,
+/// a file): nothing is ever moved into or removed through a link.
+void check_quarantine_folder(const CampaignPaths& paths);
+
 struct OrphanReport {
   std::vector<std::string> moved;     ///< files_rel of files moved to quarantine (or found: dry run)
   std::vector<std::string> restored;  ///< moved, then found referenced, and put back
@@ -74,7 +99,8 @@ struct OrphanReport {
 
 /// Moves files no done job and no live attempt refers to, and older than the snapshot by
 /// `min_age_s`, to `<root>/quarantine/<stamp>/`; files quarantined by an earlier call are removed
-/// first (unless the database refers to them again: then they go back). Nothing moves in a dry run.
+/// first (unless the database refers to them again: then they go back), only from gravsweep's own
+/// `<stamp>/` batches and never through a symbolic link. Nothing moves in a dry run.
 OrphanReport quarantine_orphans(db::Database& db, const CampaignPaths& paths, bool dry_run, double min_age_s = 5.0);
 
 }  // namespace gravsweep::queue

@@ -42,6 +42,9 @@ class Dialect {
   /// Changes `column` (unquoted) of `table` from INTEGER to REAL, keeping its values.
   virtual void widen_to_real(db::Database& db, const std::string& table, const std::string& column) const = 0;
 
+  /// A condition true when the text form of `quoted_column` contains the bound text (`--where` `~`):
+  /// SQLite's instr, PostgreSQL's strpos.
+  [[nodiscard]] virtual std::string contains(const std::string& quoted_column) const = 0;
   /// The column that orders results rows as they were written (for listings without --sort).
   [[nodiscard]] virtual const char* insertion_order() const = 0;
   /// After rows were copied in with their keys (campaign copy): generated keys continue after them.

@@ -47,6 +47,9 @@ class PostgresDialect final : public Dialect {
   void widen_to_real(db::Database& db, const std::string& table, const std::string& column) const override {
     db.exec(fmt::format("ALTER TABLE {} ALTER COLUMN \"{}\" TYPE DOUBLE PRECISION", table, column));
   }
+  [[nodiscard]] std::string contains(const std::string& quoted_column) const override {
+    return fmt::format("strpos(CAST({} AS TEXT), ?) > 0", quoted_column);
+  }
   [[nodiscard]] const char* insertion_order() const override { return "finished_at, job_id"; }
   void after_copy(db::Database& db) const override {
     db.exec(

@@ -56,6 +56,9 @@ class SqliteDialect final : public Dialect {
                     "ALTER TABLE {0}_widened RENAME TO {0}",
                     table));
   }
+  [[nodiscard]] std::string contains(const std::string& quoted_column) const override {
+    return fmt::format("instr(CAST({} AS TEXT), ?) > 0", quoted_column);
+  }
   [[nodiscard]] const char* insertion_order() const override { return "rowid"; }
   void after_copy(db::Database&) const override {}  // rowid keys continue after the largest
 };

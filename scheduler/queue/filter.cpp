@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 
 #include "scheduler/queue/dialect.h"
@@ -50,7 +51,8 @@ struct Lexer {
     }
     fail("an operator (< <= > >= = != ~)");
   }
-  json value() {
+  /// The value, and in `text` the value as typed (without its quotes).
+  json value(std::string& text) {
     skip();
     if (i >= s.size()) fail("a value");
     if (s[i] == '\'' || s[i] == '"') {
@@ -59,16 +61,22 @@ struct Lexer {
       while (i < s.size() && s[i] != q) out.push_back(s[i++]);
       if (i >= s.size()) fail(fmt::format("a closing {}", q));
       ++i;
+      text = out;
       return out;
     }
     const std::size_t b = i;
     while (i < s.size() && !std::isspace(static_cast<unsigned char>(s[i])) && s[i] != ',' && s[i] != '&') ++i;
     const std::string word = s.substr(b, i - b);
+    text = word;
     if (word == "true") return true;
     if (word == "false") return false;
     char* end = nullptr;
     const double d = std::strtod(word.c_str(), &end);
     if (end && *end == '\0' && !word.empty()) {
+      if (!std::isfinite(d)) {
+        i = b;
+        fail("a finite number (nan and inf compare with nothing)");
+      }
       if (word.find_first_of(".eE") == std::string::npos && std::abs(d) < 9e15) return static_cast<std::int64_t>(d);
       return d;
     }
@@ -96,6 +104,13 @@ struct Lexer {
 
 std::string quote_ident(const std::string& n) { return "\"" + n + "\""; }
 
+/// Refuses a value that is not a number compared with a column that holds numbers.
+void check_number(const Condition& c, const std::string& where) {
+  if (c.op == "~" || c.value.is_number() || c.value.is_boolean()) return;
+  throw std::invalid_argument(
+      fmt::format("--where '{}': column '{}' holds numbers, found '{}', expected a number", where, c.column, c.text));
+}
+
 }  // namespace
 
 std::vector<Condition> parse_where(const std::string& expr) {
@@ -105,8 +120,8 @@ std::vector<Condition> parse_where(const std::string& expr) {
     Condition c;
     c.column = lx.ident();
     c.op = lx.op();
-    c.value = lx.value();
-    if (c.op == "~" && !c.value.is_string()) c.value = c.value.dump();
+    c.value = lx.value(c.text);
+    if (c.op == "~") c.value = c.text;
     out.push_back(std::move(c));
   } while (lx.connector());
   return out;
@@ -146,13 +161,16 @@ bool row_matches(const json& row, const std::vector<std::string>& where) {
         throw std::invalid_argument(
             fmt::format("--where '{}': found column '{}', expected one of: {}", w, c.column, list));
       }
-      ok = ok && holds(row.at(c.column), c);
+      const json& v = row.at(c.column);
+      if (v.is_number() || v.is_boolean()) check_number(c, w);
+      ok = ok && holds(v, c);
     }
   return ok;
 }
 
 ResultsTable query_results(db::Database& db, const ResultsQuery& q) {
   const std::vector<std::string> all = result_columns(db);
+  const std::set<std::string> numeric = numeric_result_columns(db);
   auto check = [&](const std::string& col, const std::string& where) {
     if (std::find(all.begin(), all.end(), col) == all.end()) {
       std::string list;
@@ -176,11 +194,16 @@ ResultsTable query_results(db::Database& db, const ResultsQuery& q) {
     for (const auto& c : parse_where(w)) {
       check(c.column, fmt::format("--where '{}'", w));
       if (c.op == "~") {
-        clauses.push_back(fmt::format("instr({}, ?) > 0", quote_ident(c.column)));
-      } else {
+        clauses.push_back(dialect_of(db).contains(quote_ident(c.column)));
+        binds.push_back(c.text);
+      } else if (numeric.count(c.column)) {
+        check_number(c, w);
         clauses.push_back(fmt::format("{} {} ?", quote_ident(c.column), c.op));  // op from a fixed list
+        binds.push_back(c.value);
+      } else {
+        clauses.push_back(fmt::format("{} {} ?", quote_ident(c.column), c.op));
+        binds.push_back(c.text);  // a text column compares with the text as typed
       }
-      binds.push_back(c.value);
     }
   }
   for (std::size_t i = 0; i < clauses.size(); ++i) sql += (i ? " AND " : " WHERE ") + clauses[i];

@@ -19,17 +19,20 @@ namespace gravsweep::queue {
 
 struct Condition {
   std::string column, op;
-  nlohmann::json value;
+  nlohmann::json value;  ///< a finite number, a boolean, or text
+  std::string text;      ///< the value as typed (without quotes): what `~` looks for, and text columns compare to
 };
 
-/// Throws std::invalid_argument naming the position and what was expected.
+/// Throws std::invalid_argument naming the position and what was expected (also for nan and inf:
+/// no value compares with them the same way on both backends).
 std::vector<Condition> parse_where(const std::string& expr);
 
 /// The in-memory twin of query_results, for rows that are not in a database (the trials of a lab
 /// campaign, the planned jobs of `submit --where`): true when `row` ({column: value}) satisfies
 /// every condition of every expression. Numbers (and booleans) compare as numbers, everything else
-/// as text; `~` is a substring match. A column the row lacks throws std::invalid_argument naming
-/// the expression and the columns the row has.
+/// as text; `~` is a substring match. A column the row lacks, or a value that is not a number
+/// compared (< <= > >= = !=) with a column holding a number, throws std::invalid_argument naming
+/// the expression, the column and the value.
 bool row_matches(const nlohmann::json& row, const std::vector<std::string>& where);
 
 struct ResultsQuery {
@@ -45,7 +48,10 @@ struct ResultsTable {
   std::vector<std::vector<nlohmann::json>> rows;
 };
 
-/// Runs the query on the results table; bad columns/expressions throw std::invalid_argument.
+/// Runs the query on the results table; bad columns/expressions throw std::invalid_argument. Typed
+/// the same on both backends: a numeric column (numeric_result_columns) compares with numbers only
+/// (anything else throws, naming the column and the value), a text column with the value's text as
+/// typed, and `~` looks for the typed text in the column's text form.
 ResultsTable query_results(db::Database& db, const ResultsQuery& q);
 
 }  // namespace gravsweep::queue

@@ -132,19 +132,48 @@ bool bed_mismatch(Database& db, const Claim& c, const std::string& reason) {
   return true;
 }
 
-bool release(Database& db, const Claim& c, const std::string& why) {
+std::string release(Database& db, const Claim& c, const std::string& why, int max_releases) {
+  const double now = clock_s(db);
+  const std::string stopped = fmt::format(
+      "released {} times without finishing (every attempt interrupted: a Slurm time limit or a scancel shorter "
+      "than the job?); stopped so that it does not loop; `gravsweep resume --dead` runs it again",
+      max_releases);
+  Transaction tx(db);
+  std::string state;
+  {
+    // The attempt is not counted against the retry budget; the release is, against max_releases.
+    Statement st(db,
+                 "UPDATE jobs SET releases=releases+1, "
+                 "state=CASE WHEN releases+1>=?1 THEN 'dead' ELSE 'queued' END, "
+                 "last_error=CASE WHEN releases+1>=?1 THEN ?2 ELSE last_error END, "
+                 "finished_at=CASE WHEN releases+1>=?1 THEN ?3 ELSE finished_at END, "
+                 "attempts=CASE WHEN attempts>0 THEN attempts-1 ELSE 0 END, lease_owner=NULL, lease_expires=NULL, "
+                 "progress=NULL, phase=NULL, detail=NULL WHERE job_id=?4 AND lease_token=?5 AND state='running' "
+                 "RETURNING state");
+    st.bind(1, max_releases).bind(2, stopped).bind(3, now).bind(4, c.job_id).bind(5, c.token);
+    if (!st.step()) return "";
+    state = st.get_text(0);
+    st.run();
+  }
+  end_attempt(db, c, "released", now, kExitInterrupted, why);
+  if (state == "dead") detail::cascade_dead(db, c.job_id, now);
+  tx.commit();
+  return state;
+}
+
+bool give_back(Database& db, const Claim& c, const std::string& why) {
   const double now = clock_s(db);
   Transaction tx(db);
   {
     Statement st(db,
                  "UPDATE jobs SET state='queued', attempts=CASE WHEN attempts>0 THEN attempts-1 ELSE 0 END, "
-                 "lease_owner=NULL, lease_expires=NULL, "
-                 "progress=NULL, phase=NULL, detail=NULL WHERE job_id=? AND lease_token=? AND state='running'");
-    st.bind(1, c.job_id).bind(2, c.token);
+                 "last_error=?1, lease_owner=NULL, lease_expires=NULL, progress=NULL, phase=NULL, detail=NULL "
+                 "WHERE job_id=?2 AND lease_token=?3 AND state='running'");
+    st.bind(1, why).bind(2, c.job_id).bind(3, c.token);
     st.run();
     if (db.changes() != 1) return false;
   }
-  end_attempt(db, c, "released", now, kExitInterrupted, why);
+  end_attempt(db, c, "released", now, kExitFailure, why);
   tx.commit();
   return true;
 }

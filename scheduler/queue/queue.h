@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -129,8 +130,20 @@ std::string fail(db::Database& db, const Claim& c, const std::string& error, int
 /// queued to be rebuilt, its other unstarted drops waiting for it. false = fenced out.
 bool bed_mismatch(db::Database& db, const Claim& c, const std::string& reason);
 
-/// Gives the job back (interrupted worker): queued again, the attempt not counted. false = fenced out.
-bool release(db::Database& db, const Claim& c, const std::string& why);
+/// Releases a job may have before it is stopped (dead, with the reason): a job interrupted at
+/// every attempt (a time limit shorter than the job) would otherwise loop forever, uncounted.
+inline constexpr int kDefaultMaxReleases = 5;
+
+/// Gives the job back (interrupted worker): the attempt is not counted against the retry budget
+/// but the release is counted (jobs.releases); the job is queued again, or dead with the reason
+/// once it was released `max_releases` times. Returns the new state ("queued" or "dead"), ""
+/// when fenced out.
+std::string release(db::Database& db, const Claim& c, const std::string& why, int max_releases = kDefaultMaxReleases);
+
+/// Gives the job back after an environmental failure (the files root's disk full): queued again,
+/// the attempt closed as released with `why`, counted neither against the retry budget nor as a
+/// release (the job did nothing wrong). false = fenced out.
+bool give_back(db::Database& db, const Claim& c, const std::string& why);
 
 /// True while some job may still become runnable (queued, waiting, failed, running).
 bool work_remains(db::Database& db);
@@ -184,7 +197,10 @@ struct Status {
   std::vector<RunningJob> running;
   std::vector<KindRuntime> runtimes;
   std::int64_t stale_leases = 0;
-  std::int64_t blocked = 0;  ///< dead because a dependency is dead (jobs.blocked_by)
+  std::int64_t blocked = 0;              ///< dead because a dependency is dead (jobs.blocked_by)
+  std::int64_t released_attempts = 0;    ///< attempts given back (interrupted), not counted in attempts
+  std::int64_t released_jobs = 0;        ///< unfinished jobs with at least one released attempt
+  std::int64_t stopped_by_releases = 0;  ///< dead because they were released max_releases times
   std::int64_t active_workers = 0;
   double eta_s = -1;  ///< < 0: unknown (no finished job of some remaining kind)
   std::vector<std::pair<std::string, std::string>> recent_errors;  ///< (job_id, error) of dead jobs
@@ -195,6 +211,9 @@ Status status(db::Database& db, std::size_t max_running = 20);
 // ---- results ----------------------------------------------------------------------------------
 /// Column names of the results table, in display order (fixed, parameters, metrics).
 std::vector<std::string> result_columns(db::Database& db);
+/// The names of the results columns that hold numbers (fixed INTEGER/REAL ones, and the swept
+/// parameters and metrics stored as INTEGER or REAL).
+std::set<std::string> numeric_result_columns(db::Database& db);
 /// The columns a results table shows by default: job_id, every swept parameter, and the paper's
 /// metrics (vc_m_s, apeak_m_s2, zstop_m, tstop_s, rebound) where the campaign has them.
 std::vector<std::string> summary_result_columns(db::Database& db);

@@ -169,6 +169,13 @@ std::vector<std::string> result_columns(Database& db) {
   return cols;
 }
 
+std::set<std::string> numeric_result_columns(Database& db) {
+  std::set<std::string> out{"attempt", "trace_bytes", "runtime_s", "finished_at"};
+  Statement st(db, "SELECT name FROM results_columns WHERE sql_type IN ('INTEGER', 'REAL')");
+  while (st.step()) out.insert(st.get_text(0));
+  return out;
+}
+
 std::vector<std::string> summary_result_columns(Database& db) {
   static const std::vector<std::string> kPaperMetrics{"vc_m_s", "apeak_m_s2", "zstop_m", "tstop_s", "rebound"};
   std::vector<std::string> cols{"job_id"}, metrics;

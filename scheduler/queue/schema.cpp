@@ -36,6 +36,7 @@ CREATE TABLE IF NOT EXISTS jobs(
   not_before {real} NOT NULL DEFAULT 0,
   attempts {integer} NOT NULL DEFAULT 0,
   max_attempts {integer} NOT NULL,
+  releases {integer} NOT NULL DEFAULT 0,  -- attempts given back (interrupted), not counted in attempts
   lease_owner TEXT,
   lease_token {integer} NOT NULL DEFAULT 0,
   lease_expires {real},
@@ -149,12 +150,16 @@ void ensure_schema(Database& db) {
 
 void add_missing_columns(Database& db) {
   Transaction tx(db);
-  if (dialect_of(db).has_column(db, "jobs", "blocked_by")) return;
-  db.exec("ALTER TABLE jobs ADD COLUMN blocked_by TEXT");
-  // Campaigns written before the column marked a blocked job only in its message (once, here).
-  db.exec(
-      "UPDATE jobs SET blocked_by=substr(last_error, 12, length(last_error)-19) "
-      "WHERE state='dead' AND last_error LIKE 'dependency % is dead'");
+  const Dialect& d = dialect_of(db);
+  if (!d.has_column(db, "jobs", "blocked_by")) {
+    db.exec("ALTER TABLE jobs ADD COLUMN blocked_by TEXT");
+    // Campaigns written before the column marked a blocked job only in its message (once, here).
+    db.exec(
+        "UPDATE jobs SET blocked_by=substr(last_error, 12, length(last_error)-19) "
+        "WHERE state='dead' AND last_error LIKE 'dependency % is dead'");
+  }
+  if (!d.has_column(db, "jobs", "releases"))
+    db.exec(fmt::format("ALTER TABLE jobs ADD COLUMN releases {} NOT NULL DEFAULT 0", d.schema_types().integer));
   tx.commit();
 }
 

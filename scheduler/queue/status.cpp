@@ -187,6 +187,16 @@ Status status(Database& db, std::size_t max_running) {
   }
   {
     Statement st(db,
+                 "SELECT coalesce(sum(releases), 0), coalesce(sum(CASE WHEN releases>0 AND state!='done' THEN 1 "
+                 "ELSE 0 END), 0), coalesce(sum(CASE WHEN state='dead' AND last_error LIKE 'released % times "
+                 "without finishing%' THEN 1 ELSE 0 END), 0) FROM jobs");
+    st.step();
+    s.released_attempts = st.get_int(0);
+    s.released_jobs = st.get_int(1);
+    s.stopped_by_releases = st.get_int(2);
+  }
+  {
+    Statement st(db,
                  "SELECT job_id, coalesce(last_error,'') FROM jobs WHERE state='dead' AND "
                  "blocked_by IS NULL ORDER BY finished_at DESC LIMIT 5");
     while (st.step()) s.recent_errors.emplace_back(st.get_text(0), st.get_text(1));

@@ -1,6 +1,7 @@
 #include "scheduler/queue/worker.h"
 
 #include <fcntl.h>
+#include <sys/statvfs.h>
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -43,6 +44,94 @@ void sleep_interruptible(double seconds) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
 }
 
+/// The worker's connection, made again when a PostgreSQL server restarts or is away for a while: a
+/// call that fails because the connection is gone is run again on a new connection, reconnecting
+/// with backoff (0.2 s doubling to 5 s) for up to `outage_s`; then the error stands. Every call
+/// re-prepares its statements, so none outlives the connection it was made on.
+class Reconnecting {
+ public:
+  Reconnecting(db::Database& db, std::string location, double outage_s)
+      : db_(db), location_(std::move(location)), outage_s_(outage_s) {}
+  template <class Fn>
+  auto operator()(Fn&& fn) {
+    const auto give_up =
+        std::chrono::steady_clock::now() +
+        std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(outage_s_));
+    double wait_s = 0.2;
+    for (;;) {
+      try {
+        return fn();
+      } catch (const db::DbError& e) {
+        if (!e.connection_lost()) throw;
+        reconnect(e, give_up, wait_s);
+      }
+    }
+  }
+
+ private:
+  db::Database& db_;
+  std::string location_;
+  double outage_s_;
+
+  void reconnect(const db::DbError& lost, std::chrono::steady_clock::time_point give_up, double& wait_s) {
+    std::fprintf(stderr, "worker %d: database connection lost (%s); reconnecting for up to %.0f s\n",
+                 static_cast<int>(getpid()), lost.what(), outage_s_);
+    for (;;) {
+      if (std::chrono::steady_clock::now() >= give_up || pipeline::stop_requested().load()) throw lost;
+      sleep_interruptible(wait_s);
+      wait_s = std::min(2 * wait_s, 5.0);
+      try {
+        db_ = db::Database(location_);
+        std::fprintf(stderr, "worker %d: reconnected to the database\n", static_cast<int>(getpid()));
+        return;
+      } catch (const db::DbError& e) {
+        if (!e.connection_lost()) throw;
+      }
+    }
+  }
+};
+
+/// True when the job is done with the output of this attempt: a completion whose commit was
+/// acknowledged by nobody (the connection broke) but went through.
+bool completed_already(db::Database& db, const Claim& c) {
+  db::Statement st(db, "SELECT count(*) FROM jobs WHERE job_id=? AND state='done' AND output_path=?");
+  st.bind(1, c.job_id).bind(2, c.output_rel);
+  st.step();
+  return st.get_int(0) > 0;
+}
+
+/// Free bytes of the filesystem holding `dir` for an unprivileged writer; -1 when unknown.
+std::int64_t free_bytes(const fs::path& dir) {
+  struct statvfs st {};
+  if (::statvfs(dir.c_str(), &st) != 0) return -1;
+  return static_cast<std::int64_t>(st.f_bavail) * static_cast<std::int64_t>(st.f_frsize);
+}
+
+/// Empty while the files root has room for the next output (`min_free` plus the largest output
+/// seen); otherwise why not.
+std::string disk_full(const CampaignPaths& paths, std::int64_t min_free, std::int64_t largest_output) {
+  const std::int64_t free = free_bytes(paths.root), need = min_free + largest_output;
+  if (free < 0 || free >= need) return {};
+  return fmt::format(
+      "files root '{}': disk is full: {} bytes free, {} needed ({} kept free + {}, the largest output so far); "
+      "jobs stay queued, nothing counted against them: free space (or lower --min-free-mb) and run work again",
+      paths.root.string(), free, need, min_free, largest_output);
+}
+
+/// The largest output of a done job: what the next output is expected to need.
+std::int64_t largest_output(db::Database& db) {
+  db::Statement st(db, "SELECT coalesce(max(output_bytes), 0) FROM jobs WHERE state='done'");
+  st.step();
+  return st.get_int(0);
+}
+
+/// True when a failed attempt failed because of its environment, not of the job: the disk of the
+/// files root is full now, or the error says so.
+bool environmental(const std::string& error, const std::string& full) {
+  return !full.empty() || error.find(std::strerror(ENOSPC)) != std::string::npos ||
+         error.find("disk is full") != std::string::npos;
+}
+
 /// Shared between the job and its heartbeat thread.
 struct JobSignals {
   std::mutex m;
@@ -75,6 +164,10 @@ void heartbeat_loop(const WorkerOptions& o, const Claim& c, JobSignals& sig, dou
                        static_cast<int>(getpid()), c.job_id.c_str());
         }
       } catch (const std::exception& e) {
+        // A lost connection (server restarted) is made again at the next beat; the lease is fenced,
+        // so a beat after the lease expired is refused as lost.
+        const auto* dbe = dynamic_cast<const db::DbError*>(&e);
+        if (dbe && dbe->connection_lost()) db.reset();
         std::fprintf(stderr, "worker %d: heartbeat failed (will retry): %s\n", static_cast<int>(getpid()), e.what());
       }
       lock.lock();
@@ -116,8 +209,14 @@ void write_file_synced(const fs::path& path, const std::string& text) {
     }
     off += static_cast<std::size_t>(n);
   }
-  ::fsync(fd);
-  ::close(fd);
+  // A full disk may show only here (delayed allocation): the data is not safe until fsync says so.
+  if (::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
+    throw std::runtime_error(fmt::format("cannot write '{}' (fsync): {}", path.string(), std::strerror(err)));
+  }
+  if (::close(fd) != 0)
+    throw std::runtime_error(fmt::format("cannot write '{}' (close): {}", path.string(), std::strerror(errno)));
 }
 
 Runner noop_runner() {
@@ -139,8 +238,8 @@ Runner noop_runner() {
     if (ctx.claim.attempt <= fail_attempts)
       throw std::runtime_error(
           fmt::format("noop job asked to fail on attempt {} (fail_attempts={})", ctx.claim.attempt, fail_attempts));
-    std::ofstream(ctx.output_tmp) << json{{"job_id", ctx.claim.job_id}, {"attempt", ctx.claim.attempt}}.dump();
-    // (the worker fsyncs the output before renaming it)
+    // A write error (a full disk, no file descriptor left) fails the attempt with its errno.
+    write_file_synced(ctx.output_tmp, json{{"job_id", ctx.claim.job_id}, {"attempt", ctx.claim.attempt}}.dump());
     RunOutput out;
     out.metrics["noop_value"] = s.contains("value") ? s["value"] : json(0);
     out.metrics["sleep_s"] = sleep_s;
@@ -159,6 +258,16 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
   std::error_code ec;
   for (const char* d : kOutputFolders) fs::create_directories(paths.root / d, ec);
   std::unique_ptr<db::Database> beat_db;  // the heartbeat thread's own connection, kept across jobs
+  Reconnecting with_db(db, o.db_path.string(), o.db_outage_s);
+  std::int64_t largest = with_db([&] { return largest_output(db); });
+  // An attempt that failed for its environment goes back uncounted; the worker stops claiming.
+  const auto give_back_env = [&](const Claim& c, const std::string& error, std::string full) {
+    with_db([&] { return give_back(db, c, "environmental, not counted: " + error); });
+    ++rep.released;
+    rep.disk_full = full.empty() ? error : full;
+    std::fprintf(stderr, "worker %d: job %s given back, not counted: %s\n", who.pid, c.job_id.c_str(),
+                 rep.disk_full.c_str());
+  };
   long ran = 0;
   while (!pipeline::stop_requested().load() && (o.max_jobs < 0 || ran < o.max_jobs)) {
     if (supervisor_gone()) {
@@ -166,10 +275,23 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
       pipeline::stop_requested().store(true);
       break;
     }
+    if (const std::string full = disk_full(paths, o.min_free_bytes, largest); !full.empty() || !rep.disk_full.empty()) {
+      if (!o.follow) {
+        if (rep.disk_full.empty()) rep.disk_full = full;
+        std::fprintf(stderr, "worker %d: %s\n", who.pid, rep.disk_full.c_str());
+        break;
+      }
+      rep.disk_full.clear();  // --follow: wait for space
+      sleep_interruptible(std::max(o.poll_s, 1.0));
+      if (!full.empty()) continue;
+    }
     Reclaimed lost;
     std::optional<Claim> c;
     try {
-      c = claim(db, who, paths, o.lease_s, &lost);
+      c = with_db([&] {
+        lost = Reclaimed{};
+        return claim(db, who, paths, o.lease_s, &lost);
+      });
     } catch (const db::DbError& e) {
       if (!e.busy()) throw;
       sleep_interruptible(0.05 + 0.1 * (getpid() % 7) / 7.0);  // busy beyond the timeout: retry with jitter
@@ -183,7 +305,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
                      lost.dead);
     }
     if (!c) {
-      if (!o.follow && !work_remains(db)) break;
+      if (!o.follow && !with_db([&] { return work_remains(db); })) break;
       sleep_interruptible(o.poll_s);
       continue;
     }
@@ -221,7 +343,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
             "bed is rebuilt and the drop waits for it",
             bed.string(), c->dep_job_id, found, c->dep_sha256);
         std::fprintf(stderr, "worker %d: job %s: %s\n", who.pid, c->job_id.c_str(), why.c_str());
-        if (bed_mismatch(db, *c, why))
+        if (with_db([&] { return bed_mismatch(db, *c, why); }))
           ++rep.failed;
         else
           ++rep.fenced_out;
@@ -230,7 +352,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     }
     int threads = o.threads;
     try {
-      threads = threads_for_claim(db, *c, o.threads, o.pool_threads);
+      threads = with_db([&] { return threads_for_claim(db, *c, o.threads, o.pool_threads); });
       if (threads != o.threads && o.verbose)
         std::fprintf(stderr, "worker %d: bed job %s runs alone: %d threads\n", who.pid, c->job_id.c_str(), threads);
     } catch (const db::DbError& e) {
@@ -274,19 +396,27 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     }
     if (pipeline::stop_requested().load() && (!error.empty() || !fs::exists(tmp))) {
       remove_tmp_of(paths.tmp(), prefix);
-      release(db, *c, "interrupted by SIGINT/SIGTERM; lease released");
+      const std::string state =
+          with_db([&] { return release(db, *c, "interrupted by SIGINT/SIGTERM; lease released", o.max_releases); });
       ++rep.released;
       rep.interrupted = true;
-      if (o.verbose) std::fprintf(stderr, "worker %d: job %s released (interrupted)\n", who.pid, c->job_id.c_str());
+      if (o.verbose)
+        std::fprintf(stderr, "worker %d: job %s released (interrupted)%s\n", who.pid, c->job_id.c_str(),
+                     state == "dead" ? fmt::format("; stopped after {} releases", o.max_releases).c_str() : "");
       break;
     }
     if (error.empty() && !fs::exists(tmp)) {
       error = fmt::format("job {} finished but wrote no output at '{}'", c->job_id, tmp.string());
       exit_code = kExitFailure;
     }
+    if (!error.empty() && environmental(error, disk_full(paths, o.min_free_bytes, largest))) {
+      remove_tmp_of(paths.tmp(), prefix);
+      give_back_env(*c, error, disk_full(paths, o.min_free_bytes, largest));
+      continue;
+    }
     if (!error.empty()) {
       remove_tmp_of(paths.tmp(), prefix);
-      const std::string state = fail(db, *c, error, exit_code, permanent, o.backoff_base_s);
+      const std::string state = with_db([&] { return fail(db, *c, error, exit_code, permanent, o.backoff_base_s); });
       if (state == "dead")
         ++rep.dead;
       else if (state == "failed")
@@ -315,7 +445,11 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
       fs::remove(final_path, ec);
       const std::string why =
           fmt::format("job {}: cannot store its output at '{}': {}", c->job_id, final_path.string(), e.what());
-      const std::string state = fail(db, *c, why, 1, false, o.backoff_base_s);
+      if (environmental(why, disk_full(paths, o.min_free_bytes, largest))) {
+        give_back_env(*c, why, disk_full(paths, o.min_free_bytes, largest));
+        continue;
+      }
+      const std::string state = with_db([&] { return fail(db, *c, why, 1, false, o.backoff_base_s); });
       ++(state == "dead" ? rep.dead : state == "failed" ? rep.failed : rep.fenced_out);
       std::fprintf(stderr, "worker %d: %s\n", who.pid, why.c_str());
       continue;
@@ -324,8 +458,15 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     done.report = out.report;
     done.report["wall_s"] = secs;
     done.report["threads"] = threads;
-    if (complete(db, *c, done)) {
+    bool retried = false;  // after a lost connection the completion may have gone through
+    const bool completed = with_db([&] {
+      if (retried && completed_already(db, *c)) return true;
+      retried = true;
+      return complete(db, *c, done);
+    });
+    if (completed) {
       ++rep.done;
+      largest = std::max(largest, done.bytes);
       if (o.verbose) std::fprintf(stderr, "worker %d: job %s done in %.2f s\n", who.pid, c->job_id.c_str(), secs);
     } else {
       fs::remove(final_path, ec);

@@ -6,6 +6,7 @@
 // lease back (the attempt does not count against the retry budget).
 #pragma once
 #include <atomic>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -54,6 +55,13 @@ struct WorkerOptions {
   double poll_s = 0.5;     ///< idle wait between claims when nothing is runnable
   long max_jobs = -1;      ///< stop after this many jobs (-1: no limit)
   double backoff_base_s = 2.0;
+  int max_releases = kDefaultMaxReleases;  ///< a job interrupted this many times is stopped (dead)
+  /// How long a worker keeps reconnecting to a PostgreSQL server that restarted or went away,
+  /// with backoff, before it gives up (its running job goes on meanwhile; its lease is fenced).
+  double db_outage_s = 300;
+  /// Free space the files root must keep beyond the largest output seen (`work --min-free-mb`): below
+  /// it the worker claims nothing (the disk is full), and a failed attempt is not counted.
+  std::int64_t min_free_bytes = 64ll << 20;
   std::string code_version = "unknown";
   bool verbose = true;
   std::filesystem::path bed_cache;  ///< `work --bed-cache`: passed to the runners (RunContext)
@@ -62,11 +70,13 @@ struct WorkerOptions {
 struct WorkerReport {
   long done = 0, failed = 0, dead = 0, released = 0, fenced_out = 0, reclaimed = 0;
   bool interrupted = false;
+  std::string disk_full;  ///< why the worker stopped claiming: the files root's disk is full (empty: it is not)
 };
 
 WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners);
 
-/// Writes `text` to `path` and fsyncs it (helper for runners).
+/// Writes `text` to `path` and fsyncs it (helper for runners); throws std::runtime_error naming the
+/// file and the errno text (ENOSPC, EMFILE, EIO) when open, write, fsync or close fails.
 void write_file_synced(const std::filesystem::path& path, const std::string& text);
 /// fsync of a file or directory (best effort on directories).
 void fsync_path(const std::filesystem::path& path);

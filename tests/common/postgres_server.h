@@ -50,6 +50,17 @@ class PostgresServer {
   }
   [[nodiscard]] int port() const { return port_; }
 
+  /// Restarts the server (`pg_ctl restart -m fast|immediate`, the same port and options): every
+  /// open connection breaks. 0 on success.
+  int restart(const std::string& mode) { return run(pg_ctl() + " -D " + data() + " -m " + mode + " -w -t 60 restart"); }
+  /// Stops the server (until start_again); 0 on success.
+  int stop(const std::string& mode) { return run(pg_ctl() + " -D " + data() + " -m " + mode + " -w -t 60 stop"); }
+  /// Starts the stopped server again with its options; 0 on success.
+  int start_again() {
+    return run(pg_ctl() + " -D " + data() + " -o \"" + opts_ + "\" -l " + (dir_ / "server.log").string() +
+               " -w -t 60 start");
+  }
+
   ~PostgresServer() {
     if (started_) (void)run(pg_ctl() + " -D " + data() + " -m immediate -w stop");
     std::error_code ec;
@@ -63,6 +74,7 @@ class PostgresServer {
   std::filesystem::path bin_, dir_;
   int port_ = 0;
   bool started_ = false;
+  std::string opts_;  ///< the server's options (port, socket folder, ...), for start_again
 
   [[nodiscard]] std::string data() const { return (dir_ / "data").string(); }
   [[nodiscard]] std::string pg_ctl() const { return (bin_ / "pg_ctl").string(); }
@@ -99,10 +111,9 @@ class PostgresServer {
       return "initdb failed: " + log_tail();
     for (int tries = 0; tries < 5 && !started_; ++tries) {
       port_ = 20000 + static_cast<int>(rd() % 30000);
-      const std::string opts = "-k " + dir_.string() + " -p " + std::to_string(port_) +
-                               " -c listen_addresses=127.0.0.1 -c fsync=off -c max_connections=200";
-      started_ = run(pg_ctl() + " -D " + data() + " -o \"" + opts + "\" -l " + (dir_ / "server.log").string() +
-                     " -w -t 60 start") == 0;
+      opts_ = "-k " + dir_.string() + " -p " + std::to_string(port_) +
+              " -c listen_addresses=127.0.0.1 -c fsync=off -c max_connections=200";
+      started_ = start_again() == 0;
     }
     if (!started_) {
       std::ifstream f(dir_ / "server.log");

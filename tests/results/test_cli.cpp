@@ -214,3 +214,26 @@ TEST(Cli, SynthRestTailFixedRangeSensorAndTruth) {
       EXPECT_NEAR(sd, 0.02 * 0.1, 0.3 * 0.02 * 0.1) << "scaled with g";
   }
 }
+
+// A trial outside physical ranges in an imported file (written before import checked them, edited
+// here) is refused by the model verbs, naming the file, the trial and the field, instead of a fit
+// of NaN or 1e29 N parameters with exit 0.
+TEST(Cli, ModelFitRefusesATrialOutsidePhysicalRangesNamingIt) {
+  TempDir d;
+  const std::string c = d.str() + "/c", db = d.str() + "/x.db";
+  ASSERT_EQ(run("synth --out '" + c + "' --speeds 0.2,0.5,0.8,1.1 --repeats 2 --seed 4").code, 0);
+  ASSERT_EQ(run("measurements import '" + c + "' --db '" + db + "'").code, 0);
+  const auto good = run("model fit '" + db + "' --model base --no-plot", true);
+  ASSERT_EQ(good.code, 0) << good.out;
+  for (const char* mass : {"1e308", "1e30"}) {
+    const std::string sql = std::string("UPDATE trials SET projectile_mass_kg=") + mass + " WHERE trial_id='S003'";
+    ASSERT_EQ(std::system(("/usr/bin/python3 -c \"import sqlite3; c=sqlite3.connect('" + db + "'); c.execute(\\\"" +
+                           sql + "\\\"); c.commit()\"")
+                              .c_str()),
+              0);
+    const auto r = run("model fit '" + db + "' --model base --no-plot", true);
+    EXPECT_EQ(r.code, 2) << mass << ": " << r.out;
+    EXPECT_NE(r.out.find("trial 'S003': projectile_mass_kg"), std::string::npos) << mass << ": " << r.out;
+    EXPECT_NE(r.out.find("x.db"), std::string::npos) << mass << ": " << r.out;
+  }
+}

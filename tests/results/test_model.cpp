@@ -11,6 +11,7 @@
 #include <vector>
 #include <nlohmann/json.hpp>
 
+#include "engine/core/error.h"
 #include "spec/json_schema.h"
 #include "results/model/model.h"
 #include "results/model/synth.h"
@@ -94,6 +95,28 @@ TEST(Terms, ANewTermIsAFeatureFunctionAndFitsLikeTheOthers) {
   const auto h0 = summarize(c, cross_validate(parse_model("base"), c, 4, 1));
   const auto h1 = summarize(c, cross_validate(truth, c, 4, 1));
   EXPECT_LT(h1.zstop_rel_pct, h0.zstop_rel_pct);
+}
+
+// A fit whose result is not finite (a trial of mass 1e308 read without the import's range check)
+// throws, naming the parameters and the trial responsible, instead of returning NaN parameters.
+TEST(Fit, ANonFiniteFitFailsNamingTheTrial) {
+  TempDir d;
+  SynthOptions o = small_synth(5);
+  o.gravity_m_s2 = {9.81};
+  write_synthetic_campaign(d.str(), parse_model("base"), o);
+  Campaign c = load_campaign(d.str());
+  ASSERT_GE(c.trials.size(), 6u);
+  EXPECT_TRUE(fit_model(parse_model("base"), c).coef.allFinite());
+  c.trials[2].info.projectile_mass_kg = 1e308;
+  try {
+    (void)fit_model(parse_model("base"), c);
+    FAIL() << "a non-finite fit returned";
+  } catch (const gravsweep::NumericalFailure& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("not finite"), std::string::npos) << m;
+    EXPECT_NE(m.find(c.trials[2].info.trial_id), std::string::npos) << m;
+    EXPECT_NE(m.find("base.f0_N"), std::string::npos) << m;
+  }
 }
 
 TEST(Table3, PaperMethodGivesParametersWithUncertainties) {

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <fstream>
 #include <functional>
 #include <random>
@@ -194,5 +195,60 @@ TEST(BedInput, ACorruptBedFileExitsTwoNamingItInRunAndBench) {
     r = run_cli({"bench", "--bed", bad.string(), "--steps", "5", "--threads", "1"}, p.dir.path);
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_NE(r.err.find(bad.string()), std::string::npos) << r.err;
+  }
+}
+
+namespace {
+
+/// Multiplies element `index` of a float64 dataset of `file` by `factor` (through HDF5); a 0 becomes `factor`.
+void scale_element(const fs::path& file, const char* dataset, std::size_t index, double factor) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  const hid_t d = H5Dopen2(f, dataset, H5P_DEFAULT);
+  const hid_t space = H5Dget_space(d);
+  std::vector<double> values(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space)));
+  H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data());
+  values.at(index) = values.at(index) == 0 ? factor : values.at(index) * factor;
+  H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data());
+  H5Sclose(space);
+  H5Dclose(d);
+  H5Fclose(f);
+}
+
+}  // namespace
+
+// A bed corrupted with its checksum regenerated (flipped exponents in radius, mass or a position):
+// the physical ranges of its grains are checked when it is loaded, exit 2 naming the file and the
+// grain, instead of a numerical failure (exit 3) at step 0 that names neither.
+TEST(BedInput, ABedWithAGrainOutsidePhysicalRangesExitsTwoNamingTheFileAndGrain) {
+  const auto& p = prepared();
+  struct Corrupt {
+    const char* dataset;
+    std::size_t element;
+    double factor;
+    const char* what;
+  };
+  const double k2_64 = std::ldexp(1.0, 64);
+  for (const Corrupt& c :
+       {Corrupt{"/grains/radius_m", 5, k2_64, "radius_m"}, Corrupt{"/grains/radius_m", 6, 1 / k2_64, "radius_m"},
+        Corrupt{"/grains/mass_kg", 7, k2_64, "mass_kg"}, Corrupt{"/grains/mass_kg", 8, 1 / k2_64, "mass_kg"},
+        Corrupt{"/grains/position_m", 3 * 9 + 2, k2_64, "position_m"},
+        Corrupt{"/grains/velocity_m_s", 3 * 10, 1e300, "velocity_m_s"}}) {
+    SCOPED_TRACE(fmt::format("{}[{}] x {}", c.dataset, c.element, c.factor));
+    const fs::path dir = p.dir.path / fmt::format("range_{}_{}", fs::path(c.dataset).filename().string(), c.element);
+    const fs::path bed = copy_bed(dir, false);
+    scale_element(bed, c.dataset, c.element, c.factor);
+    write_text(bed.string() + ".sha256", sweep::sha256_file(bed) + "  bed.h5\n");  // the checksum regenerated
+    const std::string name(c.dataset);
+    const bool per_axis = name.find("position") != std::string::npos || name.find("velocity") != std::string::npos;
+    const std::size_t grain = per_axis ? c.element / 3 : c.element;
+    auto r = run_cli({"run", "tiny.json", "--out", dir.filename().string() + "_out", "--bed", bed.string(), "--quiet"},
+                     p.dir.path);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find(bed.string()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(fmt::format("grain {}:", grain)), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(c.what), std::string::npos) << r.err;
+    r = run_cli({"bench", "--bed", bed.string(), "--steps", "5", "--threads", "1"}, p.dir.path);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find(fmt::format("grain {}:", grain)), std::string::npos) << r.err;
   }
 }

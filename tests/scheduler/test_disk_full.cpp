@@ -7,6 +7,8 @@
 
 #include <cerrno>
 #include <cstring>
+#include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "db/database.h"
 #include "scheduler/queue/impact.h"
@@ -31,7 +33,9 @@ TEST(DiskFull, WorkerExitsOneCleanlyAndFinishedWorkStaysIntact) {
   const std::string example = std::string(GRAVSWEEP_SOURCE_DIR) + "/examples/sweep_tiny.json";
   ASSERT_EQ(run_cli({"submit", example, "--db", "c.db"}, mnt).code, 0);
   // stderr is captured outside the tmpfs: on the full disk the message itself could not be written.
-  const auto r = run_cli({"work", "--db", "c.db", "--threads", "1", "--quiet"}, mnt, d.path);
+  // --min-free-mb 0: the worker runs jobs until the disk fills under them (the free-space check
+  // would stop it before the first).
+  const auto r = run_cli({"work", "--db", "c.db", "--threads", "1", "--min-free-mb", "0", "--quiet"}, mnt, d.path);
   EXPECT_EQ(r.code, 1) << "exit " << r.code << ": " << r.err.substr(r.err.size() > 800 ? r.err.size() - 800 : 0);
   EXPECT_TRUE(r.err.find("disk is full") != std::string::npos || r.err.find("No space left") != std::string::npos)
       << r.err.substr(r.err.size() > 800 ? r.err.size() - 800 : 0);
@@ -45,4 +49,87 @@ TEST(DiskFull, WorkerExitsOneCleanlyAndFinishedWorkStaysIntact) {
     ++done;
   }
   std::printf("disk full after %d finished job(s): exit %d\n", done, r.code);
+}
+
+// A noop job whose output cannot be written (the files root's disk is full) fails its attempt with
+// the errno's text; it is never recorded done with an empty output.
+TEST(DiskFull, ANoopJobOnAFullFilesRootFailsWithTheErrno) {
+  TempDir d;
+  const fs::path mnt = d.path / "small";
+  fs::create_directories(mnt);
+  if (::mount("tmpfs", mnt.c_str(), "tmpfs", 0, "size=256k") != 0)
+    GTEST_SKIP() << "cannot mount a 256 kB tmpfs here (" << std::strerror(errno)
+                 << "): needs root and CAP_SYS_ADMIN; the disk-full case is not tested";
+  struct Unmount {
+    fs::path p;
+    ~Unmount() { ::umount2(p.c_str(), MNT_DETACH); }
+  } unmount{mnt};
+  nlohmann::json doc = {{"sweep", "full"},
+                        {"job", "noop"},
+                        {"max_attempts", 1},
+                        {"base", {{"g", 1.0}}},
+                        {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {1, 2, 3, 4, 5}}}}}};
+  write_text(d.path / "spec.json", doc.dump());
+  const std::string root = (mnt / "files").string();
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db", "--files", root}, d.path).code, 0);
+  for (const char* dir : {"noop", "tmp", "beds", "traces"}) fs::create_directories(fs::path(root) / dir);
+  {  // fill the disk
+    std::ofstream fill(mnt / "fill", std::ios::binary);
+    const std::string block(4096, 'x');
+    while (fill.write(block.data(), static_cast<std::streamsize>(block.size())) && fill.flush()) {
+    }
+  }
+  // --min-free-mb 0: the worker claims on the full disk (the free-space check would stop it first).
+  const auto r = run_cli({"work", "--db", "c.db", "--files", root, "--min-free-mb", "0", "--quiet"}, d.path);
+  EXPECT_NE(r.code, 0) << r.err;
+  db::Database db((d.path / "c.db").string());
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), 0) << "done with an empty output";
+  EXPECT_GE(sql_int(db, "SELECT count(*) FROM attempts WHERE error LIKE '%No space left on device%'"), 1)
+      << sql_text(db, "SELECT error FROM attempts LIMIT 1");
+}
+
+// A full files root burns no retry budget: the worker checks the free space before it claims (and
+// stops, exit 1, naming the root and the bytes free); an attempt that fails on the full disk goes
+// back to the queue uncounted; with space again every job finishes.
+TEST(DiskFull, AFullFilesRootStopsClaimingAndCountsNothingAgainstTheJobs) {
+  TempDir d;
+  const fs::path mnt = d.path / "small";
+  fs::create_directories(mnt);
+  if (::mount("tmpfs", mnt.c_str(), "tmpfs", 0, "size=256k") != 0)
+    GTEST_SKIP() << "cannot mount a 256 kB tmpfs here (" << std::strerror(errno)
+                 << "): needs root and CAP_SYS_ADMIN; the disk-full case is not tested";
+  struct Unmount {
+    fs::path p;
+    ~Unmount() { ::umount2(p.c_str(), MNT_DETACH); }
+  } unmount{mnt};
+  nlohmann::json doc = {{"sweep", "full"},
+                        {"job", "noop"},
+                        {"max_attempts", 1},
+                        {"base", {{"g", 1.0}}},
+                        {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {1, 2, 3, 4, 5}}}}}};
+  write_text(d.path / "spec.json", doc.dump());
+  const std::string root = (mnt / "files").string();
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db", "--files", root}, d.path).code, 0);
+  for (const char* dir : {"noop", "tmp", "beds", "traces"}) fs::create_directories(fs::path(root) / dir);
+  {  // fill the disk
+    std::ofstream fill(mnt / "fill", std::ios::binary);
+    const std::string block(4096, 'x');
+    while (fill.write(block.data(), static_cast<std::streamsize>(block.size())) && fill.flush()) {
+    }
+  }
+  db::Database db((d.path / "c.db").string());
+  auto r = run_cli({"work", "--db", "c.db", "--files", root, "--quiet"}, d.path);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("disk is full"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(root), std::string::npos) << r.err;
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts"), 0) << "nothing may start on a full disk";
+  r = run_cli({"work", "--db", "c.db", "--files", root, "--min-free-mb", "0", "--quiet"}, d.path);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='released' AND error LIKE '%No space left%'"), 1);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='queued' AND attempts=0 AND releases=0"), 5)
+      << "an environmental failure counts against no job";
+  fs::remove(mnt / "fill");
+  r = run_cli({"work", "--db", "c.db", "--files", root, "--min-free-mb", "0", "--quiet"}, d.path);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), 5);
 }

@@ -4,7 +4,9 @@
 
 #include <fmt/format.h>
 
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "campaign_store.h"
 #include "db/database.h"
@@ -161,13 +163,95 @@ TEST(PostgresCampaign, SlurmSubmitDryRunPrintsOneArrayOfPilotWorkers) {
   for (const std::string& line :
        {std::string("#SBATCH --array=1-3\n"), std::string("#SBATCH --cpus-per-task=2\n"),
         std::string("#SBATCH --partition=debug\n"), std::string("#SBATCH --time=00:10:00\n"),
-        "#SBATCH --output=" + (store.files / "slurm").string() + "/%A_%a.log\n",
+        "#SBATCH --output=\"" + (store.files / "slurm").string() + "/%A_%a.log\"\n",
         " work --db '" + store.location + "' --files '" + store.files.string() + "' --threads 2 --lease 60\n"})
     EXPECT_NE(r.out.find(line), std::string::npos) << line << " not in:\n" << r.out;
   EXPECT_FALSE(fs::exists(store.files / "slurm")) << "a dry run submits and writes nothing";
   // An SQLite campaign is refused: its file must not be shared between nodes.
-  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
-  r = run_cli({"slurm", "submit", "--db", "c.db", "--dry-run"}, d.path);
+  // (lite.db: c.files beside c.db is the server campaign's files root, marked as its own)
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "lite.db"}, d.path).code, 0);
+  r = run_cli({"slurm", "submit", "--db", "lite.db", "--dry-run"}, d.path);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("PostgreSQL"), std::string::npos) << r.err;
+}
+
+TEST(PostgresCampaign, SlurmSubmitRefusesOptionsOutsideSlurmSyntaxAndQuotesEveryPath) {
+  TempDir d;
+  const CampaignStore store(Store::postgres, d.path);
+  if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
+  const fs::path root = d.path / "my files";  // a space: must not cut the #SBATCH --output line
+  json doc = {{"sweep", "s"},
+              {"job", "noop"},
+              {"base", {{"i", 0}}},
+              {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"values", {1, 2}}}}}};
+  write_text(d.path / "spec.json", doc.dump());
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", store.location, "--files", root.string()}, d.path).code, 0);
+  const auto slurm = [&](const std::string& option, const std::string& value) {
+    return run_cli({"slurm", "submit", "--db", store.location, "--files", root.string(), option, value, "--dry-run"},
+                   d.path);
+  };
+  struct Bad {
+    const char *option, *value;
+  };
+  for (const Bad& b : {Bad{"--time", "00:10:00\n#SBATCH --wrap=id"}, Bad{"--time", "10 minutes"},
+                       Bad{"--time", "1:2:3:4"}, Bad{"--partition", "debug\nrm -rf ~"}, Bad{"--partition", "a b"},
+                       Bad{"--account", "proj;id"}, Bad{"--account", "a\n#SBATCH --uid=0"}}) {
+    const auto r = slurm(b.option, b.value);
+    EXPECT_EQ(r.code, 2) << b.option << " " << b.value << ":\n" << r.out << r.err;
+    EXPECT_NE(r.err.find(b.option), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find("#SBATCH"), std::string::npos) << r.out;
+  }
+  for (const char* t : {"30", "30:00", "04:00:00", "2-0", "2-12:00", "1-00:30:00", "UNLIMITED"})
+    EXPECT_EQ(slurm("--time", t).code, 0) << t;
+  EXPECT_EQ(slurm("--partition", "debug,long").code, 0);
+  const auto r = slurm("--account", "proj_1.a-b");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("#SBATCH --account=proj_1.a-b\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("#SBATCH --output=\"" + (root / "slurm").string() + "/%A_%a.log\"\n"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find(" --files '" + root.string() + "' "), std::string::npos) << r.out;
+}
+
+// The server restarted (fast, then immediate) and stopped for a few seconds while four workers
+// run: the workers reconnect with backoff and go on; every job is done exactly once and no worker
+// exits (before, "server closed the connection unexpectedly", exit 1, jobs left running).
+TEST(PostgresCampaign, WorkersRideOutServerRestartsAndAnOutage) {
+  TempDir d;
+  std::string why;
+  PostgresServer* server = PostgresServer::shared(why);
+  if (!server) GTEST_SKIP() << "PostgreSQL not available: " << why;
+  const std::string url = server->create_database();
+  const fs::path root = d.path / "files";
+  constexpr int kJobs = 80;  // 10 s of work on 4 workers: longer than the restarts and the outage
+  json doc = {{"sweep", "restart"},
+              {"job", "noop"},
+              {"base", {{"i", 0}, {"sleep_s", 0.5}}},
+              {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"range", {{"start", 1}, {"stop", kJobs}, {"step", 1}}}}}}};
+  write_text(d.path / "spec.json", doc.dump());
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", url, "--files", root.string()}, d.path).code, 0);
+  const fs::path log = d.path / "work.log";
+  const pid_t work = start_cli({"work", "--db", url, "--files", root.string(), "--workers", "4", "--threads", "1",
+                                "--lease", "30", "--poll", "0.05", "--db-outage", "60"},
+                               log);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  EXPECT_EQ(server->restart("fast"), 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  EXPECT_EQ(server->restart("immediate"), 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  EXPECT_EQ(server->stop("fast"), 0);
+  std::this_thread::sleep_for(std::chrono::seconds(4));
+  EXPECT_EQ(server->start_again(), 0);
+  const int code = wait_child(work, 240);
+  std::ifstream in(log);
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  EXPECT_EQ(code, 0) << text.substr(text.size() > 3000 ? text.size() - 3000 : 0);
+  EXPECT_EQ(text.find("exited with code"), std::string::npos) << "a worker exited";
+  EXPECT_NE(text.find("reconnected to the database"), std::string::npos) << "the outage was not noticed";
+  db::Database db(url);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), kJobs);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='done'"), kJobs) << "a job was done twice";
+  EXPECT_EQ(sql_int(db, "SELECT count(DISTINCT job_id) FROM results"), kJobs);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='running'"), 0);
+  db::Statement st(db, "SELECT output_path, output_sha256 FROM jobs");
+  while (st.step()) EXPECT_EQ(sweep::sha256_file(root / st.get_text(0)), st.get_text(1)) << st.get_text(0);
 }

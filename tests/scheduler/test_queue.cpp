@@ -245,14 +245,46 @@ TEST_P(QueueTest, ReleaseDoesNotSpendTheBudget) {
   submit_spec(noop_spec("s", {1}, 1));
   auto c = claim(db, me, paths, 60);
   ASSERT_TRUE(c);
-  EXPECT_TRUE(release(db, *c, "SIGTERM"));
+  EXPECT_EQ(release(db, *c, "SIGTERM"), "queued");
   EXPECT_EQ(sql_text(db, "SELECT state FROM jobs"), "queued");
   EXPECT_EQ(sql_int(db, "SELECT attempts FROM jobs"), 0);
   auto again = claim(db, me, paths, 60);
   ASSERT_TRUE(again);
   EXPECT_EQ(again->attempt, 1);
   EXPECT_GT(again->token, c->token);
-  EXPECT_FALSE(release(db, *c, "stale")) << "an old token cannot release the new lease";
+  EXPECT_EQ(release(db, *c, "stale"), "") << "an old token cannot release the new lease";
+}
+
+// A job interrupted at every attempt (a Slurm time limit shorter than the job) does not loop
+// forever uncounted: each release is counted apart from the retry budget, `status` shows them,
+// and the job stops (dead, with the reason) at the release limit; `resume --dead` revives it.
+TEST_P(QueueTest, ReleasesAreCountedAndAJobReleasedTooOftenStops) {
+  submit_spec(noop_spec("s", {1}, 3));
+  for (int i = 1; i <= 5; ++i) {
+    auto c = claim(db, me, paths, 60);
+    ASSERT_TRUE(c) << "release " << i << ": "
+                   << sql_text(db, "SELECT state || ' ' || coalesce(last_error,'') FROM jobs");
+    EXPECT_EQ(c->attempt, 1) << "a released attempt is not counted against the retry budget";
+    release(db, *c, "time limit");
+    EXPECT_EQ(sql_int(db, "SELECT releases FROM jobs"), i);
+    EXPECT_EQ(sql_int(db, "SELECT attempts FROM jobs"), 0);
+    EXPECT_EQ(sql_text(db, "SELECT state FROM jobs"), i < 5 ? "queued" : "dead");
+  }
+  EXPECT_FALSE(claim(db, me, paths, 60)) << "stopped after 5 releases";
+  EXPECT_NE(sql_text(db, "SELECT last_error FROM jobs").find("released 5 times without finishing"), std::string::npos)
+      << sql_text(db, "SELECT last_error FROM jobs");
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='released'"), 5);
+  const auto st = test::run_cli({"status", "--db", store.location}, dir.path);
+  ASSERT_EQ(st.code, 0) << st.err;
+  EXPECT_NE(st.out.find("5 attempt(s) released"), std::string::npos) << st.out;
+  EXPECT_NE(st.out.find("1 job(s) stopped after too many releases"), std::string::npos) << st.out;
+  ResumeOptions o;
+  o.retry_dead = true;
+  resume(db, paths, o);
+  EXPECT_EQ(sql_int(db, "SELECT releases FROM jobs"), 0);
+  auto again = claim(db, me, paths, 60);
+  ASSERT_TRUE(again);
+  EXPECT_TRUE(complete(db, *again, done_for(*again)));
 }
 
 TEST_P(QueueTest, ResumeRequeuesExpiredAndFailedAndRemovesOrphans) {
