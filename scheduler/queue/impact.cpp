@@ -30,8 +30,11 @@ void add_impact_runners(RunnerTable& table) {
   table[JobKind::drop] = [](const RunContext& ctx) {
     if (ctx.bed_path.empty())
       throw std::runtime_error(fmt::format("drop job {} has no prepared bed", ctx.claim.job_id));
-    auto r =
-        pipeline::run_drop_job(ctx.claim.scenario, ctx.bed_path, ctx.output_tmp, ctx.threads, ctx.progress, ctx.stop);
+    pipeline::DropCheckpointing ckpt;
+    ckpt.path = ctx.checkpoint;
+    ckpt.interval_s = ctx.checkpoint_interval_s;
+    auto r = pipeline::run_drop_job(ctx.claim.scenario, ctx.bed_path, ctx.output_tmp, ctx.threads, ctx.progress,
+                                    ctx.stop, ckpt);
     if (r.trace_path != ctx.output_tmp && !r.trace_path.empty()) std::filesystem::rename(r.trace_path, ctx.output_tmp);
     if (!r.snapshot_path.empty()) {
       // Grain snapshots (/output/snapshot_interval_s > 0): <campaign>.files/snapshots/, a folder that

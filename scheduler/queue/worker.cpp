@@ -250,7 +250,9 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
                        sig.detail = detail;
                      },
                      &sig.stop,
-                     o.bed_cache};
+                     o.bed_cache,
+                     paths.root / "checkpoints" / (c->job_id + ".ckpt.h5"),
+                     o.checkpoint_interval_s};
       out = runner->second(ctx);
     } catch (const ConfigError& e) {
       error = e.what();
@@ -274,7 +276,9 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     }
     if (pipeline::stop_requested().load() && (!error.empty() || !fs::exists(tmp))) {
       remove_tmp_of(paths.tmp(), prefix);
-      release(db, *c, "interrupted by SIGINT/SIGTERM; lease released");
+      release(db, *c,
+              error.empty() ? "interrupted by SIGINT/SIGTERM; lease released"
+                            : fmt::format("interrupted by SIGINT/SIGTERM ({}); lease released", error));
       ++rep.released;
       rep.interrupted = true;
       if (o.verbose) std::fprintf(stderr, "worker %d: job %s released (interrupted)\n", who.pid, c->job_id.c_str());
