@@ -47,7 +47,14 @@ void DropCheckpointer::warn(const std::string& message) const {
 
 void DropCheckpointer::load() {
   std::error_code ec;
-  if (!fs::exists(cfg_.path, ec)) return;  // a first attempt, or no checkpoint was due yet
+  if (!fs::exists(cfg_.path, ec)) {
+    if (cfg_.attempt > 1)
+      warn(
+          fmt::format("no checkpoint {} of an earlier attempt (none was due before it ended, or it was removed): "
+                      "the drop starts from its release",
+                      cfg_.path.string()));
+    return;
+  }
   std::string why;
   try {
     auto c = std::make_unique<results::CheckpointData>(results::read_checkpoint(cfg_.path));

@@ -33,6 +33,8 @@ struct DropCheckpointing {
   /// Wall seconds between two checkpoints; also written when a stop is requested. <= 0: none
   /// written (one left by an earlier attempt is still continued from).
   double interval_s = kDefaultCheckpointInterval_s;
+  /// The job's attempt: from the second on, a missing checkpoint is reported (warn) too.
+  int attempt = 1;
   /// Where warnings go (a checkpoint discarded or not written); empty: stderr.
   std::function<void(const std::string&)> warn;
 };

@@ -33,6 +33,7 @@ void add_impact_runners(RunnerTable& table) {
     pipeline::DropCheckpointing ckpt;
     ckpt.path = ctx.checkpoint;
     ckpt.interval_s = ctx.checkpoint_interval_s;
+    ckpt.attempt = ctx.claim.attempt;
     auto r = pipeline::run_drop_job(ctx.claim.scenario, ctx.bed_path, ctx.output_tmp, ctx.threads, ctx.progress,
                                     ctx.stop, ckpt);
     if (r.trace_path != ctx.output_tmp && !r.trace_path.empty()) std::filesystem::rename(r.trace_path, ctx.output_tmp);
