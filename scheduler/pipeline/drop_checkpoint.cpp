@@ -94,7 +94,8 @@ DropCheckpoints DropCheckpointer::hooks() {
   h.resume = resume();
   if (cfg_.path.empty() || !(cfg_.interval_s > 0)) return h;
   h.due = [this] {
-    if (stop_ != nullptr && stop_->load(std::memory_order_relaxed)) return true;
+    const std::atomic<bool>* save_on = cfg_.save_on_stop != nullptr ? cfg_.save_on_stop : stop_;
+    if (save_on != nullptr && save_on->load(std::memory_order_relaxed)) return true;
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - last_write_).count() >= cfg_.interval_s;
   };
   h.save = [this](const System& sys, const DropLoopState& loop) { save(sys, loop); };
@@ -121,7 +122,7 @@ void DropCheckpointer::save(const System& sys, const DropLoopState& loop) {
     warn(fmt::format("checkpoint {} not written (the drop goes on): {}", cfg_.path.string(), e.what()));
   }
   last_write_ = std::chrono::steady_clock::now();
-  if (stop_ != nullptr && stop_->load())
+  if ((stop_ != nullptr && stop_->load()) || (cfg_.save_on_stop != nullptr && cfg_.save_on_stop->load()))
     throw Interrupted(fmt::format("drop interrupted at t = {:.4f} s; {}", t_s,
                                   last_t_s_ == t_s ? "checkpoint " + cfg_.path.string() : "no checkpoint written"));
 }

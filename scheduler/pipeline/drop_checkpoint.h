@@ -33,6 +33,10 @@ struct DropCheckpointing {
   /// Wall seconds between two checkpoints; also written when a stop is requested. <= 0: none
   /// written (one left by an earlier attempt is still continued from).
   double interval_s = kDefaultCheckpointInterval_s;
+  /// The stop request that is worth a checkpoint; null: the job's stop flag. A worker passes the
+  /// process's (SIGTERM, stop.h): a job told to stop because another worker took its lease over
+  /// just stops, and leaves the checkpoint to the job's owner.
+  const std::atomic<bool>* save_on_stop = nullptr;
   /// The job's attempt: from the second on, a missing checkpoint is reported (warn) too.
   int attempt = 1;
   /// Where warnings go (a checkpoint discarded or not written); empty: stderr.

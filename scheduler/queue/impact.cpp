@@ -4,6 +4,7 @@
 
 #include "scheduler/pipeline/bed_cache.h"
 #include "scheduler/pipeline/impact_job.h"
+#include "scheduler/pipeline/stop.h"
 
 namespace gravsweep::queue {
 
@@ -34,6 +35,7 @@ void add_impact_runners(RunnerTable& table) {
     ckpt.path = ctx.checkpoint;
     ckpt.interval_s = ctx.checkpoint_interval_s;
     ckpt.attempt = ctx.claim.attempt;
+    ckpt.save_on_stop = &pipeline::stop_requested();  // SIGTERM, not a lease taken over
     auto r = pipeline::run_drop_job(ctx.claim.scenario, ctx.bed_path, ctx.output_tmp, ctx.threads, ctx.progress,
                                     ctx.stop, ckpt);
     if (r.trace_path != ctx.output_tmp && !r.trace_path.empty()) std::filesystem::rename(r.trace_path, ctx.output_tmp);
