@@ -68,6 +68,12 @@ struct Particles {
     f(force_N), f(torque_N_m), f(radius_m), f(mass_kg), f(inv_mass_1_kg), f(inv_inertia_1_kg_m2);
     f(material), f(size_class);
   }
+  template <class F>
+  void for_each_array(F&& f) const {
+    f(position_m), f(velocity_m_s), f(omega_rad_s), f(eval_velocity_m_s), f(eval_omega_rad_s);
+    f(force_N), f(torque_N_m), f(radius_m), f(mass_kg), f(inv_mass_1_kg), f(inv_inertia_1_kg_m2);
+    f(material), f(size_class);
+  }
 
   /// Removes the particles whose flag is true, keeping the order of the others.
   void remove_if(const std::vector<bool>& remove) {

@@ -7,6 +7,7 @@
 // polydisperse grains).
 #pragma once
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "engine/contact/contact.h"
@@ -72,6 +73,17 @@ class VerletList {
   /// gives every listed pair an empty record.
   void set_frame_history(bool keep);
   [[nodiscard]] bool keeps_frame_history() const { return keep_frame_; }
+
+  /// The positions of the last build whatever their count (checkpoints, System::save_state).
+  [[nodiscard]] const std::vector<Vec3>& build_positions() const { return position_at_build_; }
+  /// Puts back what a checkpoint saved beside the public arrays (System::restore_state): the
+  /// positions of the last build, its skin, the build count and whether frame histories are kept.
+  void restore_build(std::vector<Vec3> position_at_build, double skin_m, long long builds, bool keep_frame) {
+    position_at_build_ = std::move(position_at_build);
+    skin_m_ = skin_m;
+    builds_ = builds;
+    keep_frame_ = keep_frame;
+  }
 
   /// Forget everything (after particles were added: indices changed).
   void clear();

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "engine/core/error.h"
 
@@ -65,17 +66,17 @@ std::optional<FirstTouch> first_touch_bottom(const System& sys, double x_m, doub
   return best;
 }
 
-DropResult drop_projectile(System& sys, double surface_height_m, const ProjectileSpec& ps, const DropStop& stop,
-                           double sample_rate_hz, const DropProgress& progress, const DropSnapshots& snapshots) {
+namespace {
+
+/// Checks the projectile and puts it at its start (at rest at the drop height, or start_gap_m
+/// above the first grain it would meet with the speed that free fall turns into the impact
+/// speed); fills the release facts of `res` and returns the projectile's index.
+ParticleIndex release_projectile(System& sys, double surface_height_m, const ProjectileSpec& ps, DropResult& res) {
   if (ps.impact_speed_m_s.has_value() == ps.drop_height_m.has_value())
     throw ConfigError("projectile: give exactly one of impact_speed_m_s and drop_height_m");
   if (!(ps.diameter_m > 0) || !(ps.mass_kg > 0)) throw ConfigError("projectile: diameter_m and mass_kg must be > 0");
-  if (!(sample_rate_hz > 0)) throw ConfigError("drop: sample_rate_hz must be > 0");
-  const double dt = sys.config().dt_s;
   const double g = -sys.config().gravity_m_s2.z();  // > 0: downward gravity
   const double R = 0.5 * ps.diameter_m;
-
-  DropResult res;
   res.surface_height_m = surface_height_m;
   double v0 = 0;  // downward speed at release
   double bottom = 0;
@@ -108,85 +109,149 @@ DropResult drop_projectile(System& sys, double surface_height_m, const Projectil
   res.release_height_m = bottom;
   res.release_speed_m_s = v0;
   const Vec3 centre(ps.lateral_offset_x_m, ps.lateral_offset_y_m, bottom + R);
-
   // The domain must hold the projectile: extend its top above the release point.
   {
     SystemConfig& cfg = sys.mutable_config();
     if (cfg.domain) cfg.domain->hi_m.z() = std::max(cfg.domain->hi_m.z(), centre.z() + 2 * R);
   }
-  ParticleIndex ip = sys.particles.add(centre, R, ps.mass_kg, ps.material, SizeClass::projectile);
+  const ParticleIndex ip = sys.particles.add(centre, R, ps.mass_kg, ps.material, SizeClass::projectile);
   sys.particles.set_velocity(ip, Vec3(0, 0, -v0));
   sys.invalidate();
   sys.initialize();
   res.projectile = ip;
+  return ip;
+}
 
-  const long long steps_per_sample = std::max<long long>(1, std::llround(1.0 / (sample_rate_hz * dt)));
-  const double sample_dt = static_cast<double>(steps_per_sample) * dt;
-  const long long hold_samples = std::max<long long>(1, std::llround(stop.hold_time_s / sample_dt));
-  const long long max_samples = static_cast<long long>(std::ceil(stop.max_time_s / sample_dt));
-  const double t0 = sys.time_s();
-  const long long step0 = sys.step_count();
+/// One drop from its release (or a checkpoint) to the stop criterion or the time cap.
+class DropRun {
+ public:
+  DropRun(System& sys, const ProjectileSpec& ps, const DropStop& stop, double sample_rate_hz,
+          const DropProgress& progress, const DropSnapshots& snapshots, const DropCheckpoints& checkpoints)
+      : sys_(sys), ps_(ps), stop_(stop), progress_(progress), snapshots_(snapshots), checkpoints_(checkpoints) {
+    if (!(sample_rate_hz > 0)) throw ConfigError("drop: sample_rate_hz must be > 0");
+    const double dt = sys.config().dt_s;
+    steps_per_sample_ = std::max<long long>(1, std::llround(1.0 / (sample_rate_hz * dt)));
+    sample_dt_ = static_cast<double>(steps_per_sample_) * dt;
+    hold_samples_ = std::max<long long>(1, std::llround(stop.hold_time_s / sample_dt_));
+    max_samples_ = static_cast<long long>(std::ceil(stop.max_time_s / sample_dt_));
+    // Snapshots every snapshot_every_ samples (0: off), the last one at the end of the run.
+    const bool snap = snapshots.interval_s > 0 && snapshots.write;
+    snapshot_every_ = snap ? std::max<long long>(1, std::llround(snapshots.interval_s / sample_dt_)) : 0;
+  }
 
-  auto sample = [&](double accel_up) {
-    const auto& p = sys.particles;
+  /// The release: the projectile placed, sample 0 (the force at release: free fall unless
+  /// something already touches) and the first snapshot.
+  void release(double surface_height_m) {
+    release_projectile(sys_, surface_height_m, ps_, st_.result);
+    st_.release_time_s = sys_.time_s();
+    st_.release_step = sys_.step_count();
+    sys_.compute_forces();
+    sample(sys_.particles.force_N[st_.result.projectile].z() / ps_.mass_kg);
+    snapshot(0);
+  }
+
+  /// Continues a saved drop (DropCheckpoints::resume).
+  void resume(const DropState& saved) {
+    const Particles& p = saved.system.particles;
+    const ParticleIndex ip = saved.loop.result.projectile;
+    if (ip >= p.size() || ip >= p.size_class.size() || p.size_class[ip] != SizeClass::projectile ||
+        saved.loop.result.samples.empty() || saved.loop.samples_done + 1 != std::ssize(saved.loop.result.samples))
+      throw std::invalid_argument(fmt::format(
+          "drop state cannot be continued: particle {} of {} is not the projectile, or its {} samples are not "
+          "the {} taken",
+          ip, p.size(), saved.loop.result.samples.size(), saved.loop.samples_done + 1));
+    sys_.restore_state(saved.system);
+    st_ = saved.loop;
+  }
+
+  DropResult run();
+
+ private:
+  System& sys_;
+  const ProjectileSpec& ps_;
+  const DropStop& stop_;
+  const DropProgress& progress_;
+  const DropSnapshots& snapshots_;
+  const DropCheckpoints& checkpoints_;
+  long long steps_per_sample_ = 1, hold_samples_ = 1, max_samples_ = 0, snapshot_every_ = 0;
+  double sample_dt_ = 0;
+  DropLoopState st_;
+
+  DropSample sample(double accel_up) {
+    const auto& p = sys_.particles;
+    const ParticleIndex ip = st_.result.projectile;
     DropSample s;
-    s.t_s = sys.time_s() - t0;
+    s.t_s = sys_.time_s() - st_.release_time_s;
     s.position_m = p.position_m[ip];
-    s.depth_m = surface_height_m - (p.position_m[ip].z() - R);
+    s.depth_m = st_.result.surface_height_m - (p.position_m[ip].z() - 0.5 * ps_.diameter_m);
     s.velocity_down_m_s = -p.velocity_m_s[ip].z();
     s.accel_up_m_s2 = accel_up;
     s.omega_rad_s = p.omega_rad_s[ip];
-    s.contacts = sys.contact_count(ip);
-    s.grain_kinetic_energy_J = grain_kinetic_energy_J(sys);
-    res.samples.push_back(s);
+    s.contacts = sys_.contact_count(ip);
+    s.grain_kinetic_energy_J = grain_kinetic_energy_J(sys_);
+    st_.result.samples.push_back(s);
     return s;
-  };
-
-  // Snapshots every snapshot_every samples (0: off), the last one at the end of the run.
-  const bool snap = snapshots.interval_s > 0 && snapshots.write;
-  const long long snapshot_every = snap ? std::max<long long>(1, std::llround(snapshots.interval_s / sample_dt)) : 0;
-  long long last_snapshot = -1;
-  auto snapshot = [&](long long k) {
-    if (!snap || k == last_snapshot) return;
-    snapshots.write(sys, ip, sys.time_s() - t0);
-    last_snapshot = k;
-  };
-
-  // Sample 0: the force at release (free fall unless something already touches).
-  sys.compute_forces();
-  sample(sys.particles.force_N[ip].z() / ps.mass_kg);
-  snapshot(0);
-  long long k_done = 0;
-  res.samples.reserve(static_cast<std::size_t>(std::min<long long>(max_samples + 2, 1 << 22)));
-  long long below = 0;
-  for (long long k = 1; k <= max_samples; ++k) {
-    const double vz_before = sys.particles.velocity_m_s[ip].z();
-    sys.advance(steps_per_sample);
-    res.grains_spilled += remove_spilled_grains(sys, ip);
-    res.projectile = ip;
-    const double vz_after = sys.particles.velocity_m_s[ip].z();
-    const DropSample s = sample((vz_after - vz_before) / sample_dt);
-    k_done = k;
-    if (snap && k % snapshot_every == 0) snapshot(k);
-    if (s.contacts > 0 && !res.first_contact_s) res.first_contact_s = s.t_s;
-    if (res.first_contact_s) {
-      const double speed = sys.particles.velocity_m_s[ip].norm();
-      below = speed < stop.speed_m_s ? below + 1 : 0;
-      if (below >= hold_samples) {
-        res.stopped = true;
-        res.rest_s = s.t_s - static_cast<double>(hold_samples - 1) * sample_dt;
-        break;
-      }
-    }
-    if (progress && k % 50 == 0)
-      progress(static_cast<double>(k) / static_cast<double>(max_samples),
-               fmt::format("t={:.4f}s depth={:.2f}cm v={:.3f}m/s contacts={}", s.t_s, 100 * s.depth_m,
-                           s.velocity_down_m_s, s.contacts));
   }
-  snapshot(k_done);
-  res.steps = sys.step_count() - step0;
-  if (progress) progress(1.0, res.stopped ? "projectile at rest" : "time cap reached");
-  return res;
+
+  void snapshot(long long k) {
+    if (snapshot_every_ == 0 || k == st_.last_snapshot) return;
+    snapshots_.write(sys_, st_.result.projectile, sys_.time_s() - st_.release_time_s);
+    st_.last_snapshot = k;
+  }
+
+  /// Advances one sample interval and records it; true when the stop criterion ends the drop.
+  bool next_sample(long long k);
+};
+
+bool DropRun::next_sample(long long k) {
+  DropResult& res = st_.result;
+  const double vz_before = sys_.particles.velocity_m_s[res.projectile].z();
+  sys_.advance(steps_per_sample_);
+  res.grains_spilled += remove_spilled_grains(sys_, res.projectile);
+  const double vz_after = sys_.particles.velocity_m_s[res.projectile].z();
+  const DropSample s = sample((vz_after - vz_before) / sample_dt_);
+  st_.samples_done = k;
+  if (snapshot_every_ > 0 && k % snapshot_every_ == 0) snapshot(k);
+  if (s.contacts > 0 && !res.first_contact_s) res.first_contact_s = s.t_s;
+  if (res.first_contact_s) {
+    const double speed = sys_.particles.velocity_m_s[res.projectile].norm();
+    st_.below_stop = speed < stop_.speed_m_s ? st_.below_stop + 1 : 0;
+    if (st_.below_stop >= hold_samples_) {
+      res.stopped = true;
+      res.rest_s = s.t_s - static_cast<double>(hold_samples_ - 1) * sample_dt_;
+      return true;
+    }
+  }
+  // Between two samples the loop's state is whole: a checkpoint may be taken here.
+  if (checkpoints_.save && checkpoints_.due && checkpoints_.due()) checkpoints_.save(sys_, st_);
+  if (progress_ && k % 50 == 0)
+    progress_(static_cast<double>(k) / static_cast<double>(max_samples_),
+              fmt::format("t={:.4f}s depth={:.2f}cm v={:.3f}m/s contacts={}", s.t_s, 100 * s.depth_m,
+                          s.velocity_down_m_s, s.contacts));
+  return false;
+}
+
+DropResult DropRun::run() {
+  st_.result.samples.reserve(static_cast<std::size_t>(std::min<long long>(max_samples_ + 2, 1 << 22)));
+  for (long long k = st_.samples_done + 1; k <= max_samples_; ++k)
+    if (next_sample(k)) break;
+  snapshot(st_.samples_done);
+  st_.result.steps = sys_.step_count() - st_.release_step;
+  if (progress_) progress_(1.0, st_.result.stopped ? "projectile at rest" : "time cap reached");
+  return std::move(st_.result);
+}
+
+}  // namespace
+
+DropResult drop_projectile(System& sys, double surface_height_m, const ProjectileSpec& ps, const DropStop& stop,
+                           double sample_rate_hz, const DropProgress& progress, const DropSnapshots& snapshots,
+                           const DropCheckpoints& checkpoints) {
+  DropRun run(sys, ps, stop, sample_rate_hz, progress, snapshots, checkpoints);
+  if (checkpoints.resume != nullptr)
+    run.resume(*checkpoints.resume);
+  else
+    run.release(surface_height_m);
+  return run.run();
 }
 
 }  // namespace gravsweep

@@ -96,11 +96,43 @@ struct DropSnapshots {
   std::function<void(const System&, ParticleIndex projectile, double t_since_release_s)> write;
 };
 
+/// Everything the drop's loop keeps between two samples besides the System (whose dynamic state
+/// System::save_state gives): with both, drop_projectile continues a drop where it was, bit for bit.
+struct DropLoopState {
+  DropResult result;             ///< samples so far, release facts, first contact, spilled grains,
+                                 ///< the projectile's index
+  long long samples_done = 0;    ///< index k of the last sample taken (0: the release sample only)
+  long long below_stop = 0;      ///< consecutive samples after contact below the stop speed
+  long long last_snapshot = -1;  ///< sample index of the last grain snapshot (-1: none yet)
+  double release_time_s = 0;     ///< System time at release: t = 0 of the samples
+  long long release_step = 0;    ///< System step count at release
+};
+
+/// A drop saved between two samples: the System's state and the loop's.
+struct DropState {
+  SystemState system;
+  DropLoopState loop;
+};
+
+/// Checkpoints of a drop. After each sample that does not end the drop, `due()` is asked; when it
+/// answers true, `save(sys, loop)` is called between two samples (the caller stores
+/// sys.save_state() and `loop`); it may throw to end the run (after saving on a stop request).
+/// With `resume`, drop_projectile continues that drop instead of releasing the projectile: `sys`
+/// must hold the configuration and the walls of the saved drop (its particles are replaced; a
+/// state that does not fit is refused with std::invalid_argument before anything runs).
+struct DropCheckpoints {
+  std::function<bool()> due;
+  std::function<void(const System&, const DropLoopState&)> save;
+  const DropState* resume = nullptr;
+};
+
 /// Adds the projectile to the bed held by `sys` (grains + container walls), releases it and runs
 /// to the stop criterion or the time cap. `surface_height_m` is the bed's mean surface (engine z).
+/// Snapshots of a resumed drop are those from the resume on (the earlier ones were the earlier
+/// run's); its samples are all of them.
 DropResult drop_projectile(System& sys, double surface_height_m, const ProjectileSpec& projectile, const DropStop& stop,
                            double sample_rate_hz, const DropProgress& progress = {},
-                           const DropSnapshots& snapshots = {});
+                           const DropSnapshots& snapshots = {}, const DropCheckpoints& checkpoints = {});
 
 /// Kinetic energy (translational + rotational) of the free grains.
 double grain_kinetic_energy_J(const System& sys);

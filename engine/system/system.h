@@ -15,13 +15,9 @@
 #include "engine/integrate/integrators.h"
 #include "engine/neighbor/verlet_list.h"
 #include "engine/system/force_function.h"
+#include "engine/system/system_state.h"
 
 namespace gravsweep {
-
-/// Axis-aligned region; a particle centre outside it is a numerical failure ("left the container").
-struct Domain {
-  Vec3 lo_m, hi_m;
-};
 
 struct SystemConfig {
   std::string contact_law = "hertz";               ///< see contact_law_names() (contact/registry.h)
@@ -44,13 +40,6 @@ struct SystemConfig {
   std::optional<Domain> domain;
   bool track_energy = false;    ///< accumulate the normal spring energy
   bool check_time_step = true;  ///< reject dt above the law's stability bound
-};
-
-/// Per-step counters from the force evaluation.
-struct StepStats {
-  long long contacts = 0;       ///< touching particle-particle pairs
-  long long wall_contacts = 0;  ///< touching particle-wall pairs
-  double elastic_energy_J = 0;  ///< sum of normal spring energies (track_energy only)
 };
 
 class System {
@@ -77,6 +66,15 @@ class System {
 
   void step();
   void advance(long long steps);
+
+  /// The dynamic state between two steps (system_state.h): a checkpoint of the run.
+  [[nodiscard]] SystemState save_state() const;
+  /// Continues the run saved by save_state(): this System must have the configuration and the
+  /// walls of the saved one (its particles are replaced). The next steps are bit-identical to
+  /// those of the saved run for the same thread count. Throws std::invalid_argument naming the
+  /// first inconsistency (array sizes, wall count, frame histories the law does not keep); the
+  /// state is checked before anything is replaced, so a refused state changes nothing.
+  void restore_state(SystemState state);
 
   [[nodiscard]] double time_s() const { return time_s_; }
   [[nodiscard]] long long step_count() const { return step_; }
@@ -136,6 +134,7 @@ class System {
   /// parallel region, checked against `finish` (inside step()).
   void force_pass(bool displacement_checked, StepCheck* finish);
   void rebuild_neighbors();
+  void check_restorable(const SystemState& s) const;
   void raise_state_failure(long long particle, StateFault cause);
 };
 

@@ -182,6 +182,28 @@ void write_uint8(hid_t parent, const std::string& name, const std::vector<std::u
   write_dataset(parent, name, H5T_STD_U8LE, H5T_NATIVE_UINT8, data.data(), {data.size()}, units, description);
 }
 
+void write_raw(hid_t parent, const std::string& name, hid_t type, const void* data, const std::vector<hsize_t>& dims,
+               const std::string& units, const std::string& description) {
+  write_dataset(parent, name, type, type, data, dims, units, description, Storage::contiguous);
+}
+
+std::vector<hsize_t> dataset_dims(hid_t parent, const std::string& name) {
+  Handle ds = open_dataset(parent, name);
+  Handle space(H5Dget_space(ds), &H5Sclose);
+  const int rank = H5Sget_simple_extent_ndims(space);
+  if (rank < 0) fail(parent, fmt::format("cannot read the shape of '{}'", name));
+  std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
+  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+  return dims;
+}
+
+void read_raw(hid_t parent, const std::string& name, hid_t mem_type, void* data) {
+  Handle ds = open_dataset(parent, name);
+  Handle space(H5Dget_space(ds), &H5Sclose);
+  if (H5Sget_simple_extent_npoints(space) > 0 && H5Dread(ds, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
+    fail(parent, fmt::format("cannot read dataset '{}'", name));
+}
+
 std::vector<double> read_doubles(hid_t parent, const std::string& name, std::vector<hsize_t>* dims_out) {
   return read_dataset<double>(parent, name, H5T_NATIVE_DOUBLE, dims_out);
 }

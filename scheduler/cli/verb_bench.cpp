@@ -15,6 +15,7 @@
 #include "engine/scenario/tile.h"
 #include "results/io/bed_file.h"
 #include "scheduler/pipeline/impact_job.h"
+#include "scheduler/cli/bench_checkpoint.h"
 #include "scheduler/cli/progress.h"
 #include "scheduler/cli/verbs.h"
 
@@ -34,6 +35,8 @@ struct BenchOptions {
   double tile_relax_s = 0.01;                         ///< relaxation of a tiled bed before timing
   double diameter_m = 0.315;
   std::string bed_file;
+  std::string checkpoint_dir;              ///< --checkpoint-dir: measure a drop checkpoint there
+  std::size_t checkpoint_samples = 10000;  ///< trace samples in it (1 s at the paper's 10 kHz)
 };
 
 struct BenchRow {
@@ -65,6 +68,8 @@ BenchRow time_bed(const System& bed, const std::string& label, const BenchOption
   }
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double n = static_cast<double>(sys.particles.size());
+  if (!o.checkpoint_dir.empty() && threads == o.threads.front())
+    print_checkpoint_cost(sys, o.checkpoint_dir, o.checkpoint_samples);
   return BenchRow{label,
                   sys.particles.size(),
                   threads,
@@ -179,19 +184,20 @@ void run_bench(const BenchOptions& o) {
 
 void setup_bench(CLI::App& app) {
   auto opt = std::make_shared<BenchOptions>();
-  auto* sub =
-      app.add_subcommand("bench",
-                         "Time the engine on the paper's bed: prepares a settled bed (31.5 cm cylinder, grains\n"
-                         "1 +/- 0.05 cm, 10 cm fill, about 8,000 grains, Table 1 Chrono parameters), then times\n"
-                         "--steps steps at dt = 1 us with each thread count and prints ns per particle-step,\n"
-                         "contacts per particle and bytes per particle.\n\n"
-                         "Example:\n"
-                         "  gravsweep bench --threads 1,2              # the issue's figures\n"
-                         "  gravsweep bench --bed runs/1g/bed.h5       # time a bed prepared by `gravsweep run`\n"
-                         "  gravsweep bench --scaling --steps 300      # also about 64,000 and 512,000 grains\n\n"
-                         "--scaling copies the settled base bed's inscribed square side by side into a wide box\n"
-                         "(tiles), relaxes it briefly and times it too: cost per particle-step against N at the\n"
-                         "settled bed's contact density (settling 500,000 poured grains would take hours).");
+  auto* sub = app.add_subcommand(
+      "bench",
+      "Time the engine on the paper's bed: prepares a settled bed (31.5 cm cylinder, grains\n"
+      "1 +/- 0.05 cm, 10 cm fill, about 8,000 grains, Table 1 Chrono parameters), then times\n"
+      "--steps steps at dt = 1 us with each thread count and prints ns per particle-step,\n"
+      "contacts per particle and bytes per particle.\n\n"
+      "Example:\n"
+      "  gravsweep bench --threads 1,2              # the issue's figures\n"
+      "  gravsweep bench --bed runs/1g/bed.h5       # time a bed prepared by `gravsweep run`\n"
+      "  gravsweep bench --scaling --steps 300      # also about 64,000 and 512,000 grains\n"
+      "  gravsweep bench --bed BED --threads 1 --checkpoint-dir /shared/x  # a drop checkpoint's cost\n\n"
+      "--scaling copies the settled base bed's inscribed square side by side into a wide box\n"
+      "(tiles), relaxes it briefly and times it too: cost per particle-step against N at the\n"
+      "settled bed's contact density (settling 500,000 poured grains would take hours).");
   sub->add_option("--steps", opt->steps, "timed steps per thread count")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -213,6 +219,12 @@ void setup_bench(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--tile-relax", opt->tile_relax_s, "relaxation of a tiled bed before timing, s")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  sub->add_option("--checkpoint-dir", opt->checkpoint_dir,
+                  "also checkpoint the timed bed (as a running drop's, with --checkpoint-samples trace samples) "
+                  "into this folder and print its size and the seconds to write, read and restore it")
+      ->check(CLI::ExistingDirectory);
+  sub->add_option("--checkpoint-samples", opt->checkpoint_samples, "trace samples in the measured checkpoint")
       ->capture_default_str();
   sub->callback([opt]() { run_bench(*opt); });
 }

@@ -16,6 +16,7 @@
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
+#include "scheduler/pipeline/drop_checkpoint.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
 #include "scheduler/queue/spawn.h"
@@ -30,6 +31,7 @@ struct SlurmOptions {
   std::string db, files, partition, time_limit, account;
   int workers = 1, threads = 1;
   double lease_s = 60;
+  double checkpoint_interval_s = pipeline::kDefaultCheckpointInterval_s;
   bool dry_run = false;
 };
 
@@ -83,8 +85,9 @@ std::string sbatch_script(const SlurmOptions& o, const std::string& exe, const f
   if (!o.account.empty()) s += fmt::format("#SBATCH --account={}\n", o.account);
   s += "# One pilot worker per array task: it claims jobs until none is left. SIGTERM (scancel, or the\n"
        "# time limit) makes it give its lease back; SIGKILL loses only the current attempt.\n";
-  s += fmt::format("exec {} work --db {} --files {} --threads {} --lease {}\n", sh_quote(exe), sh_quote(o.db),
-                   sh_quote(fs::absolute(o.files).string()), o.threads, o.lease_s);
+  s += fmt::format("exec {} work --db {} --files {} --threads {} --lease {} --checkpoint-interval {}\n", sh_quote(exe),
+                   sh_quote(o.db), sh_quote(fs::absolute(o.files).string()), o.threads, o.lease_s,
+                   o.checkpoint_interval_s);
   return s;
 }
 
@@ -163,7 +166,8 @@ void setup_slurm(CLI::App& app) {
       "Submit --workers pilot workers as one sbatch job array: each task runs `gravsweep work` with\n"
       "--threads engine threads (cpus-per-task) until no job is left; logs in <files>/slurm/. Needs a\n"
       "PostgreSQL campaign and a files root every node mounts at the same path. --dry-run prints the\n"
-      "script. Workers stopped by the time limit or scancel lose nothing. --time, --partition and\n"
+      "script. Workers stopped by the time limit or scancel lose nothing: a running drop is\n"
+      "checkpointed at the SIGTERM and the next task continues it. --time, --partition and\n"
       "--account are checked against Slurm's syntax (exit 2 otherwise); every path is quoted.\n\n"
       "Example:\n"
       "  gravsweep slurm submit --db postgresql://me@dbhost:5432/sweep --files /shared/sweep \\\n"
@@ -180,6 +184,10 @@ void setup_slurm(CLI::App& app) {
   sub->add_option("--account", o->account, "Slurm account");
   sub->add_option("--lease", o->lease_s, "lease length, s, passed to the workers")
       ->check(CLI::Range(0.5, 86400.0))
+      ->capture_default_str();
+  sub->add_option("--checkpoint-interval", o->checkpoint_interval_s,
+                  "wall seconds between two checkpoints of a running drop, passed to the workers (0: none)")
+      ->check(CLI::Range(0.0, 1e7))
       ->capture_default_str();
   sub->add_flag("--dry-run", o->dry_run, "print the sbatch script, submit nothing");
   sub->callback([o]() { run_submit(*o); });

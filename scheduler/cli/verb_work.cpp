@@ -17,6 +17,7 @@
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
+#include "scheduler/pipeline/drop_checkpoint.h"
 #include "scheduler/pipeline/stop.h"
 #include "scheduler/queue/impact.h"
 #include "scheduler/queue/campaign.h"
@@ -45,6 +46,7 @@ struct WorkOptions {
   long max_jobs = -1;
   bool quiet = false;
   std::string bed_cache;  ///< --bed-cache: prepared beds shared between campaigns (pipeline/bed_cache.h)
+  double checkpoint_interval_s = pipeline::kDefaultCheckpointInterval_s;  ///< --checkpoint-interval
 };
 
 /// Exit code after the workers stopped: 4 when some job is dead.
@@ -82,6 +84,7 @@ int supervise(const WorkOptions& o, int threads) {
   if (o.heartbeat_s > 0) args.insert(args.end(), {"--heartbeat", fmt::format("{}", o.heartbeat_s)});
   if (o.follow) args.push_back("--follow");
   if (!o.bed_cache.empty()) args.insert(args.end(), {"--bed-cache", o.bed_cache});
+  args.insert(args.end(), {"--checkpoint-interval", fmt::format("{}", o.checkpoint_interval_s)});
   if (o.quiet) args.push_back("--quiet");
   if (o.max_jobs >= 0) args.insert(args.end(), {"--max-jobs", std::to_string(o.max_jobs)});
   // Block SIGINT/SIGTERM here while forking; the supervisor forwards them to the children.
@@ -185,6 +188,7 @@ int run_work(const WorkOptions& o) {
   w.code_version = pipeline::build_version();
   w.verbose = !o.quiet;
   w.bed_cache = o.bed_cache;
+  w.checkpoint_interval_s = o.checkpoint_interval_s;
   const auto rep = queue::run_worker(w, queue::all_runners());
   if (!o.quiet)
     fmt::print(stderr,
@@ -212,7 +216,10 @@ void setup_work(CLI::App& app) {
       "the worker claims nothing and stops (exit 1), and an attempt that failed on a full disk goes\n"
       "back to the queue without being counted against the job.\n"
       "A bed job that runs alone (nothing else running or claimable: its drops wait for it) gets the\n"
-      "threads of all the workers (--workers x --threads), so no core idles while it runs.\n\n"
+      "threads of all the workers (--workers x --threads), so no core idles while it runs.\n"
+      "A running drop is checkpointed every --checkpoint-interval seconds and at SIGTERM (scancel, a\n"
+      "Slurm time limit); the job's next attempt continues from there, so a drop longer than a task's\n"
+      "time limit still finishes.\n\n"
       "Examples:\n"
       "  gravsweep work --db campaign.db --workers 2 --threads 1\n"
       "  gravsweep work --db campaign.db --follow          # a worker that waits for new submissions\n"
@@ -263,6 +270,12 @@ void setup_work(CLI::App& app) {
                   "folder of prepared beds shared between campaigns and machines: a bed job whose bed is "
                   "there (<bed job id>.h5 + .sha256, checksum and bed key verified) copies it instead of "
                   "preparing it; a bed job that prepares its bed stores it there");
+  sub->add_option("--checkpoint-interval", opt->checkpoint_interval_s,
+                  "wall seconds between two checkpoints of a running drop (<files>/checkpoints/<job>.ckpt.h5; "
+                  "also written at SIGTERM); the next attempt of the job continues from it, bit for bit on "
+                  "the same thread count. 0: no checkpoints")
+      ->check(CLI::Range(0.0, 1e7))
+      ->capture_default_str();
   sub->add_flag("--quiet", opt->quiet, "no per-job log lines");
   sub->callback([opt]() {
     const int code = run_work(*opt);

@@ -92,6 +92,19 @@ void require_at_rest(const System& sys, const results::BedData& bed, const Scena
       r.rms_speed_m_s, c.rms_speed_fraction, c.rms_speed_fraction * v, slowest_impact_at_rest_m_s(r, c)));
 }
 
+/// Runs `drop` continuing ckpt's checkpoint; when the engine refuses that state, the checkpoint
+/// is discarded with a warning and the drop starts over (the refused state changed nothing).
+template <class Drop>
+DropResult resume_or_start(DropCheckpointer& ckpt, const Drop& drop) {
+  if (ckpt.resume() == nullptr) return drop();
+  try {
+    return drop();
+  } catch (const std::invalid_argument& e) {
+    ckpt.discard(e.what());
+    return drop();
+  }
+}
+
 }  // namespace
 
 json bed_key(const json& scenario) { return bed_key_of_validated(validate_scenario(scenario)); }
@@ -244,7 +257,7 @@ void load_bed(System& sys, const results::BedData& bed) {
 
 DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& bed_in,
                            const std::filesystem::path& trace_out, int threads, const Progress& progress,
-                           const std::atomic<bool>* stop) {
+                           const std::atomic<bool>* stop, const DropCheckpointing& checkpointing) {
   const json s = validate_scenario(scenario);
   ScenarioParams p = scenario_params(s);
   if (threads > 0) p.drop_config.threads = threads;
@@ -275,14 +288,19 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
       snaps->append(sn);
     };
   }
-  const DropResult dr = drop_projectile(
-      sys, bed.surface_height_m, p.projectile, p.stop, p.sample_rate_hz,
-      [&](double f, const std::string& d) {
-        check_stop(stop, "drop");
-        if (progress) progress("drop", f, d);
-      },
-      ds);
-  const double wall_s = seconds_since(t0);
+  DropCheckpointer ckpt(checkpointing, checkpointing.path.empty() ? json() : drop_identity(s, bed_in, sys.threads()),
+                        stop);
+  const auto drop = [&] {
+    return drop_projectile(
+        sys, bed.surface_height_m, p.projectile, p.stop, p.sample_rate_hz,
+        [&](double f, const std::string& d) {
+          check_stop(stop, "drop");
+          if (progress) progress("drop", f, ckpt.detail(d));
+        },
+        ds, ckpt.hooks());
+  };
+  const DropResult dr = resume_or_start(ckpt, drop);
+  const double wall_s = seconds_since(t0) + ckpt.prior_wall_time_s();
 
   results::TraceData td;
   for (const auto& smp : dr.samples) {
@@ -359,6 +377,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   m["lateral_offset_m"] = std::hypot(p.projectile.lateral_offset_x_m, p.projectile.lateral_offset_y_m);
   m["threads"] = sys.threads();
   m["wall_time_s"] = wall_s;
+  ckpt.add_metrics(m);
   td.metrics_json = m.dump();
   check_stop(stop, "drop");
   DropJobResult out{trace_out, m, {}, {}};
@@ -369,6 +388,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
     out.snapshot_xdmf = snaps->finish();
   }
   results::write_trace(trace_out, td);
+  ckpt.finished();
   return out;
 }
 

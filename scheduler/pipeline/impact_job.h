@@ -12,6 +12,7 @@
 
 #include "engine/system/system.h"
 #include "results/io/bed_file.h"
+#include "scheduler/pipeline/drop_checkpoint.h"
 #include "spec/json_schema.h"
 
 namespace gravsweep::pipeline {
@@ -50,9 +51,11 @@ BedJobResult run_bed_job(const nlohmann::json& scenario, const std::filesystem::
 /// rebound, plus wall time. A collision the metrics cannot resolve (e.g. no contact before the time
 /// cap) is not an error: the metrics carry "metrics_error" with the reason, and null values.
 /// With /output/snapshot_interval_s > 0 it also writes results::snapshot_path_for(trace_out) and its XDMF.
+/// With checkpointing.path set, it continues the drop saved there if that checkpoint is usable,
+/// saves the drop there as drop_checkpoint.h says, and removes it once the trace is written.
 DropJobResult run_drop_job(const nlohmann::json& scenario, const std::filesystem::path& bed_in,
                            const std::filesystem::path& trace_out, int threads, const Progress& progress,
-                           const std::atomic<bool>* stop);
+                           const std::atomic<bool>* stop, const DropCheckpointing& checkpointing = {});
 
 /// Canonical key of the bed a scenario needs (container, grains, fill, gravity, materials, contact
 /// law, preparation settings and seed): drops with equal keys share a bed. Validates the scenario.

@@ -4,6 +4,7 @@
 
 #include "scheduler/pipeline/bed_cache.h"
 #include "scheduler/pipeline/impact_job.h"
+#include "scheduler/pipeline/stop.h"
 
 namespace gravsweep::queue {
 
@@ -30,8 +31,13 @@ void add_impact_runners(RunnerTable& table) {
   table[JobKind::drop] = [](const RunContext& ctx) {
     if (ctx.bed_path.empty())
       throw std::runtime_error(fmt::format("drop job {} has no prepared bed", ctx.claim.job_id));
-    auto r =
-        pipeline::run_drop_job(ctx.claim.scenario, ctx.bed_path, ctx.output_tmp, ctx.threads, ctx.progress, ctx.stop);
+    pipeline::DropCheckpointing ckpt;
+    ckpt.path = ctx.checkpoint;
+    ckpt.interval_s = ctx.checkpoint_interval_s;
+    ckpt.attempt = ctx.claim.attempt;
+    ckpt.save_on_stop = &pipeline::stop_requested();  // SIGTERM, not a lease taken over
+    auto r = pipeline::run_drop_job(ctx.claim.scenario, ctx.bed_path, ctx.output_tmp, ctx.threads, ctx.progress,
+                                    ctx.stop, ckpt);
     if (r.trace_path != ctx.output_tmp && !r.trace_path.empty()) std::filesystem::rename(r.trace_path, ctx.output_tmp);
     if (!r.snapshot_path.empty()) {
       // Grain snapshots (/output/snapshot_interval_s > 0): <campaign>.files/snapshots/, a folder that

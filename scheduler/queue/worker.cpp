@@ -372,7 +372,9 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
                        sig.detail = detail;
                      },
                      &sig.stop,
-                     o.bed_cache};
+                     o.bed_cache,
+                     paths.root / "checkpoints" / (c->job_id + ".ckpt.h5"),
+                     o.checkpoint_interval_s};
       out = runner->second(ctx);
     } catch (const ConfigError& e) {
       error = e.what();
@@ -396,8 +398,12 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     }
     if (pipeline::stop_requested().load() && (!error.empty() || !fs::exists(tmp))) {
       remove_tmp_of(paths.tmp(), prefix);
-      const std::string state =
-          with_db([&] { return release(db, *c, "interrupted by SIGINT/SIGTERM; lease released", o.max_releases); });
+      const std::string state = with_db([&] {
+        return release(db, *c,
+                       error.empty() ? "interrupted by SIGINT/SIGTERM; lease released"
+                                     : fmt::format("interrupted by SIGINT/SIGTERM ({}); lease released", error),
+                       o.max_releases);
+      });
       ++rep.released;
       rep.interrupted = true;
       if (o.verbose)

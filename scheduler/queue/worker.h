@@ -26,6 +26,10 @@ struct RunContext {
   ProgressFn progress;
   const std::atomic<bool>* stop = nullptr;  ///< set when the job must end early
   std::filesystem::path bed_cache;          ///< bed jobs: shared prepared beds (empty: none)
+  /// Drop jobs: this job's checkpoint, <files>/checkpoints/<job>.ckpt.h5 (pipeline/drop_checkpoint.h),
+  /// written every checkpoint_interval_s of wall time (<= 0: never) and on a stop request.
+  std::filesystem::path checkpoint;
+  double checkpoint_interval_s = 0;
 };
 
 struct RunOutput {
@@ -64,7 +68,8 @@ struct WorkerOptions {
   std::int64_t min_free_bytes = 64ll << 20;
   std::string code_version = "unknown";
   bool verbose = true;
-  std::filesystem::path bed_cache;  ///< `work --bed-cache`: passed to the runners (RunContext)
+  std::filesystem::path bed_cache;     ///< `work --bed-cache`: passed to the runners (RunContext)
+  double checkpoint_interval_s = 300;  ///< `work --checkpoint-interval`: passed to the runners (RunContext)
 };
 
 struct WorkerReport {

@@ -209,3 +209,53 @@ TEST_F(ClusterFixture, ATaskKilledAtItsTimeLimitLosesNothing) {
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NO_FATAL_FAILURE(expect_complete_and_exact(db, 8, 8));
 }
+
+TEST_F(ClusterFixture, ADropLongerThanATaskTimeLimitCompletesAcrossTasksFromItsCheckpoints) {
+  // One drop needing about three times a task's 1-minute limit (90 s simulated at 1 m/s2, about
+  // 1.9 s of wall time each on one thread here; a stop speed no grain jitter falls below, so it
+  // runs to the cap; 200 Hz trace). Tasks are submitted one after the other: each is stopped at its
+  // time limit (SIGTERM), checkpoints the drop and gives its lease back; the next one continues.
+  json base = json::parse(tiny_base());
+  base["gravity_m_s2"] = 1.0;
+  base["stop"] = {{"max_time_s", 90.0}, {"speed_m_s", 1e-12}, {"hold_time_s", 10.0}};
+  base["output"] = {{"sample_rate_hz", 200.0}, {"filter_cutoff_hz", 50.0}};
+  json doc = {
+      {"sweep", "slurm_long"},
+      {"base", base},
+      {"axes", {{{"name", "impact_speed_m_s"}, {"pointer", "/projectile/impact_speed_m_s"}, {"values", {0.5}}}}}};
+  write_text(dir.path / "spec.json", doc.dump());
+  ASSERT_EQ(run_cli(with_store({"submit", "spec.json"}), dir.path).code, 0);
+  db::Database db(store.location);
+  constexpr int kMaxTasks = 8;
+  constexpr double kInterval_s = 20;
+  int tasks = 0;
+  while (tasks < kMaxTasks && sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'") < 2) {
+    const auto r = run_cli(with_store({"slurm", "submit", "--workers", "1", "--threads", "1", "--time", "00:01:00",
+                                       "--lease", "5", "--checkpoint-interval", fmt::format("{}", kInterval_s)}),
+                           dir.path);
+    ASSERT_EQ(r.code, 0) << r.err;
+    ++tasks;
+    ASSERT_TRUE(slurm->wait_idle(240)) << "the task outlived its time limit: " << slurm->client("squeue");
+  }
+  ASSERT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), 2) << "not done after " << tasks << " tasks";
+  const std::string drop = "(SELECT job_id FROM jobs WHERE kind='drop')";
+  const auto released = sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='released' AND job_id=" + drop);
+  EXPECT_GE(released, 2) << "the drop outlasted at least two tasks";
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='released' AND job_id=" + drop +
+                            " AND error LIKE '%checkpoint%'"),
+            released)
+      << "each released attempt says where its checkpoint is";
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome IN ('lost', 'running', 'failed')"), 0);
+  EXPECT_EQ(sql_int(db, "SELECT checkpoint_resumes FROM results WHERE kind='drop'"), released);
+  // At most one checkpoint interval of work lost per task: the attempts' time beyond the drop's
+  // own (counted up to each checkpoint it continued from).
+  db::Statement st(db, "SELECT (SELECT sum(runtime_s) FROM attempts WHERE job_id=" + drop +
+                           "), wall_time_s FROM results WHERE kind='drop'");
+  ASSERT_TRUE(st.step());
+  const double attempts_s = st.get_double(0), drop_s = st.get_double(1);
+  EXPECT_LT(attempts_s - drop_s, static_cast<double>(released + 1) * kInterval_s)
+      << attempts_s << " s of attempts for a drop of " << drop_s << " s";
+  EXPECT_TRUE(fs::is_empty(store.files / "checkpoints")) << "the checkpoint outlived the drop";
+  std::printf("long drop: %d tasks, %lld released attempts, %.1f s of attempts for %.1f s of drop\n", tasks,
+              static_cast<long long>(released), attempts_s, drop_s);
+}

@@ -1,0 +1,52 @@
+#include "scheduler/cli/bench_checkpoint.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <chrono>
+
+#include "results/io/checkpoint_file.h"
+
+namespace gravsweep::cli {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+void print_checkpoint_cost(const System& sys, const std::filesystem::path& dir, std::size_t samples) {
+  const std::filesystem::path file = dir / fmt::format("bench-{}.ckpt.h5", static_cast<long>(::getpid()));
+  auto t0 = std::chrono::steady_clock::now();
+  results::CheckpointData c;
+  c.drop.system = sys.save_state();
+  c.drop.loop.result.samples.resize(samples);  // the trace so far: a drop of samples / rate seconds
+  c.drop.loop.samples_done = static_cast<long long>(samples) - 1;
+  const double save_s = seconds_since(t0);
+  t0 = std::chrono::steady_clock::now();
+  results::write_checkpoint(file, c);
+  const double write_s = seconds_since(t0);
+  const auto bytes = static_cast<double>(std::filesystem::file_size(file));
+  t0 = std::chrono::steady_clock::now();
+  results::CheckpointData back = results::read_checkpoint(file);
+  const double read_s = seconds_since(t0);
+  t0 = std::chrono::steady_clock::now();
+  System fresh(sys.config());
+  fresh.walls = sys.walls;
+  fresh.restore_state(std::move(back.drop.system));
+  const double restore_s = seconds_since(t0);
+  std::filesystem::remove(file);
+  const double n = static_cast<double>(sys.particles.size());
+  const double sample_bytes = static_cast<double>(samples * sizeof(DropSample));
+  fmt::print(
+      "\ncheckpoint of {} grains and {} trace samples in {}: {:.2f} MB, {:.0f} bytes per grain (without the samples, "
+      "{} bytes each: {:.1f} MB), {} listed pairs, {} wall candidates\n"
+      "  save_state {:.3f} s, write + fsync {:.3f} s, read + verify {:.3f} s, restore {:.3f} s\n",
+      sys.particles.size(), samples, dir.string(), bytes / 1e6, (bytes - sample_bytes) / n, sizeof(DropSample),
+      sample_bytes / 1e6, c.drop.system.list_neighbor.size(), c.drop.system.wall_candidates.size(), save_s, write_s,
+      read_s, restore_s);
+}
+
+}  // namespace gravsweep::cli

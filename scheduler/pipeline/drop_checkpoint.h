@@ -1,0 +1,90 @@
+// Checkpoints of a drop job (results/io/checkpoint_file.h): the drop is saved every interval_s of
+// wall time and when a stop is requested (SIGTERM: scancel, a Slurm time limit), and the next
+// attempt of the same job continues from the last checkpoint, bit for bit when it runs on the
+// same number of threads. A checkpoint that cannot be used (missing, cut short, failing its
+// content hash, written for another scenario, bed or build) is discarded with a warning naming
+// the file, and the drop starts over: never a failed job. The checkpoint is removed once the
+// drop's trace is written.
+//
+// Why a worker setting (`work --checkpoint-interval`) and not a scenario field: how often to pay
+// for durability depends on the machine (time limits, how often nodes die), not on the physics;
+// a resumed drop is bit-identical whatever the interval, so the interval must not enter the job
+// id or the bed key, which hash the scenario.
+#pragma once
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "engine/scenario/impact.h"
+#include "results/io/checkpoint_file.h"
+
+namespace gravsweep::pipeline {
+
+/// Default wall time between two checkpoints of a campaign's drop (`work --checkpoint-interval`):
+/// about 1 % of a drop's time for a paper-sized bed, whose checkpoint takes well under a second.
+inline constexpr double kDefaultCheckpointInterval_s = 300;
+
+struct DropCheckpointing {
+  std::filesystem::path path;  ///< this job's checkpoint file; empty: no checkpoints at all
+  /// Wall seconds between two checkpoints; also written when a stop is requested. <= 0: none
+  /// written (one left by an earlier attempt is still continued from).
+  double interval_s = kDefaultCheckpointInterval_s;
+  /// The stop request that is worth a checkpoint; null: the job's stop flag. A worker passes the
+  /// process's (SIGTERM, stop.h): a job told to stop because another worker took its lease over
+  /// just stops, and leaves the checkpoint to the job's owner.
+  const std::atomic<bool>* save_on_stop = nullptr;
+  /// The job's attempt: from the second on, a missing checkpoint is reported (warn) too.
+  int attempt = 1;
+  /// Where warnings go (a checkpoint discarded or not written); empty: stderr.
+  std::function<void(const std::string&)> warn;
+};
+
+/// What drop a checkpoint belongs to: the validated scenario, the SHA-256 of the bed file and
+/// the thread count (DropCheckpointer ignores the last when it compares).
+nlohmann::json drop_identity(const nlohmann::json& validated_scenario, const std::filesystem::path& bed, int threads);
+
+/// The checkpoints of one drop: the one to continue from, and the hooks that write new ones.
+class DropCheckpointer {
+ public:
+  /// `identity` says what drop this is (scenario, bed checksum, threads): a checkpoint whose
+  /// identity differs (threads aside) or that another build wrote is discarded. Reads the
+  /// checkpoint at cfg.path if there is one.
+  DropCheckpointer(DropCheckpointing cfg, nlohmann::json identity, const std::atomic<bool>* stop);
+
+  /// The drop to continue, or null (no usable checkpoint).
+  [[nodiscard]] const DropState* resume() const { return resume_ ? &resume_->drop : nullptr; }
+  /// The engine refused the resume (drop_projectile threw std::invalid_argument): warns, removes
+  /// the file and forgets it; the drop starts over.
+  void discard(const std::string& why);
+  /// drop_projectile's hooks: due() when the interval has passed or a stop was requested; save()
+  /// writes the checkpoint, then throws Interrupted if a stop was requested.
+  [[nodiscard]] DropCheckpoints hooks();
+  /// The drop is recorded: its checkpoint is removed.
+  void finished();
+
+  /// The progress detail with the last checkpoint appended (what `status` shows).
+  [[nodiscard]] std::string detail(const std::string& drop_detail) const;
+  /// Wall time of the earlier attempts up to the checkpoint continued from (0: none).
+  [[nodiscard]] double prior_wall_time_s() const;
+  /// checkpoint_resumes, resumed_at_s, checkpoints_written for the drop's metrics.
+  void add_metrics(nlohmann::json& m) const;
+
+ private:
+  DropCheckpointing cfg_;
+  nlohmann::json identity_;
+  const std::atomic<bool>* stop_;
+  std::unique_ptr<results::CheckpointData> resume_;
+  std::chrono::steady_clock::time_point started_, last_write_;
+  long long written_ = 0;
+  double last_t_s_ = -1;    ///< simulated time (since release) of the last checkpoint written
+  std::string last_clock_;  ///< UTC time of day it was written
+  void warn(const std::string& message) const;
+  void load();
+  void save(const System& sys, const DropLoopState& loop);
+};
+
+}  // namespace gravsweep::pipeline

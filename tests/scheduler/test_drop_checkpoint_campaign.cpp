@@ -1,0 +1,134 @@
+// Checkpoints of a campaign's drop through real worker processes (`gravsweep work`,
+// scheduler/pipeline/drop_checkpoint.h): a worker stopped by SIGTERM mid-drop writes the drop's
+// checkpoint, gives its lease back and says so in the attempts table; a worker killed by SIGKILL
+// leaves the last periodic checkpoint, which `status` names while the drop runs; either way the
+// next worker continues the drop and records the trace of an uninterrupted campaign, value for
+// value, and removes the checkpoint.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "results/io/trace_file.h"
+#include "scheduler_test_helpers.h"
+
+using namespace gravsweep;
+using namespace gravsweep::test;
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace {
+
+/// One bed and one long drop of the tiny scenario: 2 s of simulated time at 1 m/s2 (about 4 s of
+/// wall time), run to the time cap (the hold time is longer), long enough to be caught mid-drop.
+std::string one_drop_spec() {
+  json base = json::parse(tiny_base());
+  base["stop"]["max_time_s"] = 2.0;
+  base["stop"]["hold_time_s"] = 10.0;
+  json spec;
+  spec["sweep"] = "ckpt";
+  spec["base"] = base;
+  spec["axes"] = json::array({{{"name", "gravity_m_s2"}, {"pointer", "/gravity_m_s2"}, {"values", {1.0}}}});
+  return spec.dump(2);
+}
+
+/// Submits the spec into `<dir>/<name>.db`.
+void submit(const fs::path& dir, const std::string& name) {
+  write_text(dir / "spec.json", one_drop_spec());
+  const CmdResult r = run_cli({"submit", "spec.json", "--db", name + ".db"}, dir);
+  ASSERT_EQ(r.code, 0) << r.err;
+}
+
+/// A worker of campaign `<dir>/<name>.db` (absolute: start_cli runs in the test's folder).
+std::vector<std::string> work_args(const fs::path& dir, const std::string& name, const std::string& interval_s) {
+  return {"work",      "--db", (dir / (name + ".db")).string(), "--threads", "1", "--lease", "2",
+          "--backoff", "0",    "--checkpoint-interval",         interval_s};
+}
+
+/// Waits until the drop job's progress detail (what `status` shows) contains `text`; false after
+/// `timeout_s`.
+bool wait_for_detail(const fs::path& db_path, const std::string& text, double timeout_s) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (std::chrono::steady_clock::now() < end) {
+    try {
+      db::Database db(db_path.string());
+      if (sql_text(db, "SELECT coalesce(detail,'') FROM jobs WHERE kind='drop' AND state='running'").find(text) !=
+          std::string::npos)
+        return true;
+    } catch (const std::exception&) {  // busy: ask again
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return false;
+}
+
+fs::path trace_of(const fs::path& dir, const std::string& name) {
+  db::Database db((dir / (name + ".db")).string());
+  return campaign_file(dir, name, sql_text(db, "SELECT trace_path FROM results WHERE kind='drop'"));
+}
+
+void expect_same_trace(const fs::path& a_path, const fs::path& b_path) {
+  const results::TraceData a = results::read_trace(a_path), b = results::read_trace(b_path);
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(a.t_s, b.t_s);
+  EXPECT_EQ(a.depth_m, b.depth_m);
+  EXPECT_EQ(a.velocity_down_m_s, b.velocity_down_m_s);
+  EXPECT_EQ(a.accel_up_m_s2, b.accel_up_m_s2);
+  EXPECT_EQ(a.position_m, b.position_m);
+  EXPECT_EQ(a.omega_rad_s, b.omega_rad_s);
+  EXPECT_EQ(a.contacts, b.contacts);
+  EXPECT_EQ(a.grain_kinetic_energy_J, b.grain_kinetic_energy_J);
+}
+
+class CampaignCheckpoint : public ::testing::Test {
+ protected:
+  TempDir d_;
+  void SetUp() override {
+    ASSERT_NO_FATAL_FAILURE(submit(d_.path, "ref"));
+    const CmdResult r = run_cli(work_args(d_.path, "ref", "0"), d_.path);
+    ASSERT_EQ(r.code, 0) << r.err;
+    ASSERT_NO_FATAL_FAILURE(submit(d_.path, "c"));
+  }
+  fs::path checkpoints() const { return d_.path / "c.files" / "checkpoints"; }
+  /// Runs a worker to the end and checks what the resumed campaign recorded.
+  void finish_and_compare() {
+    const CmdResult r = run_cli(work_args(d_.path, "c", "300"), d_.path);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err.find("discarded"), std::string::npos) << r.err;
+    db::Database db((d_.path / "c.db").string());
+    EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), 2);
+    EXPECT_EQ(sql_int(db, "SELECT checkpoint_resumes FROM results WHERE kind='drop'"), 1);
+    EXPECT_TRUE(fs::is_empty(checkpoints())) << "the checkpoint outlived the recorded drop";
+    EXPECT_NO_FATAL_FAILURE(expect_same_trace(trace_of(d_.path, "ref"), trace_of(d_.path, "c")));
+  }
+};
+
+}  // namespace
+
+TEST_F(CampaignCheckpoint, SigtermCheckpointsAndTheNextWorkerContinues) {
+  const pid_t w = start_cli(work_args(d_.path, "c", "300"), d_.path / "w1.log");
+  ASSERT_TRUE(wait_for_detail(d_.path / "c.db", "depth=", 60)) << "the drop never started";
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));  // well inside the drop
+  kill(w, SIGTERM);
+  ASSERT_EQ(wait_child(w, 60), 130);
+  ASSERT_EQ(std::distance(fs::directory_iterator(checkpoints()), fs::directory_iterator()), 1);
+  {
+    db::Database db((d_.path / "c.db").string());
+    const std::string why = sql_text(db, "SELECT coalesce(error,'') FROM attempts WHERE outcome='released'");
+    EXPECT_NE(why.find("checkpoint"), std::string::npos) << "the attempts table says where it stopped: " << why;
+  }
+  EXPECT_NO_FATAL_FAILURE(finish_and_compare());
+}
+
+TEST_F(CampaignCheckpoint, SigkillLosesAtMostOneIntervalAndStatusNamesTheCheckpoint) {
+  const pid_t w = start_cli(work_args(d_.path, "c", "0.3"), d_.path / "w1.log");
+  ASSERT_TRUE(wait_for_detail(d_.path / "c.db", "ckpt t=", 60)) << "no checkpoint shown in the progress detail";
+  const CmdResult status = run_cli({"status", "--db", "c.db"}, d_.path);
+  EXPECT_NE(status.out.find("ckpt t="), std::string::npos) << status.out;
+  kill(w, SIGKILL);
+  wait_child(w, 10);
+  ASSERT_EQ(std::distance(fs::directory_iterator(checkpoints()), fs::directory_iterator()), 1);
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // the lease (2 s) lapses
+  EXPECT_NO_FATAL_FAILURE(finish_and_compare());
+}
