@@ -34,7 +34,8 @@ case "${1:-}" in
       sweep=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["sweep"])' "$spec")
       dir="$data/${sweep#gravity_sweep_}"
       rm -rf "$dir.tmp"
-      if "$gs" export --db "$db" --sweep "$sweep" --out "$dir.tmp" --rate-hz 2000; then
+      if "$gs" export --db "$db" --sweep "$sweep" --out "$dir.tmp" --rate-hz 2000 &&
+        [ "$(wc -l < "$dir.tmp/trials.csv")" -gt 1 ]; then
         rm -rf "$dir" && mv "$dir.tmp" "$dir"
       else
         echo "export: $sweep: nothing exported (see above)"; rm -rf "$dir.tmp"
@@ -42,8 +43,6 @@ case "${1:-}" in
     done
     "$gs" results --db "$db" --where 'sweep~gravity_sweep_' --where "kind=drop" --all --format csv \
       --out "$data/results.csv"
-    "$gs" results --db "$db" --where 'sweep~gravity_sweep_' --where "kind=bed" --all --format csv \
-      --out "$data/beds.csv"
     du -sh "$data"
     ;;
   *)

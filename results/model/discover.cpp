@@ -303,10 +303,16 @@ Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds, doub
   d.baseline = baseline.name();
   ModelSpec current = baseline;
   d.residual_before = residual_axes(fit_model(current, c), c);
+  // A gravity-scaled baseline (no parameter per gravity level, e.g. scaled_base) is tested only
+  // against terms that are one law for all levels too: a per-level term would absorb, level by
+  // level, the very effect whose size does not follow g that this mode is meant to find.
+  d.gravity_scaled =
+      std::none_of(baseline.terms.begin(), baseline.terms.end(), [](const ModelTerm& t) { return t.per_gravity; });
   for (int round = 0; round < max_rounds; ++round) {
     std::vector<ModelTerm> named;
     for (const auto& term : term_registry())
-      if (!current.has(term.name)) named.push_back({&term, term.per_gravity, 1.0});
+      if (!current.has(term.name) && !(d.gravity_scaled && term.per_gravity))
+        named.push_back({&term, term.per_gravity, 1.0});
     const auto cands = rank_candidates(current, c, named, folds, alpha, min_improvement);
     d.rounds.push_back(cands);
     if (cands.empty() || !cands.front().significant) break;

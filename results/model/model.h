@@ -155,6 +155,9 @@ struct Candidate {
 };
 struct Discovery {
   std::string baseline;
+  /// The baseline has no parameter per gravity level (one law for all levels): only such terms
+  /// are candidates (scaled mode, `model rank --scaled`).
+  bool gravity_scaled = false;
   std::vector<std::vector<Candidate>> rounds;  ///< ranking of the named terms per forward step
   std::vector<std::string> added;              ///< named winners, in order
   std::string verdict;                         ///< the sentence for users

@@ -43,6 +43,7 @@ struct TermInfo {
 // The registry: one row per term (the function is defined in terms/<name>.cpp).
 #define GRAVSWEEP_MODEL_TERMS(X) \
   X(base)                        \
+  X(scaled_base)                 \
   X(depth_friction)              \
   X(gravity_depth_friction)      \
   X(viscous_drag)                \

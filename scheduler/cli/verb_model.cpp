@@ -390,12 +390,18 @@ void setup_model(CLI::App& app) {
       "like a named term: --model 'base+z^1*v^1'.\n\n"
       "Examples:\n  gravsweep model rank ../shared/data/measurements/depth-friction-dev\n"
       "  gravsweep model rank campaign.db          # the drops of `gravsweep submit` + `work`\n"
-      "  gravsweep model rank data/reproduction/chrono_1g --where 'impact_velocity_m_s<0.5'  # one regime");
+      "  gravsweep model rank data/reproduction/chrono_1g --where 'impact_velocity_m_s<0.5'  # one regime\n"
+      "  gravsweep model rank data/gravity_sweep/g9.81 data/gravity_sweep/g1.62 --scaled  # one law for all g");
   rank->alias("discover");
   rank->add_option("dir", orank->dir, kDirHelp)->required();
   rank->add_option("--where", orank->where, kWhereHelp);
   add_input_files_option(rank, orank->files);
   rank->add_option("--baseline", orank->baseline, "starting model")->capture_default_str();
+  rank->add_flag_callback(
+      "--scaled", [orank]() { orank->baseline = "scaled_base"; },
+      "scaled mode: start from one gravity-scaled law for every level (scaled_base: phi m g + m v^2/d1) and "
+      "rank only terms that are one law for all levels too, so an effect whose size does not follow g "
+      "(e.g. cohesion) is found instead of absorbed level by level; same as --baseline scaled_base");
   rank->add_option("--folds", orank->folds, "cross-validation folds")->check(CLI::Range(2, 100))->capture_default_str();
   rank->add_option("--alpha", orank->alpha, "family-wise significance level")->capture_default_str();
   rank->add_option("--min-improvement", orank->min_improvement, "minimum mean relative improvement")

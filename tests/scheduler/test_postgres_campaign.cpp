@@ -160,11 +160,11 @@ TEST(PostgresCampaign, SlurmSubmitDryRunPrintsOneArrayOfPilotWorkers) {
                     "--threads", "2", "--partition", "debug", "--time", "00:10:00", "--dry-run"},
                    d.path);
   ASSERT_EQ(r.code, 0) << r.err;
-  for (const std::string& line :
-       {std::string("#SBATCH --array=1-3\n"), std::string("#SBATCH --cpus-per-task=2\n"),
-        std::string("#SBATCH --partition=debug\n"), std::string("#SBATCH --time=00:10:00\n"),
-        "#SBATCH --output=\"" + (store.files / "slurm").string() + "/%A_%a.log\"\n",
-        " work --db '" + store.location + "' --files '" + store.files.string() + "' --threads 2 --lease 60 --checkpoint-interval 300\n"})
+  for (const std::string& line : {std::string("#SBATCH --array=1-3\n"), std::string("#SBATCH --cpus-per-task=2\n"),
+                                  std::string("#SBATCH --partition=debug\n"), std::string("#SBATCH --time=00:10:00\n"),
+                                  "#SBATCH --output=\"" + (store.files / "slurm").string() + "/%A_%a.log\"\n",
+                                  " work --db '" + store.location + "' --files '" + store.files.string() +
+                                      "' --threads 2 --lease 60 --checkpoint-interval 300\n"})
     EXPECT_NE(r.out.find(line), std::string::npos) << line << " not in:\n" << r.out;
   EXPECT_FALSE(fs::exists(store.files / "slurm")) << "a dry run submits and writes nothing";
   // An SQLite campaign is refused: its file must not be shared between nodes.

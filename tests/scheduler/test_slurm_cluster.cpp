@@ -91,6 +91,7 @@ TEST_F(ClusterFixture, ATinyImpactCampaignCompletesThroughSlurmWithATaskScancell
   // scancel landed.
   json base = json::parse(tiny_base());
   base["stop"]["max_time_s"] = 6.0;
+  base["at_rest"] = {{"surface_speed_fraction", 1.0}, {"rms_speed_fraction", 1.0}};  // a quick test bed
   // Every drop runs its full time: a drop that came to rest early jumped from 30 % to done
   // between the progress reading and the scancel, and the victim's attempt read "done".
   base["stop"]["hold_time_s"] = 10.0;
@@ -218,6 +219,7 @@ TEST_F(ClusterFixture, ADropLongerThanATaskTimeLimitCompletesAcrossTasksFromItsC
   json base = json::parse(tiny_base());
   base["gravity_m_s2"] = 1.0;
   base["stop"] = {{"max_time_s", 90.0}, {"speed_m_s", 1e-12}, {"hold_time_s", 10.0}};
+  base["at_rest"] = {{"surface_speed_fraction", 1.0}, {"rms_speed_fraction", 1.0}};  // a quick test bed
   base["output"] = {{"sample_rate_hz", 200.0}, {"filter_cutoff_hz", 50.0}};
   json doc = {
       {"sweep", "slurm_long"},
