@@ -311,7 +311,7 @@ Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds, doub
   for (int round = 0; round < max_rounds; ++round) {
     std::vector<ModelTerm> named;
     for (const auto& term : term_registry())
-      if (!current.has(term.name) && !(d.gravity_scaled && term.per_gravity))
+      if (!current.has(term.name) && !term.baseline_only && !(d.gravity_scaled && term.per_gravity))
         named.push_back({&term, term.per_gravity, 1.0});
     const auto cands = rank_candidates(current, c, named, folds, alpha, min_improvement);
     d.rounds.push_back(cands);

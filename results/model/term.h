@@ -38,6 +38,9 @@ struct TermInfo {
   std::function<std::vector<double>(double g_m_s2, double mass_kg, double diameter_m)> typical;
   /// A form of the generated family (generated.h), not a named effect of the library.
   bool generated = false;
+  /// A baseline to start from (`--baseline`), never ranked as a missing effect: scaled_base is
+  /// the whole Poncelet law again, collinear with base's per-level f0 and 1/d1.
+  bool baseline_only = false;
 };
 
 // The registry: one row per term (the function is defined in terms/<name>.cpp).

@@ -16,6 +16,7 @@ TermInfo scaled_base_term() {
   t.signature = "-";
   t.params = {"phi", "inv_d1_1_m"};
   t.per_gravity = false;
+  t.baseline_only = true;
   t.features = [](const TermContext& c, double* out) {
     out[0] = c.mass_kg * c.g_m_s2;
     out[1] = c.mass_kg * c.v_m_s * c.v_m_s;
