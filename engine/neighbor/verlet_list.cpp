@@ -211,7 +211,7 @@ void VerletList::build(const Particles& p, double skin_m, int threads) {
   // (dynamic: the density varies), each chunk written to its own buffer with a row's large-particle
   // pairs first and the row sorted; then the chunks copied into place after a prefix sum of the
   // row counts. Searching the cells once instead of twice (count, then fill) takes 4 % off the
-  // 0.1 m/s2 drop, which rebuilds every ~120 steps (BENCHMARKS.md, issue 12).
+  // 0.1 m/s2 drop, which rebuilds every ~120 steps (BENCHMARKS.md).
   std::sort(large_pairs.begin(), large_pairs.end());
   count_.assign(n + 1, 0);
   const std::size_t n_chunks = (n + kBuildChunk - 1) / kBuildChunk;

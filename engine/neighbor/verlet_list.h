@@ -19,7 +19,7 @@ namespace gravsweep {
 /// test): a row costs kRowWork, a touching pair kTouchingWork more (the contact law). Set so
 /// that the two threads of the 0.1 m/s2 drop spend equal time in pair + wall work (perf per
 /// thread: 35.5 % / 35.8 % of the samples at 6 and 9; 3 and 6 left thread 0 15 % more, 10 and 14
-/// left thread 1 10 % more; BENCHMARKS.md, issue 12).
+/// left thread 1 10 % more; BENCHMARKS.md).
 inline constexpr std::uint32_t kRowWork = 2;
 inline constexpr std::uint32_t kTouchingWork = 6;
 /// Work of a particle-wall candidate in the same units (System adds it, add_wall_work).

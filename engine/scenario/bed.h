@@ -38,7 +38,7 @@ struct SettleCriteria {
   /// set a new low by kPlateauNewLow in this long and is back within that factor of the low (not
   /// in a burst above it): on the paper's bed it falls to a floor of
   /// 2-4e-5 m/s within ~0.4 s and then only creeps, with small avalanches, above the paper's 1e-5
-  /// (BENCHMARKS.md, issue 12), so the rest of the cap buys nothing.
+  /// (BENCHMARKS.md), so the rest of the cap buys nothing.
   double plateau_window_s = 0;
 };
 
@@ -60,8 +60,8 @@ struct BedSpec {
   double packing_fraction = 0.60;  ///< assumed random packing, for the grain count
   /// Spacing of the triangular lattice the grains are placed on before the pour, in largest grain
   /// diameters (the jitter is 45 % of the gap). 1.04 keeps a monodisperse bed's lattice through the
-  /// pour: it packs in order (packing fraction 0.68-0.69, above random close packing's 0.64; issue 11,
-  /// part 5); 1.5 randomises it (0.62).
+  /// pour: it packs in order (packing fraction 0.68-0.69, above random close packing's 0.64;
+  /// REPRODUCTION.md part 5); 1.5 randomises it (0.62).
   double placement_spacing_diameters = kLatticeSpacingDiameters;
   std::uint64_t seed = 1;
   SettleCriteria settle;

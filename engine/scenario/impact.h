@@ -88,7 +88,7 @@ std::optional<FirstTouch> first_touch_bottom(const System& sys, double x_m, doub
 /// progress(fraction of the time cap, detail); may throw to abort the run.
 using DropProgress = std::function<void(double, const std::string&)>;
 
-/// Grain snapshots during a drop (issue 15): `write(sys, projectile, t_s)` is called at release,
+/// Grain snapshots during a drop: `write(sys, projectile, t_s)` is called at release,
 /// every interval_s of simulated time (rounded to whole samples, at least one) and at the end.
 /// Off when interval_s <= 0 or `write` is empty. `write` may throw to abort the run.
 struct DropSnapshots {

@@ -73,7 +73,7 @@ struct TouchingPair {
 /// pair-loop work before a row (`work`, n + 1 prefix sums, plus `row_work` per row) reaches k / nt
 /// of the total, so a thread whose rows hold more touching pairs gets fewer rows. Static rows gave
 /// thread 0 1.5x thread 1's pair work in a 0.1 m/s2 drop: after the gravity ramp the bottom of the
-/// bed keeps its contacts and the top opens (BENCHMARKS.md, issue 12). Depends only on the list:
+/// bed keeps its contacts and the top opens (BENCHMARKS.md). Depends only on the list:
 /// every step between two builds cuts alike.
 inline std::size_t balanced_cut(const std::uint32_t* work, std::uint32_t row_work, std::size_t n, int k, int nt) {
   if (n == 0 || k <= 0) return 0;
