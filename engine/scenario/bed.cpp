@@ -292,6 +292,12 @@ BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progr
   if (progress) progress(BedPhase::flatten, 1.0, fmt::format("{} grains kept", sys.particles.size()));
   // Relax the new surface (at the drop's gravity when the bed was settled at another, reached by a
   // geometric ramp so that the contacts unload gradually).
+  if (spec.surface_relax_s > 0) {
+    const auto steps = static_cast<long long>(std::llround(spec.surface_relax_s / sys.config().dt_s));
+    if (progress) progress(BedPhase::relax, 0.0, fmt::format("surface relax: {:.3f} s", spec.surface_relax_s));
+    sys.advance(steps);
+    rep.surface_relax_s = spec.surface_relax_s;
+  }
   const bool quenched = spec.quench_interval_s > 0 && spec.quench_time_s > 0;
   if (spec.relax_gravity_m_s2)
     ramp_gravity(sys, *spec.relax_gravity_m_s2, spec.gravity_ramp_s, spec.settle.check_interval_s, progress, quenched);

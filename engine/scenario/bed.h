@@ -87,6 +87,13 @@ struct BedSpec {
   /// and its criteria are measured on free grains.
   double quench_interval_s = 0;
   double quench_time_s = 0;
+  /// Time the flattened surface runs at the settling gravity before the ramp (0: none). Flattening
+  /// leaves grains perched where the removed layer held them; they roll into their pockets in a few
+  /// sqrt(d / g): 0.03 s at 9.81 m/s2, 0.3 s at 0.1 and 3 s at 0.001 m/s2, where a quench, stopping
+  /// every grain whose spin runs against its torque, holds them perched for as long as it lasts.
+  /// A pocket that holds at one gravity holds at any (rigid grains: gravity scales every force of
+  /// a contact network at rest alike), so the surface is let settle where it is cheap.
+  double surface_relax_s = 0;
 };
 
 /// Phase of bed preparation, for progress reporting.
@@ -101,8 +108,9 @@ struct BedReport {
   std::size_t grains_kept = 0;
   double settle_time_s = 0;
   double relax_time_s = 0;
-  double quench_time_s = 0;  ///< time run under the quench after the ramp (0: no quench)
-  bool settled = false;      ///< criteria met in both phases (false: the time cap or the creep floor ended one)
+  double quench_time_s = 0;    ///< time run under the quench after the ramp (0: no quench)
+  double surface_relax_s = 0;  ///< time the flattened surface ran at the settling gravity before the ramp
+  bool settled = false;        ///< criteria met in both phases (false: the time cap or the creep floor ended one)
   SettleEnd settle_end = SettleEnd::time_cap;  ///< how the settling of the pour ended
   SettleEnd relax_end = SettleEnd::time_cap;   ///< how the relaxation after flattening ended
   double rms_speed_m_s = 0;

@@ -162,6 +162,7 @@ BedJobResult run_bed_job(const json& scenario, const std::filesystem::path& bed_
               {"settle_time_s", rep.settle_time_s},
               {"relax_time_s", rep.relax_time_s},
               {"quench_time_s", rep.quench_time_s},
+              {"surface_relax_s", rep.surface_relax_s},
               {"rms_speed_m_s", rest.rms_speed_m_s},
               {"max_speed_m_s", rest.max_speed_m_s},
               {"max_surface_speed_m_s", rest.max_surface_speed_m_s},

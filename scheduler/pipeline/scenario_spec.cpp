@@ -449,6 +449,8 @@ ScenarioParams scenario_params(const json& s) {
     b.quench_interval_s = bj["/quench/interval_s"_json_pointer];
     b.quench_time_s = bj["/quench/time_s"_json_pointer];
   }
+  // Optional and without a default (0 = none), so that the bed keys of existing beds stay.
+  b.surface_relax_s = bj.value("surface_relax_s", 0.0);
 
   const json& pj = s.at("projectile");
   ProjectileSpec& ps = out.projectile;
