@@ -43,6 +43,22 @@ struct HookePkdgrav {
     return kPi * std::sqrt(m_eff_kg / k_N_m) * std::sqrt(1 + loge * loge / (kPi * kPi));
   }
 
+  /// Shortest contact time of the pairs present; a linear spring's does not depend on the speed.
+  static double shortest_contact_time_s(const LawSetup& s, double /*v_rel_m_s*/) {
+    double t = kInf;
+    const std::size_t nm = s.materials.size();
+    for (std::size_t a = 0; a < nm; ++a)
+      for (std::size_t b = a; b < nm; ++b) {
+        const bool wall_a = s.is_wall_material[a], wall_b = s.is_wall_material[b];
+        if (wall_a && wall_b) continue;
+        const double ma = wall_a ? kInf : s.min_mass_kg[a], mb = wall_b ? kInf : s.min_mass_kg[b];
+        if (ma <= 0 || mb <= 0 || !(s.pairs(a, b).kn_N_m > 0)) continue;
+        const double m_eff = std::isinf(ma) ? mb : std::isinf(mb) ? ma : ma * mb / (ma + mb);
+        t = std::min(t, contact_time_s(s.pairs(a, b).kn_N_m, m_eff, s.pairs(a, b).cor_normal));
+      }
+    return t;
+  }
+
   /// Largest stable step: every pair contact must last at least kMinStepsPerContact steps.
   static constexpr double kMinStepsPerContact = 10.0;
   static void check(const LawSetup& s) {

@@ -99,4 +99,18 @@ void check_contact_law(std::string_view law, const LawSetup& setup) {
     throw ConfigError(fmt::format("unknown contact law '{}'; valid contact laws: {}", law, join(contact_law_names())));
 }
 
+double shortest_contact_time_s(std::string_view law, const LawSetup& setup, double v_rel_m_s) {
+  double t = 0;
+  bool found = false;
+  std::apply(
+      [&](auto... l) {
+        ((law == decltype(l)::name ? (found = true, t = decltype(l)::shortest_contact_time_s(setup, v_rel_m_s), 0) : 0),
+         ...);
+      },
+      ContactLaws{});
+  if (!found)
+    throw ConfigError(fmt::format("unknown contact law '{}'; valid contact laws: {}", law, join(contact_law_names())));
+  return t;
+}
+
 }  // namespace gravsweep

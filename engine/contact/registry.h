@@ -2,8 +2,9 @@
 //
 // To add a contact law: write engine/contact/<name>.h with a struct that has `name`,
 // `description`, `static void prepare(PairCoefficients&)`, `static void check(const LawSetup&)`, `static double
-// normal_energy_J(...)` and `static void evaluate(...)` (see hertz_chrono.h), then add the struct to the ContactLaws
-// list in registry.cpp. A rolling model is the same with `apply(...)` (see engine/rolling/) and the RollingModels list.
+// shortest_contact_time_s(const LawSetup&, double v_rel_m_s)`, `static double normal_energy_J(...)` and `static void
+// evaluate(...)` (see hertz_chrono.h), then add the struct to the ContactLaws list in registry.cpp. A rolling model is
+// the same with `apply(...)` (see engine/rolling/) and the RollingModels list.
 #pragma once
 #include <string>
 #include <string_view>
@@ -33,5 +34,9 @@ void prepare_contact_law(std::string_view law, PairTable& pairs);
 
 /// Runs the named law's parameter and time-step checks.
 void check_contact_law(std::string_view law, const LawSetup& setup);
+
+/// The named law's shortest contact time over the pairs present at relative normal speed v_rel_m_s
+/// (infinite when no pair can touch or the speed is 0 for a speed-dependent law).
+double shortest_contact_time_s(std::string_view law, const LawSetup& setup, double v_rel_m_s);
 
 }  // namespace gravsweep

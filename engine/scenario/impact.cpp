@@ -126,12 +126,27 @@ ParticleIndex release_projectile(System& sys, double surface_height_m, const Pro
 class DropRun {
  public:
   DropRun(System& sys, const ProjectileSpec& ps, const DropStop& stop, double sample_rate_hz,
-          const DropProgress& progress, const DropSnapshots& snapshots, const DropCheckpoints& checkpoints)
-      : sys_(sys), ps_(ps), stop_(stop), progress_(progress), snapshots_(snapshots), checkpoints_(checkpoints) {
+          const DropProgress& progress, const DropSnapshots& snapshots, const DropCheckpoints& checkpoints,
+          const DropTimeStep& time_step)
+      : sys_(sys),
+        ps_(ps),
+        stop_(stop),
+        progress_(progress),
+        snapshots_(snapshots),
+        checkpoints_(checkpoints),
+        time_step_(time_step),
+        dt_floor_s_(sys.config().dt_s) {
     if (!(sample_rate_hz > 0)) throw ConfigError("drop: sample_rate_hz must be > 0");
     const double dt = sys.config().dt_s;
-    steps_per_sample_ = std::max<long long>(1, std::llround(1.0 / (sample_rate_hz * dt)));
-    sample_dt_ = static_cast<double>(steps_per_sample_) * dt;
+    if (adaptive()) {
+      if (!(time_step.dt_max_s >= dt))
+        throw ConfigError(
+            fmt::format("drop: time step cap dt_max_s = {} s must be >= dt_s = {} s", time_step.dt_max_s, dt));
+      sample_dt_ = 1.0 / sample_rate_hz;  // the grid; the steps fill each interval
+    } else {
+      steps_per_sample_ = std::max<long long>(1, std::llround(1.0 / (sample_rate_hz * dt)));
+      sample_dt_ = static_cast<double>(steps_per_sample_) * dt;
+    }
     hold_samples_ = std::max<long long>(1, std::llround(stop.hold_time_s / sample_dt_));
     max_samples_ = static_cast<long long>(std::ceil(stop.max_time_s / sample_dt_));
     // Snapshots every snapshot_every_ samples (0: off), the last one at the end of the run.
@@ -173,6 +188,8 @@ class DropRun {
   const DropProgress& progress_;
   const DropSnapshots& snapshots_;
   const DropCheckpoints& checkpoints_;
+  const DropTimeStep& time_step_;
+  double dt_floor_s_ = 0;  ///< the System's configured step: the adaptive step's floor
   long long steps_per_sample_ = 1, hold_samples_ = 1, max_samples_ = 0, snapshot_every_ = 0;
   double sample_dt_ = 0;
   DropLoopState st_;
@@ -199,6 +216,18 @@ class DropRun {
     st_.last_snapshot = k;
   }
 
+  bool adaptive() const { return time_step_.steps_per_contact > 0; }
+
+  /// With the adaptive step: sets the step for the next sample interval (DropTimeStep).
+  void choose_step() {
+    if (!adaptive()) return;
+    const double v_rel_m_s = 2 * sys_.max_particle_speed_m_s();
+    const double target = std::clamp(sys_.shortest_contact_time_s(v_rel_m_s) / time_step_.steps_per_contact,
+                                     dt_floor_s_, time_step_.dt_max_s);
+    steps_per_sample_ = std::max<long long>(1, static_cast<long long>(std::ceil(sample_dt_ / target - 1e-9)));
+    sys_.set_dt_s(sample_dt_ / static_cast<double>(steps_per_sample_));
+  }
+
   /// Advances one sample interval and records it; true when the stop criterion ends the drop.
   bool next_sample(long long k);
 };
@@ -206,6 +235,7 @@ class DropRun {
 bool DropRun::next_sample(long long k) {
   DropResult& res = st_.result;
   const double vz_before = sys_.particles.velocity_m_s[res.projectile].z();
+  choose_step();
   sys_.advance(steps_per_sample_);
   res.grains_spilled += remove_spilled_grains(sys_, res.projectile);
   const double vz_after = sys_.particles.velocity_m_s[res.projectile].z();
@@ -245,8 +275,8 @@ DropResult DropRun::run() {
 
 DropResult drop_projectile(System& sys, double surface_height_m, const ProjectileSpec& ps, const DropStop& stop,
                            double sample_rate_hz, const DropProgress& progress, const DropSnapshots& snapshots,
-                           const DropCheckpoints& checkpoints) {
-  DropRun run(sys, ps, stop, sample_rate_hz, progress, snapshots, checkpoints);
+                           const DropCheckpoints& checkpoints, const DropTimeStep& time_step) {
+  DropRun run(sys, ps, stop, sample_rate_hz, progress, snapshots, checkpoints, time_step);
   if (checkpoints.resume != nullptr)
     run.resume(*checkpoints.resume);
   else

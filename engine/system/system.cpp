@@ -93,8 +93,12 @@ void System::initialize() {
       pairs_.set(a, b, pc);
     }
   // Per-material extremes for the law's checks.
-  std::vector<double> min_r(nm, 0), min_m(nm, 0);
-  std::vector<bool> is_wall(nm, false);
+  auto& min_r = material_min_radius_m_;
+  auto& min_m = material_min_mass_kg_;
+  auto& is_wall = material_is_wall_;
+  min_r.assign(nm, 0);
+  min_m.assign(nm, 0);
+  is_wall.assign(nm, false);
   for (const auto& w : walls) {
     if (w.material >= nm)
       throw ConfigError(fmt::format("wall '{}': material id {} is not defined", w.name, w.material));
@@ -230,6 +234,21 @@ void System::raise_state_failure(long long bad, StateFault cause) {
                                      "{:.4g}, {:.4g}) m is outside the domain",
                                      step_, time_s_, bad, x.x(), x.y(), x.z()),
                          step_, bad);
+}
+
+double System::shortest_contact_time_s(double v_rel_m_s) {
+  if (!initialized_) initialize();
+  return gravsweep::shortest_contact_time_s(
+      config_.contact_law,
+      LawSetup{config_.materials, pairs_, material_min_radius_m_, material_min_mass_kg_, material_is_wall_,
+               config_.dt_s, config_.check_time_step},
+      v_rel_m_s);
+}
+
+double System::max_particle_speed_m_s() const {
+  double v2 = 0;
+  for (const Vec3& v : particles.velocity_m_s) v2 = std::max(v2, v.squaredNorm());
+  return std::sqrt(v2);
 }
 
 void System::step() {

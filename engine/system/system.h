@@ -85,6 +85,14 @@ class System {
   }
   /// Changes gravity between steps without re-initialising (gravity enters only the force sum).
   void set_gravity(const Vec3& g_m_s2) { config_.gravity_m_s2 = g_m_s2; }
+  /// Changes the time step between steps without re-initialising (an adaptive step: the law's
+  /// stability check ran at initialisation on the configured dt_s; the caller bounds this one).
+  void set_dt_s(double dt_s) { config_.dt_s = dt_s; }
+  /// The contact law's shortest contact time over the pairs present at relative normal speed
+  /// v_rel_m_s (contact registry, shortest_contact_time_s), initialising first if needed.
+  [[nodiscard]] double shortest_contact_time_s(double v_rel_m_s);
+  /// Fastest particle speed (walls do not move).
+  [[nodiscard]] double max_particle_speed_m_s() const;
   [[nodiscard]] const StepStats& stats() const { return stats_; }
   [[nodiscard]] const PairTable& pair_table() const { return pairs_; }
   [[nodiscard]] const VerletList& neighbor_list() const { return nlist_; }
@@ -107,6 +115,9 @@ class System {
  private:
   SystemConfig config_;
   PairTable pairs_;
+  /// Per material: smallest particle radius and mass (0: no particle), whether only walls use it.
+  std::vector<double> material_min_radius_m_, material_min_mass_kg_;
+  std::vector<bool> material_is_wall_;
   VerletList nlist_;
   std::unique_ptr<Integrator> integrator_;
   ForceFunction force_fn_ = nullptr;

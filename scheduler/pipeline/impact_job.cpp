@@ -298,7 +298,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
           check_stop(stop, "drop");
           if (progress) progress("drop", f, ckpt.detail(d));
         },
-        ds, ckpt.hooks());
+        ds, ckpt.hooks(), p.time_step);
   };
   const DropResult dr = resume_or_start(ckpt, drop);
   const double wall_s = seconds_since(t0) + ckpt.prior_wall_time_s();

@@ -471,6 +471,13 @@ ScenarioParams scenario_params(const json& s) {
   ps.vertical_offset_m = pj.at("vertical_offset_max_grain_diameters").get<double>() * b.grains.diameter_m * u(rng);
 
   out.stop = drop_stop(s.at("stop"), out.gravity_m_s2, ps.diameter_m);
+  if (s.contains("time_step")) {
+    out.time_step.steps_per_contact = s["/time_step/steps_per_contact"_json_pointer];
+    out.time_step.dt_max_s = s["/time_step/dt_max_s"_json_pointer];
+    if (out.time_step.dt_max_s < out.drop_config.dt_s)
+      throw ConfigError(fmt::format("/time_step/dt_max_s = {} s is invalid: expected at least /dt_s = {} s",
+                                    out.time_step.dt_max_s, out.drop_config.dt_s));
+  }
   out.at_rest.surface_speed_fraction = s["/at_rest/surface_speed_fraction"_json_pointer];
   out.at_rest.rms_speed_fraction = s["/at_rest/rms_speed_fraction"_json_pointer];
   out.at_rest.impact_speed_m_s = reference_impact_speed_m_s(s);
