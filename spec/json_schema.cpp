@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <regex>
 #include <set>
 #include <vector>
@@ -13,6 +14,15 @@ namespace gravsweep::spec {
 using nlohmann::json;
 
 namespace {
+
+/// An ECMAScript pattern, compiled once per pattern and thread (a sweep checks the same few
+/// patterns at each of its points).
+const std::regex& compiled_pattern(const std::string& pattern) {
+  thread_local std::map<std::string, std::regex> cache;
+  auto it = cache.find(pattern);
+  if (it == cache.end()) it = cache.emplace(pattern, std::regex(pattern, std::regex::ECMAScript)).first;
+  return it->second;
+}
 
 std::string joined(const std::vector<std::string>& items, const char* separator = ", ") {
   std::string out;
@@ -197,9 +207,18 @@ std::string described(const json& s, const std::string& what) {
 
 }  // namespace
 
+const json& SchemaValidator::resolved(const json& s, json& storage) const {
+  if (!s.is_object() || !s.contains("$ref")) return s;
+  storage = resolve(s);
+  return storage;
+}
+
 void SchemaValidator::check(json& node, const json& schema_in, const std::string& ptr,
                             std::vector<SpecProblem>& problems) const {
-  const json s = resolve(schema_in);
+  // The schema node itself, not a copy (a copy of every subschema at every node of every
+  // instance was most of a sweep's validation time, issue 33 item 13); a merge only at a $ref.
+  json merged;
+  const json& s = resolved(schema_in, merged);
   if (!check_type(node, s, ptr, problems)) return;  // nothing below a wrong type is checked
   if (s.contains("oneOf")) check_one_of(node, s, ptr, problems);
   if (node.is_number()) check_number(node, s, ptr, problems);
@@ -297,7 +316,7 @@ void SchemaValidator::check_string(const json& node, const json& s, const std::s
   if (s.contains("pattern")) {
     const std::string pattern = s["pattern"].get<std::string>();
     constexpr std::size_t kShownPatternChars = 40;  // a longer pattern is left to the description
-    if (!std::regex_search(text, std::regex(pattern, std::regex::ECMAScript)))
+    if (!std::regex_search(text, compiled_pattern(pattern)))
       problems.push_back({ptr, shown_value(node),
                           described(s, pattern.size() <= kShownPatternChars || !s.contains("description")
                                            ? fmt::format("a string matching {}", pattern)
@@ -325,7 +344,8 @@ void SchemaValidator::check_array(json& node, const json& s, const std::string& 
 
 void SchemaValidator::check_object(json& node, const json& s, const std::string& ptr,
                                    std::vector<SpecProblem>& problems) const {
-  const json props = s.value("properties", json::object());
+  static const json kNoProperties = json::object();
+  const json& props = s.contains("properties") ? s.at("properties") : kNoProperties;
   if (s.contains("additionalProperties") && s["additionalProperties"].is_boolean() &&
       !s["additionalProperties"].get<bool>()) {
     std::vector<std::string> known;
@@ -339,7 +359,7 @@ void SchemaValidator::check_object(json& node, const json& s, const std::string&
     for (const auto& r : s["required"]) {
       const std::string key = r.get<std::string>();
       if (!node.contains(key)) {
-        const json field = props.contains(key) ? resolve(props[key]) : json::object();
+        const json field = props.contains(key) ? resolve(props.at(key)) : json::object();
         problems.push_back(
             {pointer_child(ptr, key), "nothing (missing)", described(field, "a value: the field is required")});
       }
@@ -349,9 +369,10 @@ void SchemaValidator::check_object(json& node, const json& s, const std::string&
     if (node.contains(p.key())) {
       check(node[p.key()], p.value(), child_ptr, problems);
     } else {
-      const json ps = resolve(p.value());
+      json merged;
+      const json& ps = resolved(p.value(), merged);
       if (ps.contains("default")) {
-        node[p.key()] = ps["default"];
+        node[p.key()] = ps.at("default");
         check(node[p.key()], p.value(), child_ptr, problems);
       }
     }

@@ -79,6 +79,8 @@ class SchemaValidator {
  private:
   nlohmann::json schema_;
   [[nodiscard]] nlohmann::json resolve(const nlohmann::json& s) const;
+  /// `s` itself when it has no $ref, else its merge with the definition, kept in `storage`.
+  const nlohmann::json& resolved(const nlohmann::json& s, nlohmann::json& storage) const;
   void check(nlohmann::json& node, const nlohmann::json& schema, const std::string& pointer,
              std::vector<SpecProblem>& problems) const;
   /// type, enum, not: false when the node is not of the type (nothing below it is checked).

@@ -6,6 +6,7 @@
 // file, line and column and do not stop the other trials.
 #pragma once
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,8 +42,35 @@ struct Campaign {
 };
 
 /// The one processing entry: options from the trial (metric_options), bias removal from the
-/// source, the fit window. Throws std::invalid_argument with the reason.
+/// source, the fit window, a clipped record (mark_clipping). Throws std::invalid_argument with the reason.
 void process_trial(MeasuredTrial& t);
+
+/// A saturated accelerometer's flat top: the longest run of consecutive raw samples at the
+/// record's largest value (within kClipRelTolerance of it, as a sensor at full scale writes one
+/// value), [begin, end), when it is at least kClipMinSamples long and above rest. A real peak with
+/// sensor noise and grain-scale fluctuations never repeats its largest value.
+struct ClippedRun {
+  double level_m_s2 = 0;
+  std::size_t begin = 0, end = 0;
+};
+inline constexpr std::size_t kClipMinSamples = 3;
+inline constexpr double kClipRelTolerance = 1e-9;
+std::optional<ClippedRun> clipped_run(const std::vector<double>& accel_up_m_s2);
+
+/// Marks a processed lab trial whose record is clipped (Trial::clipped_at_m_s2, clipped_samples,
+/// clip_depth_error_m; all 0 otherwise) and moves its fit window past the flat top and
+/// `edge_samples` more (none left: an empty window). What stays usable (clip_exclusion): tstop
+/// always (its start and end are threshold crossings far below the clip); zstop when the depth
+/// integrated across the clip is off by at most kClipDepthTolerance of it (bring_to_rest takes the
+/// missing impulse off from the contact on, so the error is at most that speed over the time
+/// from contact to the clip's end; a record with its own depth is not integrated); apeak never.
+void mark_clipping(MeasuredTrial& t, std::size_t edge_samples);
+inline constexpr double kClipDepthTolerance = 0.02;
+enum class ClippedMetric { apeak, zstop, tstop };
+/// Why the metric of a clipped trial is left out of fits and error summaries; "" when it is used.
+std::string clip_exclusion(const MeasuredTrial& t, ClippedMetric metric);
+/// One line for a clipped trial (import table, report): the level, what is kept; "" otherwise.
+std::string clip_summary(const MeasuredTrial& t);
 
 /// Reads and processes a lab campaign folder. Throws std::runtime_error only when trials.csv itself
 /// cannot be read or lacks a required column; row- and trace-level problems become issues.
@@ -64,8 +92,12 @@ MeasuredTrial dem_trial_of(const TraceData& trace, const DemTraceRef& ref);
 /// cap, a rebound) become issues naming the trace, the job and the reason.
 Campaign load_dem_campaign(const std::string& label, const std::vector<DemTraceRef>& refs);
 
-/// Stores the campaign in the database (tables trials, trial_samples, trial_metrics, created when
-/// missing), replacing earlier rows of the same trial ids. Returns the number of trials stored.
+/// Stores the campaign in the database (tables trials and trial_metrics; samples stored once per
+/// content: traces + trace_samples for the raw record, processed_traces + processed_samples for
+/// the processed arrays, each named by its SHA-256, which trials share; the view trial_samples
+/// gives every trial's rows; campaign_db.cpp), replacing earlier rows of the same trial ids and
+/// removing samples no trial names. A database of the per-trial layout before (a table
+/// trial_samples) is moved to the shared one first. Returns the number of trials stored.
 int store_campaign(db::Database& db, const Campaign& campaign);
 
 /// Turns DEM runs (`gravsweep run` folders holding trace.h5, and campaign files folders holding
@@ -76,7 +108,8 @@ int store_campaign(db::Database& db, const Campaign& campaign);
 int write_campaign_from_runs(const std::vector<std::string>& roots, const std::string& out_dir,
                              std::vector<ImportIssue>& issues);
 
-/// Reads a campaign back from a database written by store_campaign (no reprocessing).
+/// Reads a campaign back from a database written by store_campaign (no reprocessing), of either
+/// layout (shared samples, or the per-trial table of an older gravsweep).
 Campaign load_campaign_db(db::Database& db);
 
 /// A campaign folder (read and processed) or an SQLite file (as imported).

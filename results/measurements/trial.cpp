@@ -26,6 +26,9 @@ const std::vector<TrialField>& trial_fields() {
       {"filter_cutoff_hz", nullptr, "Hz", false, &Trial::filter_cutoff_hz, nullptr},
       {"end_threshold_g", nullptr, "1", false, &Trial::end_threshold_g, nullptr},
       {"end_speed_fraction", nullptr, "1", false, &Trial::end_speed_fraction, nullptr},
+      {"clipped_at_m_s2", nullptr, "m/s2", false, &Trial::clipped_at_m_s2, nullptr},
+      {"clipped_samples", nullptr, "1", false, &Trial::clipped_samples, nullptr},
+      {"clip_depth_error_m", nullptr, "m", false, &Trial::clip_depth_error_m, nullptr},
       {"job_id", nullptr, "", false, nullptr, &Trial::job_id},
       {"code_version", nullptr, "", false, nullptr, &Trial::code_version},
   };

@@ -33,6 +33,13 @@ struct Trial {
   double filter_cutoff_hz = 500.0;
   double end_threshold_g = 0.1;
   double end_speed_fraction = 0.1;
+  // A saturated accelerometer, found by process_trial (lab records; 0 when not clipped): the level
+  // of the flat top at the record's largest value, the samples on it, and how far the depth
+  // integrated across it may be off (0 for a record with its own depth). Such a trial's apeak is a
+  // lower bound (clip_exclusion()).
+  double clipped_at_m_s2 = 0;
+  double clipped_samples = 0;
+  double clip_depth_error_m = 0;
   // Provenance.
   std::string job_id;                             ///< campaign drop job (dem), empty otherwise
   std::string code_version;                       ///< gravsweep version that wrote a DEM trace

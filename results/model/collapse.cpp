@@ -127,9 +127,10 @@ std::vector<ScaledTrial> scaled_trials(const Campaign& c) {
     ScaledTrial s;
     s.gravity_m_s2 = g;
     s.froude = m.vc_m_s / std::sqrt(g * D);
-    s.zstop_over_D = m.zstop_m / D;
+    // A clipped record's apeak (and a zstop the clip moved) is NaN here: out of the collapse.
+    s.zstop_over_D = clip_exclusion(t, ClippedMetric::zstop).empty() ? m.zstop_m / D : kNaN;
     s.tstop_sqrt_g_over_D = m.tstop_s * std::sqrt(g / D);
-    s.apeak_over_g = m.apeak_m_s2 / g;
+    s.apeak_over_g = clip_exclusion(t, ClippedMetric::apeak).empty() ? m.apeak_m_s2 / g : kNaN;
     out.push_back(s);
   }
   return out;

@@ -15,6 +15,7 @@ namespace gravsweep::results {
 struct ScaledTrial {
   double gravity_m_s2 = 0;
   double froude = 0;  ///< vc / sqrt(g D)
+  /// NaN (left out) for a clipped record's apeak and a zstop its clip moved (clip_exclusion).
   double zstop_over_D = 0, tstop_sqrt_g_over_D = 0, apeak_over_g = 0;
 };
 std::vector<ScaledTrial> scaled_trials(const Campaign& c);

@@ -437,7 +437,7 @@ HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds, unsi
 ErrorSummary summarize(const Campaign& c, const HeldOut& h) {
   ErrorSummary e;
   double st = 0, str = 0, sz = 0, szr = 0, stt = 0, sttr = 0, sa = 0, sar = 0;
-  int nt = 0, np = 0;
+  int nt = 0, nz = 0, ntt = 0, na = 0;
   for (std::size_t i = 0; i < c.trials.size(); ++i) {
     const auto& t = c.trials[i];
     const auto& m = t.processed.metrics;
@@ -451,14 +451,21 @@ ErrorSummary summarize(const Campaign& c, const HeldOut& h) {
       ++nt;
     }
     const auto& p = h.pred[i];
-    if (p.stopped) {
+    if (!p.stopped) continue;
+    // A clipped record's apeak (a lower bound), and its zstop when the clip moved it, are no
+    // measurement to hold a prediction against (clip_exclusion).
+    if (clip_exclusion(t, ClippedMetric::zstop).empty()) {
       sz += std::pow(1e3 * (p.zstop_m - m.zstop_m), 2);
       szr += std::pow((p.zstop_m - m.zstop_m) / m.zstop_m, 2);
-      stt += std::pow(1e3 * (p.tstop_s - m.tstop_s), 2);
-      sttr += std::pow((p.tstop_s - m.tstop_s) / m.tstop_s, 2);
+      ++nz;
+    }
+    stt += std::pow(1e3 * (p.tstop_s - m.tstop_s), 2);
+    sttr += std::pow((p.tstop_s - m.tstop_s) / m.tstop_s, 2);
+    ++ntt;
+    if (clip_exclusion(t, ClippedMetric::apeak).empty()) {
       sa += std::pow(p.apeak_m_s2 - m.apeak_m_s2, 2);
       sar += std::pow((p.apeak_m_s2 - m.apeak_m_s2) / m.apeak_m_s2, 2);
-      ++np;
+      ++na;
     }
   }
   e.trials = nt;
@@ -466,17 +473,13 @@ ErrorSummary summarize(const Campaign& c, const HeldOut& h) {
     e.trace_rms_m_s2 = std::sqrt(st / nt);
     e.trace_rel_pct = 100 * std::sqrt(str / nt);
   }
-  if (np) {
-    e.zstop_rms_mm = std::sqrt(sz / np);
-    e.zstop_rel_pct = 100 * std::sqrt(szr / np);
-    e.tstop_rms_ms = std::sqrt(stt / np);
-    e.tstop_rel_pct = 100 * std::sqrt(sttr / np);
-    e.apeak_rms_m_s2 = std::sqrt(sa / np);
-    e.apeak_rel_pct = 100 * std::sqrt(sar / np);
-  } else {
-    e.zstop_rms_mm = e.tstop_rms_ms = e.apeak_rms_m_s2 = NAN;
-    e.zstop_rel_pct = e.tstop_rel_pct = e.apeak_rel_pct = NAN;
-  }
+  auto rms = [](double s, int n) { return n ? std::sqrt(s / n) : NAN; };
+  e.zstop_rms_mm = rms(sz, nz);
+  e.zstop_rel_pct = 100 * rms(szr, nz);
+  e.tstop_rms_ms = rms(stt, ntt);
+  e.tstop_rel_pct = 100 * rms(sttr, ntt);
+  e.apeak_rms_m_s2 = rms(sa, na);
+  e.apeak_rel_pct = 100 * rms(sar, na);
   return e;
 }
 

@@ -118,7 +118,7 @@ struct Table3Row {
   /// Bootstrap over whole drops (kTable3BootstrapResamples, fixed seed): uncertainties that
   /// include the scatter between impact sites, which the OLS errors above understate when sites repeat.
   double f0_boot_se_N = NAN, inv_d1_boot_se_1_m = NAN;
-  std::string note;  ///< why a level was not fitted (too few trials or speeds); empty when fitted
+  std::string note;  ///< why a level was not fitted (too few trials or speeds), and clipped trials left out; else empty
 };
 inline constexpr int kTable3BootstrapResamples = 2000;
 inline constexpr unsigned kTable3BootstrapSeed = 1;

@@ -152,6 +152,7 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
           else
             a = 0.0;
           a += bias + o.sensor_noise_g * g_sensor * n01(rng);
+          if (o.sensor_range_m_s2 > 0) a = std::clamp(a, -o.sensor_range_m_s2, o.sensor_range_m_s2);
           tr << fmt::format("{:.6f},{:.5g}\n", i / fs_hz, a);
         }
         const double v_rep = v0 * (1.0 + o.speed_spread * n01(rng));

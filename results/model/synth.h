@@ -27,6 +27,9 @@ struct SynthOptions {
   /// all, so 0.1 g of a low-gravity level drowns in it).
   bool noise_scales_with_g = true;
   double rest_tail_s = 0.1;  ///< record length after the projectile comes to rest
+  /// The accelerometer's range: a reading beyond +/- this saturates at it (0: no limit), as a
+  /// sensor too small for the fastest impacts does (a flat top, measurements import flags it).
+  double sensor_range_m_s2 = 0;
   double force_fluct = 0.2;  ///< multiplicative grain-scale fluctuation (std)
   double force_fluct_tau_s = 1.5e-3;
   double bed_spread_f0 = 0.08;    ///< per-trial relative spread of friction-like terms

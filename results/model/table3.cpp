@@ -68,15 +68,86 @@ void bootstrap_eq2(const std::vector<const MeasuredTrial*>& ts, double g, double
   r.inv_d1_boot_se_1_m = sd(inv_d1);
 }
 
+/// Ordinary least squares: coefficients and their covariance.
+void ols(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::Vector2d& beta, Eigen::Matrix2d& cov) {
+  beta = A.colPivHouseholderQr().solve(b);
+  const double dof = std::max<double>(1.0, static_cast<double>(A.rows()) - 2.0);
+  const double s2 = (b - A * beta).squaredNorm() / dof;
+  cov = s2 * (A.transpose() * A).inverse();
+}
+
+/// Eq. 2 on the level's trials `ts` (apeak usable): f0, 1/d1, vt and their errors.
+void fit_eq2(const std::vector<const MeasuredTrial*>& ts, double g, Table3Row& r) {
+  const auto n = static_cast<Eigen::Index>(ts.size());
+  Eigen::MatrixXd X(n, 2);
+  Eigen::VectorXd y(n);
+  double mass = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto& m = ts[static_cast<std::size_t>(i)]->processed.metrics;
+    mass += ts[static_cast<std::size_t>(i)]->info.projectile_mass_kg / static_cast<double>(n);
+    X(i, 0) = 1.0;
+    X(i, 1) = m.vc_m_s * m.vc_m_s;
+    y(i) = m.apeak_m_s2;  // Eq. 2: apeak = f0/m + vc^2/d1 - g
+  }
+  Eigen::Vector2d b;
+  Eigen::Matrix2d cv;
+  ols(X, y, b, cv);
+  r.f0_N = mass * (b(0) + g);
+  r.f0_se_N = mass * std::sqrt(cv(0, 0));
+  r.inv_d1_1_m = b(1);
+  r.inv_d1_se_1_m = std::sqrt(cv(1, 1));
+  if (r.f0_N > 0 && r.inv_d1_1_m > 0) {
+    // Eq. 5: vt = sqrt(d1 f0 / m); delta method with the covariance of (f0, 1/d1).
+    r.vt_m_s = std::sqrt(r.f0_N / (mass * r.inv_d1_1_m));
+    const double var = 0.25 * r.vt_m_s * r.vt_m_s *
+                       (std::pow(r.f0_se_N / r.f0_N, 2) + std::pow(r.inv_d1_se_1_m / r.inv_d1_1_m, 2) -
+                        2 * mass * cv(0, 1) / (r.f0_N * r.inv_d1_1_m));
+    r.vt_se_m_s = std::sqrt(std::max(0.0, var));
+  }
+  bootstrap_eq2(ts, g, mass, r);
+}
+
+/// zstop ~ H^alpha on the level's trials `ts` (zstop usable), H = drop height + zstop (Fig. 10).
+void fit_alpha(const std::vector<const MeasuredTrial*>& ts, double g, Table3Row& r) {
+  if (ts.size() < 2) return;
+  const auto n = static_cast<Eigen::Index>(ts.size());
+  Eigen::MatrixXd Xl(n, 2);
+  Eigen::VectorXd yl(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto& m = ts[static_cast<std::size_t>(i)]->processed.metrics;
+    const auto& info = ts[static_cast<std::size_t>(i)]->info;
+    const double drop = info.drop_height_m > 0 ? info.drop_height_m : m.vc_m_s * m.vc_m_s / (2 * g);
+    Xl(i, 0) = 1.0;
+    Xl(i, 1) = std::log(drop + m.zstop_m);
+    yl(i) = std::log(std::max(m.zstop_m, 1e-9));
+  }
+  Eigen::Vector2d bl;
+  Eigen::Matrix2d cvl;
+  ols(Xl, yl, bl, cvl);
+  r.alpha = bl(1);
+  r.alpha_se = std::sqrt(cvl(1, 1));
+}
+
 std::vector<Table3Row> table3_of(const Campaign& c, const std::vector<bool>& mask) {
   std::vector<Table3Row> rows;
   for (double g : c.gravity_levels()) {
-    std::vector<const MeasuredTrial*> ts;
-    for (std::size_t i = 0; i < c.trials.size(); ++i)
-      if (mask[i] && same_gravity_level(c.trials[i].info.gravity_m_s2, g)) ts.push_back(&c.trials[i]);
+    // A clipped record's apeak is a lower bound: out of Eq. 2; its zstop out of alpha when the
+    // clip moved it (clip_exclusion).
+    std::vector<const MeasuredTrial*> ts, tz;
+    int clipped = 0;
+    for (std::size_t i = 0; i < c.trials.size(); ++i) {
+      if (!mask[i] || !same_gravity_level(c.trials[i].info.gravity_m_s2, g)) continue;
+      const bool apeak_ok = clip_exclusion(c.trials[i], ClippedMetric::apeak).empty();
+      clipped += !apeak_ok;
+      if (apeak_ok) ts.push_back(&c.trials[i]);
+      if (clip_exclusion(c.trials[i], ClippedMetric::zstop).empty()) tz.push_back(&c.trials[i]);
+    }
     Table3Row r;
     r.g_m_s2 = g;
     r.trials = static_cast<int>(ts.size());
+    const std::string left_out =
+        clipped ? fmt::format("{} clipped trial{} left out (apeak a lower bound)", clipped, clipped == 1 ? "" : "s")
+                : "";
     double vmin = INFINITY, vmax = 0;
     for (const auto* t : ts) {
       vmin = std::min(vmin, t->processed.metrics.vc_m_s);
@@ -88,50 +159,13 @@ std::vector<Table3Row> table3_of(const Campaign& c, const std::vector<bool>& mas
                                 "not fitted: Eq. 2 needs >= {} trials over a vc range of x{} (found {}, vc "
                                 "{:.3g}-{:.3g} m/s)",
                                 kTable3MinTrials, kTable3MinSpeedRatio, r.trials, vmin, vmax);
+      if (!left_out.empty()) r.note += "; " + left_out;
       rows.push_back(r);
       continue;
     }
-    const auto n = static_cast<Eigen::Index>(ts.size());
-    Eigen::MatrixXd X(n, 2), Xl(n, 2);
-    Eigen::VectorXd y(n), yl(n);
-    double mass = 0;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const auto& m = ts[static_cast<std::size_t>(i)]->processed.metrics;
-      const auto& info = ts[static_cast<std::size_t>(i)]->info;
-      mass += info.projectile_mass_kg / static_cast<double>(n);
-      X(i, 0) = 1.0;
-      X(i, 1) = m.vc_m_s * m.vc_m_s;
-      y(i) = m.apeak_m_s2;  // Eq. 2: apeak = f0/m + vc^2/d1 - g
-      const double drop = info.drop_height_m > 0 ? info.drop_height_m : m.vc_m_s * m.vc_m_s / (2 * g);
-      Xl(i, 0) = 1.0;
-      Xl(i, 1) = std::log(drop + m.zstop_m);  // H = drop height + zstop (Fig. 10)
-      yl(i) = std::log(std::max(m.zstop_m, 1e-9));
-    }
-    auto ols = [](const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::Vector2d& beta, Eigen::Matrix2d& cov) {
-      beta = A.colPivHouseholderQr().solve(b);
-      const double dof = std::max<double>(1.0, static_cast<double>(A.rows()) - 2.0);
-      const double s2 = (b - A * beta).squaredNorm() / dof;
-      cov = s2 * (A.transpose() * A).inverse();
-    };
-    Eigen::Vector2d b, bl;
-    Eigen::Matrix2d cv, cvl;
-    ols(X, y, b, cv);
-    ols(Xl, yl, bl, cvl);
-    r.f0_N = mass * (b(0) + g);
-    r.f0_se_N = mass * std::sqrt(cv(0, 0));
-    r.inv_d1_1_m = b(1);
-    r.inv_d1_se_1_m = std::sqrt(cv(1, 1));
-    if (r.f0_N > 0 && r.inv_d1_1_m > 0) {
-      // Eq. 5: vt = sqrt(d1 f0 / m); delta method with the covariance of (f0, 1/d1).
-      r.vt_m_s = std::sqrt(r.f0_N / (mass * r.inv_d1_1_m));
-      const double var = 0.25 * r.vt_m_s * r.vt_m_s *
-                         (std::pow(r.f0_se_N / r.f0_N, 2) + std::pow(r.inv_d1_se_1_m / r.inv_d1_1_m, 2) -
-                          2 * mass * cv(0, 1) / (r.f0_N * r.inv_d1_1_m));
-      r.vt_se_m_s = std::sqrt(std::max(0.0, var));
-    }
-    r.alpha = bl(1);
-    r.alpha_se = std::sqrt(cvl(1, 1));
-    bootstrap_eq2(ts, g, mass, r);
+    fit_eq2(ts, g, r);
+    fit_alpha(tz, g, r);
+    r.note = left_out;
     rows.push_back(r);
   }
   return rows;

@@ -122,7 +122,7 @@ void write_report_data(const std::string& dir, const Campaign& c, const std::vec
   const fs::path D(dir);
   {
     Table f({"trial_id", "gravity_m_s2", "vc_m_s", "fill_height_m", "drop_height_m", "apeak_m_s2", "zstop_m", "tstop_s",
-             "rebound"});
+             "rebound", "clipped_at_m_s2"});
     const std::vector<double> levels = c.gravity_levels();
     for (const auto& t : c.trials) {
       const auto& m = t.processed.metrics;
@@ -132,8 +132,9 @@ void write_report_data(const std::string& dir, const Campaign& c, const std::vec
         if (same_gravity_level(g, level)) level = g;
       const double drop =
           t.info.drop_height_m > 0 ? t.info.drop_height_m : m.vc_m_s * m.vc_m_s / (2 * t.info.gravity_m_s2);
+      // clipped_at_m_s2: 0, or the level of a saturated accelerometer (apeak a lower bound).
       f.add(cells(t.info.trial_id, level, m.vc_m_s, t.info.fill_height_m, drop, m.apeak_m_s2, m.zstop_m, m.tstop_s,
-                  m.rebound ? 1 : 0));
+                  m.rebound ? 1 : 0, t.info.clipped_at_m_s2));
     }
     write_csv(D / "trials.csv", f);
   }

@@ -50,7 +50,11 @@ void setup_measurements(CLI::App& app) {
       "zstop, tstop). Bad input (a row, a trace, a declared sample rate the timestamps contradict, a\n"
       "gap in a record, a trace_file outside the campaign folder) is listed by file:line:column and\n"
       "nothing is written (exit code 2) unless --keep-going stores the good trials (exit code 4).\n"
-      "DEM trials that cannot be measured (no contact, a rebound) are listed with the reason.\n\n"
+      "DEM trials that cannot be measured (no contact, a rebound) are listed with the reason.\n"
+      "A saturated accelerometer (a flat top: 3 or more consecutive samples at the record's largest\n"
+      "value) is flagged: column clipped_at_m_s2 and a warning; its apeak is a lower bound, left out\n"
+      "of apeak fits and errors and its samples out of trace fits; tstop is kept, and zstop while the\n"
+      "depth integrated across the clip is off by at most 2 % of it.\n\n"
       "Examples:\n"
       "  gravsweep measurements import ../shared/data/measurements/depth-friction-dev --db lab.db\n"
       "  gravsweep measurements import campaign.db --db trials.db --where 'gravity_m_s2<2'");
@@ -109,17 +113,23 @@ void setup_measurements(CLI::App& app) {
       db::Database db(o->db);
       stored = results::store_campaign(db, c);
     }
-    results::Table t(
-        {"trial_id", "source", "gravity_m_s2", "vc_m_s", "apeak_m_s2", "zstop_mm", "tstop_ms", "bias_m_s2", "rebound"});
+    // A clipped accelerometer's apeak is a lower bound: its column holds the clip level.
+    results::Table t({"trial_id", "source", "gravity_m_s2", "vc_m_s", "apeak_m_s2", "zstop_mm", "tstop_ms", "bias_m_s2",
+                      "rebound", "clipped_at_m_s2"});
     for (const auto& tr : c.trials) {
       const auto& m = tr.processed.metrics;
+      const bool clipped = tr.info.clipped_at_m_s2 > 0;
       t.add({tr.info.trial_id, results::to_string(tr.info.source), results::num(tr.info.gravity_m_s2),
              results::num(m.vc_m_s), results::num(m.apeak_m_s2), results::num(1e3 * m.zstop_m),
-             results::num(1e3 * m.tstop_s), results::num(tr.processed.bias_m_s2, 3), m.rebound ? "yes" : "no"});
+             results::num(1e3 * m.tstop_s), results::num(tr.processed.bias_m_s2, 3), m.rebound ? "yes" : "no",
+             clipped ? results::num(tr.info.clipped_at_m_s2) : ""});
     }
     t.print(o->format);
     std::fprintf(stderr, "%d trials stored in %s (read from %s: %s), %zu not usable\n", stored, o->db.c_str(),
                  o->dir.c_str(), in.kind.c_str(), c.issues.size());
+    for (const auto& tr : c.trials)
+      if (const std::string clip = results::clip_summary(tr); !clip.empty())
+        std::fprintf(stderr, "warning: trial %s: %s\n", tr.info.trial_id.c_str(), clip.c_str());
     if (!c.issues.empty()) throw ExitWith{kExitIncomplete};  // finished, but some trials failed
   });
 }

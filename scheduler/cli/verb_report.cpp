@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,30 @@ std::vector<results::HtmlFigure> report_figures() {
   };
 }
 
+/// The trials whose accelerometer saturated, and what of them the fits use; nothing when none did.
+std::optional<results::HtmlSection> clipped_section(const results::Campaign& c) {
+  results::Table t({"trial_id", "clipped_at_m_s2", "clipped_samples", "apeak_m_s2 (lower bound)", "zstop", "tstop"});
+  for (const auto& tr : c.trials) {
+    if (!(tr.info.clipped_at_m_s2 > 0)) continue;
+    const std::string z = results::clip_exclusion(tr, results::ClippedMetric::zstop);
+    t.add({tr.info.trial_id, results::num(tr.info.clipped_at_m_s2), results::num(tr.info.clipped_samples),
+           results::num(tr.processed.metrics.apeak_m_s2),
+           z.empty() ? fmt::format("kept (off by at most {} mm)", results::num(1e3 * tr.info.clip_depth_error_m, 2))
+                     : fmt::format("left out (off by up to {} mm)", results::num(1e3 * tr.info.clip_depth_error_m, 2)),
+           "kept"});
+  }
+  if (t.size() == 0) return std::nullopt;
+  return results::HtmlSection{
+      "Clipped accelerometer records",
+      fmt::format(
+          "{} trial{} saturated the accelerometer (a flat top of samples at the record's largest value). Their "
+          "apeak is a lower bound: left out of Eq. 2 (Table 3), the apeak errors and the collapse; their samples "
+          "up to the end of the flat top are left out of the trace fits. tstop is kept; zstop is kept when the "
+          "depth integrated across the clip is off by at most {:g} % of it.",
+          t.size(), t.size() == 1 ? "" : "s", 100 * results::kClipDepthTolerance),
+      {{"", t}}};
+}
+
 /// Verdict, tables and figures of the report, rendered into summary.md and index.html.
 results::HtmlReport report_page(const std::string& dir, const CampaignInput& in, const results::Discovery& d,
                                 const std::vector<results::ComparedModel>& cm) {
@@ -60,6 +85,7 @@ results::HtmlReport report_page(const std::string& dir, const CampaignInput& in,
   page.summary += fmt::format(". {} not usable{}", c.issues.size(), c.issues.empty() ? "." : "");
   for (const auto& is : c.issues) page.issues.push_back(is.to_string());
   page.verdict = d.verdict;
+  if (auto clipped = clipped_section(c)) page.sections.push_back(std::move(*clipped));
   {
     results::HtmlSection s;
     s.heading = fmt::format("Where {} fails", d.baseline);

@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <set>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/progress.h"
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/impact.h"
@@ -59,6 +61,23 @@ std::size_t keep_matching(const std::string& path, std::vector<sweep::PlannedJob
   return left_out;
 }
 
+/// Expands and validates a sweep; a large one shows its progress with an ETA on stderr.
+std::vector<sweep::PlannedJob> expand_with_progress(const sweep::SweepSpec& spec) {
+  constexpr std::size_t kProgressFromPoints = 20000;
+  ProgressBar bar(spec.points() >= kProgressFromPoints);
+  if (spec.points() >= kProgressFromPoints) {
+    const sweep::ExpansionCost c = sweep::expansion_cost(spec);
+    std::fprintf(stderr, "sweep %s: expanding and validating %zu points (about %.2g GB and %s estimated)\n",
+                 spec.name.c_str(), spec.points(), c.memory_bytes / 1e9, format_duration(c.seconds).c_str());
+  }
+  auto jobs = sweep::expand(spec, queue::impact_bed_key(), [&](std::size_t done, std::size_t total) {
+    bar.update("expand", static_cast<double>(done) / static_cast<double>(total),
+               fmt::format("{} of {} points validated", done, total));
+  });
+  bar.finish();
+  return jobs;
+}
+
 void run_submit(const SubmitOptions& o) {
   // Validate and expand every spec before the database is even opened: a bad spec writes nothing.
   struct Planned {
@@ -69,7 +88,7 @@ void run_submit(const SubmitOptions& o) {
   for (const auto& path : o.specs) {
     try {
       Planned p{sweep::load_spec(path), {}};
-      p.jobs = sweep::expand(p.spec, queue::impact_bed_key());
+      p.jobs = expand_with_progress(p.spec);
       if (const std::size_t n = keep_matching(path, p.jobs, o.where))
         fmt::print("sweep {}: --where leaves out {} of {} points\n", p.spec.name, n, p.spec.points());
       planned.push_back(std::move(p));
@@ -109,7 +128,9 @@ void setup_submit(CLI::App& app) {
       "a hash of its canonical scenario, so submitting the same spec again adds nothing and adding a\n"
       "value to one axis adds only the new jobs (\"n new, m already present\"). Drops that share a bed\n"
       "depend on one bed-preparation job. A malformed spec is refused (exit 2) with the JSON pointer,\n"
-      "the value found and the type expected, and nothing is written.\n\n"
+      "the value found and the type expected, and nothing is written. A sweep of 20,000 points or more\n"
+      "shows its expansion's progress with an ETA on stderr; one whose expansion would need more than\n"
+      "half this machine's memory or 30 minutes is refused (exit 2) with both estimates: split it.\n\n"
       "Examples:\n"
       "  gravsweep submit examples/sweep_tiny.json --db campaign.db\n"
       "  gravsweep submit a.json b.json --db campaign.db      # a campaign may hold several sweeps\n"

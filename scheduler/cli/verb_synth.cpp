@@ -50,6 +50,10 @@ void setup_synth(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--sensor-noise", o->sensor_noise_g, "sensor noise std, in g")->capture_default_str();
   sub->add_option("--bias", o->sensor_bias_g, "per-trial sensor bias std, in g")->capture_default_str();
+  sub->add_option("--sensor-range", o->sensor_range_m_s2,
+                  "accelerometer range, m/s2: readings beyond it saturate (a flat top; 0: no limit)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   sub->add_option("--rest-tail", o->rest_tail_s, "record length after the projectile comes to rest, s")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();

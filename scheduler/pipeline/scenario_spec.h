@@ -24,6 +24,10 @@ using spec::SpecProblem;
 /// expected; a rule that needs a field already found bad is skipped rather than reported twice.
 nlohmann::json validate_scenario(const nlohmann::json& scenario, const std::string& source = "scenario");
 
+/// How many times validation has run the engine's own checks (each builds an engine System four
+/// times) in this process: once per distinct set of the fields they read, not once per scenario.
+std::size_t engine_check_runs();
+
 /// Reads a scenario file (JSON) and validates it; parse errors name the file, line and column.
 nlohmann::json load_scenario(const std::filesystem::path& path);
 

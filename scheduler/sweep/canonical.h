@@ -14,6 +14,8 @@
 #include <string>
 #include <string_view>
 
+#include "spec/sha256.h"
+
 namespace gravsweep::sweep {
 
 struct CanonicalError : std::runtime_error {
@@ -31,23 +33,10 @@ nlohmann::json canonicalize(const nlohmann::json& j);
 /// the same parameter as the literal 0.3.
 double round_decimal(double v, int significant_digits = 12);
 
-/// SHA-256 (FIPS 180-4) of bytes, as 64 lowercase hex digits.
-std::string sha256_hex(std::string_view bytes);
-
-/// Streaming SHA-256, for files.
-class Sha256 {
- public:
-  Sha256();
-  void update(const void* data, std::size_t n);
-  std::string hex_digest();  ///< finalises; the object must not be updated afterwards
-
- private:
-  void block(const unsigned char* p);
-  std::uint32_t h_[8];
-  unsigned char buf_[64];
-  std::size_t buf_len_ = 0;
-  std::uint64_t total_ = 0;
-};
+/// SHA-256 (FIPS 180-4) of bytes, as 64 lowercase hex digits (spec/sha256.h).
+using spec::sha256_hex;
+/// Streaming SHA-256, for files (spec/sha256.h).
+using spec::Sha256;
 
 /// SHA-256 of a file's content; throws std::runtime_error naming the file if it cannot be read.
 std::string sha256_file(const std::filesystem::path& path);

@@ -10,6 +10,8 @@
 #include <optional>
 #include <set>
 
+#include <unistd.h>
+
 #include "scheduler/sweep/canonical.h"
 #include "spec/json_pointer.h"
 #include "spec/schemas.h"
@@ -275,7 +277,54 @@ void read_axes(const json& doc, const json* base, const std::vector<SpecProblem>
       add_group(AxisGroup{{std::move(*axis)}}, "/repeats");
 }
 
+/// Nodes of a JSON tree (every value, object and array counted once).
+double json_nodes(const json& j) {
+  double n = 1;
+  if (j.is_structured())
+    for (const auto& v : j) n += json_nodes(v);
+  return n;
+}
+
+/// Refuses a sweep whose expansion would not fit this machine (expansion_cost), saying what it
+/// would take and what is allowed.
+void refuse_costly(const SweepSpec& spec, const std::string& file) {
+  const ExpansionCost c = expansion_cost(spec);
+  const double memory = machine_memory_bytes();
+  const double max_bytes = memory > 0 ? kMaxExpansionMemoryFraction * memory : 8e9;
+  if (c.memory_bytes <= max_bytes && c.seconds <= kMaxExpansionSeconds) return;
+  const double fit =
+      std::floor(c.points * std::min(max_bytes / c.memory_bytes, kMaxExpansionSeconds / std::max(c.seconds, 1e-9)));
+  throw SpecError::sweep_spec(
+      file, {{"/axes",
+              fmt::format("{:.0f} points, which would take about {:.1f} GB of memory and {:.0f} min to expand and "
+                          "validate ({:.0f} bytes and {:.0f} us a point)",
+                          c.points, c.memory_bytes / 1e9, c.seconds / 60, c.memory_bytes / c.points,
+                          1e6 * c.seconds / c.points),
+              fmt::format("a sweep that fits in {:.0f} % of this machine's {:.1f} GB ({:.1f} GB) and {:.0f} min: about "
+                          "{:.0f} points with this scenario; split it into several specs (submitted one after another)",
+                          100 * kMaxExpansionMemoryFraction, memory / 1e9, max_bytes / 1e9, kMaxExpansionSeconds / 60,
+                          fit)}});
+}
+
 }  // namespace
+
+double machine_memory_bytes() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  return pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page) : 0.0;
+}
+
+ExpansionCost expansion_cost(const SweepSpec& spec) {
+  // Calibrated on examples/sweep_tiny.json's scenario swept to 200,000 points (BENCHMARKS.md):
+  // bytes and seconds per node of a point's scenario tree, and per point.
+  constexpr double kBytesPerNode = 110, kBytesPerPoint = 800, kSecondsPerNode = 1e-5, kSecondsPerPoint = 2.5e-5;
+  ExpansionCost c;
+  c.points = 1;
+  for (const auto& g : spec.groups) c.points *= static_cast<double>(g.size());
+  const double nodes = json_nodes(spec.base);
+  c.memory_bytes = c.points * (kBytesPerNode * nodes + kBytesPerPoint);
+  c.seconds = c.points * (kSecondsPerNode * nodes + kSecondsPerPoint);
+  return c;
+}
 
 std::size_t SweepSpec::points() const {
   std::size_t n = 1;
@@ -325,9 +374,7 @@ SweepSpec parse_spec(const json& doc_in, const std::string& file, const std::fil
   read_axes(doc, base ? &spec.base : nullptr, problems, spec, ck);
   problems.insert(problems.end(), ck.problems.begin(), ck.problems.end());
   if (!problems.empty()) throw SpecError::sweep_spec(file, problems);
-  if (spec.points() > 5'000'000)
-    throw SpecError::sweep_spec(
-        file, {{"/axes", fmt::format("{} points", spec.points()), "at most 5000000 points per sweep"}});
+  refuse_costly(spec, file);
   spec.source = doc_in;
   spec.source["base"] = spec.base;
   spec.file = file;
@@ -344,15 +391,60 @@ SweepSpec load_spec(const std::filesystem::path& path) {
   return parse_spec(doc, path.string(), path.parent_path());
 }
 
-std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
-  std::vector<PlannedJob> beds, drops;
-  std::map<std::string, std::size_t> bed_index;
-  const std::size_t n = spec.points();
-  std::vector<std::size_t> idx(spec.groups.size(), 0);
-  std::vector<SpecProblem> problems;
-  std::vector<std::size_t> repeats;
-  // A problem of a base field no axis replaces is reported once, at its pointer under /base; a
-  // swept field is checked at each point instead (its base value may be a placeholder).
+namespace {
+
+/// The problems of a sweep's points, one per field and reason (at most kMaxListed), each
+/// counting the other points that have it.
+class PointProblems {
+ public:
+  static constexpr std::size_t kMaxListed = 20;
+  /// A problem of the point `params`; `same` finds an earlier one it repeats.
+  template <class Same>
+  void add(SpecProblem p, const json& params, const Same& same) {
+    const auto it = std::find_if(problems_.begin(), problems_.end(), same);
+    if (it != problems_.end()) {
+      ++repeats_[static_cast<std::size_t>(it - problems_.begin())];
+    } else if (problems_.size() < kMaxListed) {
+      p.found += " at point " + params.dump();
+      problems_.push_back(std::move(p));
+      repeats_.push_back(0);
+    }
+  }
+  [[nodiscard]] bool empty() const { return problems_.empty(); }
+  void throw_if_any(const std::string& file) {
+    for (std::size_t i = 0; i < problems_.size(); ++i)
+      if (repeats_[i] > 0)
+        problems_[i].found +=
+            fmt::format(" (and {} more point{} with this problem)", repeats_[i], repeats_[i] == 1 ? "" : "s");
+    if (!problems_.empty()) throw SpecError::sweep_spec(file, problems_);
+  }
+
+ private:
+  std::vector<SpecProblem> problems_;
+  std::vector<std::size_t> repeats_;
+};
+
+/// The scenario and swept values of point p: its mixed-radix digits, last group fastest.
+PlannedJob point_job(const SweepSpec& spec, std::size_t p) {
+  PlannedJob job;
+  job.scenario = spec.base;
+  job.params = json::object();
+  std::size_t rem = p;
+  for (std::size_t g = spec.groups.size(); g-- > 0;) {
+    const std::size_t i = rem % spec.groups[g].size();
+    rem /= spec.groups[g].size();
+    for (const auto& axis : spec.groups[g].axes) {
+      job.scenario[json::json_pointer(axis.pointer)] = axis.values[i];
+      job.params[axis.name] = axis.values[i];
+    }
+  }
+  job.priority = spec.priority;
+  return job;
+}
+
+/// A problem of a base field no axis replaces is reported once, at its pointer under /base (a
+/// swept field is checked at each point instead: its base value may be a placeholder).
+void check_base(const SweepSpec& spec, const BedKeyFn& bed_key) {
   auto swept = [&](const std::string& pointer) {
     for (const auto& g : spec.groups)
       for (const auto& ax : g.axes)
@@ -360,41 +452,76 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
           return true;
     return false;
   };
-  if (spec.job_kind != "noop" && bed_key) {
-    try {
-      (void)bed_key(spec.base);
-    } catch (const SpecError& e) {
-      for (const auto& p : e.problems())
-        if (!swept(p.pointer)) problems.push_back({"/base" + p.pointer, p.found, p.expected});
-      if (!problems.empty()) throw SpecError::sweep_spec(spec.file.empty() ? spec.name : spec.file, problems);
-    } catch (const std::exception&) {
-      // Not checkable alone (e.g. a field every axis sets): the points report it.
-    }
+  std::vector<SpecProblem> problems;
+  try {
+    (void)bed_key(spec.base);
+  } catch (const SpecError& e) {
+    for (const auto& p : e.problems())
+      if (!swept(p.pointer)) problems.push_back({"/base" + p.pointer, p.found, p.expected});
+    if (!problems.empty()) throw SpecError::sweep_spec(spec.file.empty() ? spec.name : spec.file, problems);
+  } catch (const std::exception&) {
+    // Not checkable alone (e.g. a field every axis sets): the points report it.
   }
+}
+
+/// The bed key of a drop's scenario; nothing (its problems added) when the point is invalid.
+std::optional<json> point_bed_key(const BedKeyFn& bed_key, const PlannedJob& job, PointProblems& problems) {
+  try {
+    if (!bed_key) throw std::runtime_error("no bed key function (the impact pipeline is not built in)");
+    return bed_key(job.scenario);
+  } catch (const SpecError& e) {
+    // The base was sound, so these are problems of swept values.
+    for (const auto& sp : e.problems())
+      problems.add({"/base" + sp.pointer, sp.found, sp.expected}, job.params, [&](const SpecProblem& p) {
+        return p.pointer == "/base" + sp.pointer && p.expected == sp.expected;
+      });
+  } catch (const std::exception& e) {
+    // One problem per distinct message: a bad base field fails every point the same way.
+    const std::string expected = std::string("a valid scenario: ") + e.what();
+    problems.add({"/base", "the scenario", expected}, job.params,
+                 [&](const SpecProblem& p) { return p.expected == expected; });
+  }
+  return std::nullopt;
+}
+
+/// Adds the drop `job` to its bed (the bed job made at its first drop); parameters that differ
+/// between drops of one bed are not bed parameters (null, dropped at the end).
+void add_to_bed(const SweepSpec& spec, const json& key, PlannedJob& job, std::vector<PlannedJob>& beds,
+                std::map<std::string, std::size_t>& bed_index) {
+  const std::string bed_id = job_id(queue::kind_name(queue::JobKind::bed), key);
+  auto [it, inserted] = bed_index.emplace(bed_id, beds.size());
+  if (inserted) {
+    PlannedJob bed;
+    bed.kind = queue::JobKind::bed;
+    bed.job_id = bed_id;
+    bed.scenario = job.scenario;  // any scenario with this key prepares the same bed
+    bed.params = job.params;
+    bed.priority = spec.priority + 1;  // beds first: drops wait for them
+    beds.push_back(std::move(bed));
+  } else {
+    auto& bp = beds[it->second].params;
+    for (auto pit = job.params.begin(); pit != job.params.end(); ++pit)
+      if (bp.contains(pit.key()) && bp[pit.key()] != pit.value()) bp[pit.key()] = nullptr;
+  }
+  job.deps.push_back(bed_id);
+}
+
+}  // namespace
+
+std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key, const ExpandProgress& progress) {
+  std::vector<PlannedJob> beds, drops;
+  std::map<std::string, std::size_t> bed_index;
+  const std::size_t n = spec.points();
+  const bool noop = spec.job_kind == "noop";
+  PointProblems problems;
+  if (!noop && bed_key) check_base(spec, bed_key);
   drops.reserve(n);
   for (std::size_t p = 0; p < n; ++p) {
-    // Mixed-radix digits of p, last group fastest.
-    std::size_t rem = p;
-    for (std::size_t g = spec.groups.size(); g-- > 0;) {
-      idx[g] = rem % spec.groups[g].size();
-      rem /= spec.groups[g].size();
-    }
-    PlannedJob job;
-    job.scenario = spec.base;
-    job.params = json::object();
-    for (std::size_t g = 0; g < spec.groups.size(); ++g) {
-      for (const auto& axis : spec.groups[g].axes) {
-        job.scenario[json::json_pointer(axis.pointer)] = axis.values[idx[g]];
-        job.params[axis.name] = axis.values[idx[g]];
-      }
-    }
-    job.priority = spec.priority;
-    if (spec.job_kind == "noop") {
-      for (const auto& np : noop_problems(job.scenario, "/base")) {
-        if (problems.size() >= 20) break;
-        problems.push_back({np.pointer, np.found + " at point " + job.params.dump(), np.expected});
-        repeats.push_back(0);
-      }
+    if (progress && p % kExpandProgressEvery == 0) progress(p, n);
+    PlannedJob job = point_job(spec, p);
+    if (noop) {
+      for (auto& np : noop_problems(job.scenario, "/base"))
+        problems.add(std::move(np), job.params, [](const SpecProblem&) { return false; });
       job.kind = queue::JobKind::noop;
       job.job_id = job_id(queue::kind_name(job.kind), job.scenario);
       drops.push_back(std::move(job));
@@ -402,63 +529,13 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key) {
     }
     job.kind = queue::JobKind::drop;
     job.job_id = job_id(queue::kind_name(job.kind), job.scenario);
-    json key;
-    try {
-      if (!bed_key) throw std::runtime_error("no bed key function (the impact pipeline is not built in)");
-      key = bed_key(job.scenario);
-    } catch (const SpecError& e) {
-      // The base was sound, so these are problems of swept values: one per field and reason,
-      // counting the other points that have it.
-      for (const auto& sp : e.problems()) {
-        auto same = std::find_if(problems.begin(), problems.end(), [&](const SpecProblem& p) {
-          return p.pointer == "/base" + sp.pointer && p.expected == sp.expected;
-        });
-        if (same != problems.end()) {
-          ++repeats[static_cast<std::size_t>(same - problems.begin())];
-        } else if (problems.size() < 20) {
-          problems.push_back({"/base" + sp.pointer, sp.found + " at point " + job.params.dump(), sp.expected});
-          repeats.push_back(0);
-        }
-      }
-      continue;
-    } catch (const std::exception& e) {
-      // One problem per distinct message: a bad base field fails every point the same way.
-      const std::string expected = std::string("a valid scenario: ") + e.what();
-      auto same =
-          std::find_if(problems.begin(), problems.end(), [&](const SpecProblem& p) { return p.expected == expected; });
-      if (same != problems.end()) {
-        ++repeats[static_cast<std::size_t>(same - problems.begin())];
-      } else if (problems.size() < 20) {
-        problems.push_back({"/base", "the scenario at point " + job.params.dump(), expected});
-        repeats.push_back(0);
-      }
-      continue;
-    }
-    const std::string bed_id = job_id(queue::kind_name(queue::JobKind::bed), key);
-    auto [it, inserted] = bed_index.emplace(bed_id, beds.size());
-    if (inserted) {
-      PlannedJob bed;
-      bed.kind = queue::JobKind::bed;
-      bed.job_id = bed_id;
-      bed.scenario = job.scenario;  // any scenario with this key prepares the same bed
-      bed.params = json::object();
-      for (auto pit = job.params.begin(); pit != job.params.end(); ++pit) bed.params[pit.key()] = pit.value();
-      bed.priority = spec.priority + 1;  // beds first: drops wait for them
-      beds.push_back(std::move(bed));
-    } else {
-      // Parameters that differ between drops of one bed are not bed parameters.
-      auto& bp = beds[it->second].params;
-      for (auto pit = job.params.begin(); pit != job.params.end(); ++pit)
-        if (bp.contains(pit.key()) && bp[pit.key()] != pit.value()) bp[pit.key()] = nullptr;
-    }
-    job.deps.push_back(bed_id);
+    const auto key = point_bed_key(bed_key, job, problems);
+    if (!key) continue;
+    add_to_bed(spec, *key, job, beds, bed_index);
     drops.push_back(std::move(job));
   }
-  for (std::size_t i = 0; i < problems.size(); ++i)
-    if (repeats[i] > 0)
-      problems[i].found +=
-          fmt::format(" (and {} more point{} with this problem)", repeats[i], repeats[i] == 1 ? "" : "s");
-  if (!problems.empty()) throw SpecError::sweep_spec(spec.file.empty() ? spec.name : spec.file, problems);
+  if (progress) progress(n, n);
+  problems.throw_if_any(spec.file.empty() ? spec.name : spec.file);
   for (auto& b : beds) {  // drop the parameters that vary within the bed
     json kept = json::object();
     for (auto it = b.params.begin(); it != b.params.end(); ++it)

@@ -12,6 +12,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -71,10 +72,31 @@ struct PlannedJob {
 /// bed key of a scenario: drops with equal keys share a bed job.
 using BedKeyFn = std::function<nlohmann::json(const nlohmann::json& scenario)>;
 
+/// Told how many of the points are expanded and validated so far (every kExpandProgressEvery
+/// points, and at the end).
+using ExpandProgress = std::function<void(std::size_t done, std::size_t total)>;
+inline constexpr std::size_t kExpandProgressEvery = 1000;
+
 /// Expands the spec. Bed jobs come first (in order of first use), then drops in product order.
 /// `bed_key` is required for impact sweeps. Errors from bed_key (invalid scenario) become
 /// SpecError naming the point.
-std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key);
+std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key, const ExpandProgress& progress = {});
+
+/// What expanding and validating a sweep takes, estimated from its points and the size of its
+/// scenario before any of it is done: memory held by its planned jobs (each point's scenario as a
+/// JSON tree), and time on one core (measured figures in BENCHMARKS.md, "Sweep expansion").
+struct ExpansionCost {
+  double points = 0;
+  double memory_bytes = 0;
+  double seconds = 0;
+};
+ExpansionCost expansion_cost(const SweepSpec& spec);
+/// Physical memory of this machine in bytes (0 when unknown).
+double machine_memory_bytes();
+/// A sweep whose expansion would need more than this share of the machine's memory, or longer
+/// than kMaxExpansionSeconds, is refused at parse_spec with both estimates and the limits.
+inline constexpr double kMaxExpansionMemoryFraction = 0.5;
+inline constexpr double kMaxExpansionSeconds = 1800;
 
 /// The column name an axis without "name" gets: its pointer's tokens, lower case, joined by '_'
 /// ("/drop/speed_m_s" -> "drop_speed_m_s"); checked by the schema's rule for column names.
