@@ -104,7 +104,7 @@ class System {
   [[nodiscard]] double potential_energy_J() const;
   /// Number of contacts of particle i at the last force evaluation (walls included).
   [[nodiscard]] int contact_count(ParticleIndex i) const;
-  /// The same for every particle at once, in one pass over the pairs (grain snapshots, issue 15).
+  /// The same for every particle at once, in one pass over the pairs (grain snapshots).
   [[nodiscard]] std::vector<int> contact_counts() const;
   /// Approximate memory held per particle by the engine (state + neighbour list + histories).
   [[nodiscard]] double bytes_per_particle() const;

@@ -1,4 +1,4 @@
-// DIR/snapshots.h5 + DIR/snapshots.xdmf: the grains and the projectile during a drop (issue 15),
+// DIR/snapshots.h5 + DIR/snapshots.xdmf: the grains and the projectile during a drop,
 // written when the scenario's /output/snapshot_interval_s is > 0 (`gravsweep run` by default).
 // ParaView and VisIt open the .xdmf directly: a temporal collection, each step a spatial
 // collection of two point sets, "grains" and "projectile" (Polyvertex + attributes). Layout in

@@ -239,7 +239,7 @@ std::string improvement_words(const Candidate& cd) {
       100 * cd.mean_rel_improvement, cd.trials_better, cd.trials, cd.p_value);
 }
 
-/// The sentence for users (issue 13 item 3: humble where the named terms leave structure).
+/// The sentence for users (humble where the named terms leave structure).
 std::string verdict_of(const Discovery& d, const std::string& where_named, const std::string& where_generated) {
   std::string v;
   if (d.added.empty()) {
@@ -327,7 +327,7 @@ Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds, doub
   d.consistent_trend = consistent_trend(d.residual_after);
   // The residuals of the named winners are tested again by the held-out test itself: a form of the
   // generated family that improves them significantly (Bonferroni over the family) is structure the
-  // named terms left, even where the binned axes alone do not show it (issue 13 item 3).
+  // named terms left, even where the binned axes alone do not show it.
   if (search_generated && (d.structure_left || !d.added.empty() || !d.consistent_trend.empty())) {
     const detail::GeneratedSearch g = detail::search_generated(current, c, folds, alpha, min_improvement);
     d.generated_searched = true;

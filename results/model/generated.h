@@ -1,4 +1,4 @@
-// The generated family of candidate terms (issue 13 item 4): forms outside the named library, each
+// The generated family of candidate terms: forms outside the named library, each
 // a linear-in-parameter force c * phi(z, |v|) whose formula is its name, for the search that
 // `model rank` runs when the named terms leave the residuals structured (discover.cpp).
 //

@@ -61,7 +61,7 @@ struct Prediction {
 /// largest deceleration of the integrated motion.
 Prediction predict(const FittedModel& m, const Trial& info);
 Prediction predict(const FittedModel& m, const TermContext& trial, double t_max_s = 10.0);
-/// The metrics of a measured trial predicted the way it was measured (issue 13): zstop and tstop
+/// The metrics of a measured trial predicted the way it was measured: zstop and tstop
 /// of the integrated motion, apeak read off the model's record (model_record) processed like the
 /// trial (process_trial's options), so that the 500 Hz filter rounds both peaks alike.
 Prediction predict(const FittedModel& m, const MeasuredTrial& t);
@@ -184,7 +184,7 @@ struct Discovery {
 };
 /// A within-trial residual slope of the same sign in this many trials (sign test p below it) is a
 /// trend, however small its share of the residual variance (eta^2): DEM traces carry force-chain
-/// noise that keeps eta^2 low while the trend holds in 41 of 42 trials (issue 11, the full Chrono
+/// noise that keeps eta^2 low while the trend holds in 41 of 42 trials (the full Chrono
 /// campaign).
 inline constexpr double kConsistentTrendP = 1e-6;
 
