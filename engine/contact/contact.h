@@ -3,6 +3,7 @@
 // Body 1 is the particle with the smaller index (or the particle in a particle-wall contact);
 // body 2 is the other particle or the wall. The unit normal n points from body 1 to body 2.
 #pragma once
+#include <cmath>
 #include <vector>
 
 #include "engine/core/material.h"
@@ -78,5 +79,32 @@ struct LawSetup {
   double dt_s;
   bool check_time_step;
 };
+
+/// A pair of materials whose smallest particles can touch: the smallest bodies' effective mass
+/// m* = m_a m_b / (m_a + m_b) and radius R* = r_a r_b / (r_a + r_b), a wall counting as infinite
+/// mass and radius (so m* and R* are the particle's own).
+struct SmallestPair {
+  std::size_t a, b;  ///< material indices, a <= b
+  double m_eff_kg;
+  double r_eff_m;
+};
+
+/// Calls f(SmallestPair) for every pair of materials that can touch in this run: both present
+/// (a particle of each, or a wall), not both walls. The laws' step checks and shortest contact
+/// times walk the pairs through this one loop.
+template <class F>
+void for_each_smallest_pair(const LawSetup& s, F&& f) {
+  const auto harmonic = [](double x, double y) { return std::isinf(x) ? y : std::isinf(y) ? x : x * y / (x + y); };
+  const std::size_t nm = s.materials.size();
+  for (std::size_t a = 0; a < nm; ++a)
+    for (std::size_t b = a; b < nm; ++b) {
+      const bool wall_a = s.is_wall_material[a], wall_b = s.is_wall_material[b];
+      if (wall_a && wall_b) continue;
+      const double ma = wall_a ? kInf : s.min_mass_kg[a], mb = wall_b ? kInf : s.min_mass_kg[b];
+      if (ma <= 0 || mb <= 0) continue;  // no particle of this material
+      const double ra = wall_a ? kInf : s.min_radius_m[a], rb = wall_b ? kInf : s.min_radius_m[b];
+      f(SmallestPair{a, b, harmonic(ma, mb), harmonic(ra, rb)});
+    }
+}
 
 }  // namespace gravsweep

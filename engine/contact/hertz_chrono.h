@@ -54,19 +54,11 @@ struct HertzChrono {
   static double shortest_contact_time_s(const LawSetup& s, double v_rel_m_s) {
     double t = kInf;
     if (!(v_rel_m_s > 0)) return t;
-    const std::size_t nm = s.materials.size();
-    for (std::size_t a = 0; a < nm; ++a)
-      for (std::size_t b = a; b < nm; ++b) {
-        const bool wall_a = s.is_wall_material[a], wall_b = s.is_wall_material[b];
-        if (wall_a && wall_b) continue;
-        const double ma = wall_a ? kInf : s.min_mass_kg[a], mb = wall_b ? kInf : s.min_mass_kg[b];
-        const double ra = wall_a ? kInf : s.min_radius_m[a], rb = wall_b ? kInf : s.min_radius_m[b];
-        if (ma <= 0 || mb <= 0) continue;  // no particle of this material
-        const double m_eff = std::isinf(ma) ? mb : std::isinf(mb) ? ma : ma * mb / (ma + mb);
-        const double r_eff = std::isinf(ra) ? rb : std::isinf(rb) ? ra : ra * rb / (ra + rb);
-        const double E = s.pairs(a, b).E_eff_Pa;
-        t = std::min(t, kHertzContactTimeFactor * std::pow(m_eff * m_eff / (r_eff * E * E * v_rel_m_s), 0.2));
-      }
+    for_each_smallest_pair(s, [&](const SmallestPair& p) {
+      const double E = s.pairs(p.a, p.b).E_eff_Pa;
+      t = std::min(t,
+                   kHertzContactTimeFactor * std::pow(p.m_eff_kg * p.m_eff_kg / (p.r_eff_m * E * E * v_rel_m_s), 0.2));
+    });
     return t;
   }
   static constexpr double kHertzContactTimeFactor = 2.868;

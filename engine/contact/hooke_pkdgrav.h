@@ -46,43 +46,30 @@ struct HookePkdgrav {
   /// Shortest contact time of the pairs present; a linear spring's does not depend on the speed.
   static double shortest_contact_time_s(const LawSetup& s, double /*v_rel_m_s*/) {
     double t = kInf;
-    const std::size_t nm = s.materials.size();
-    for (std::size_t a = 0; a < nm; ++a)
-      for (std::size_t b = a; b < nm; ++b) {
-        const bool wall_a = s.is_wall_material[a], wall_b = s.is_wall_material[b];
-        if (wall_a && wall_b) continue;
-        const double ma = wall_a ? kInf : s.min_mass_kg[a], mb = wall_b ? kInf : s.min_mass_kg[b];
-        if (ma <= 0 || mb <= 0 || !(s.pairs(a, b).kn_N_m > 0)) continue;
-        const double m_eff = std::isinf(ma) ? mb : std::isinf(mb) ? ma : ma * mb / (ma + mb);
-        t = std::min(t, contact_time_s(s.pairs(a, b).kn_N_m, m_eff, s.pairs(a, b).cor_normal));
-      }
+    for_each_smallest_pair(s, [&](const SmallestPair& p) {
+      const PairCoefficients& c = s.pairs(p.a, p.b);
+      if (c.kn_N_m > 0) t = std::min(t, contact_time_s(c.kn_N_m, p.m_eff_kg, c.cor_normal));
+    });
     return t;
   }
 
   /// Largest stable step: every pair contact must last at least kMinStepsPerContact steps.
   static constexpr double kMinStepsPerContact = 10.0;
   static void check(const LawSetup& s) {
-    const std::size_t nm = s.materials.size();
-    for (std::size_t a = 0; a < nm; ++a)
-      for (std::size_t b = a; b < nm; ++b) {
-        const bool wall_a = s.is_wall_material[a], wall_b = s.is_wall_material[b];
-        if (wall_a && wall_b) continue;
-        const double ma = wall_a ? kInf : s.min_mass_kg[a], mb = wall_b ? kInf : s.min_mass_kg[b];
-        if (ma <= 0 || mb <= 0) continue;  // no particle of this material
-        const PairCoefficients& c = s.pairs(a, b);
-        const std::string label = s.materials[a].name + "-" + s.materials[b].name;
-        if (!(c.kn_N_m > 0))
-          throw ConfigError(fmt::format("contact law 'hooke': kn_N_m = {} for pair {}; expected a spring constant > 0",
-                                        c.kn_N_m, label));
-        if (!s.check_time_step) continue;
-        const double m_eff = std::isinf(ma) ? mb : std::isinf(mb) ? ma : ma * mb / (ma + mb);
-        const double limit = contact_time_s(c.kn_N_m, m_eff, c.cor_normal) / kMinStepsPerContact;
-        if (s.dt_s > limit)
-          throw ConfigError(
-              fmt::format("contact law 'hooke': dt = {:.3g} s exceeds the stability bound {:.3g} s "
-                          "(contact time / {} for pair {})",
-                          s.dt_s, limit, kMinStepsPerContact, label));
-      }
+    for_each_smallest_pair(s, [&](const SmallestPair& p) {
+      const PairCoefficients& c = s.pairs(p.a, p.b);
+      const std::string label = s.materials[p.a].name + "-" + s.materials[p.b].name;
+      if (!(c.kn_N_m > 0))
+        throw ConfigError(fmt::format("contact law 'hooke': kn_N_m = {} for pair {}; expected a spring constant > 0",
+                                      c.kn_N_m, label));
+      if (!s.check_time_step) return;
+      const double limit = contact_time_s(c.kn_N_m, p.m_eff_kg, c.cor_normal) / kMinStepsPerContact;
+      if (s.dt_s > limit)
+        throw ConfigError(
+            fmt::format("contact law 'hooke': dt = {:.3g} s exceeds the stability bound {:.3g} s "
+                        "(contact time / {} for pair {})",
+                        s.dt_s, limit, kMinStepsPerContact, label));
+    });
   }
 
   GRAVSWEEP_INLINE static void evaluate(const ContactGeometry& g, const PairCoefficients& c,

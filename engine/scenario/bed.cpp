@@ -133,8 +133,14 @@ const char* to_string(SettleEnd e) {
 }
 
 SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress, BedPhase phase,
-                 double* rms_out, double* max_out) {
+                 double* rms_out, double* max_out, const AdaptiveStep& step) {
   const double dt = sys.config().dt_s;
+  // The run's own step is the adaptive step's floor and comes back at the end.
+  struct StepScope {
+    System& sys;
+    double kept_s;
+    ~StepScope() { sys.set_dt_s(kept_s); }
+  } step_scope{sys, dt};
   // The settling threshold of rolling friction holds for this phase only (SettleCriteria).
   struct ThresholdScope {
     System& sys;
@@ -150,15 +156,17 @@ SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const 
   SettleEnd end = SettleEnd::time_cap;
   // Creep floor: the lowest RMS speed since the bed became quiet, and when it was last lowered.
   double low_m_s = std::numeric_limits<double>::infinity(), low_at_s = 0;
-  while (sys.time_s() - t0 < c.max_time_s) {
-    sys.advance(check_steps);
+  // A minimum time above the cap wins: the phase runs at least min_time_s (BedSpec::relax_time_s).
+  const double cap_s = std::max(c.max_time_s, min_time_s);
+  while (sys.time_s() - t0 < cap_s) {
+    sys.advance(step.on() ? choose_step(sys, step, dt, c.check_interval_s) : check_steps);
     grain_speeds(sys, rms, mx);
     const double elapsed = sys.time_s() - t0;
     if (progress) {
       // Progress: the larger of the time fraction and how close the RMS speed is to its target
       // on a log scale (settling is roughly exponential).
       const double speed_frac = rms > 0 ? std::clamp(1.0 - std::log10(rms / c.rms_speed_m_s) / 4.0, 0.0, 1.0) : 1.0;
-      progress(phase, std::max(elapsed / c.max_time_s, speed_frac),
+      progress(phase, std::max(elapsed / cap_s, speed_frac),
                fmt::format("t={:.3f}s rms={:.2e}m/s max={:.2e}m/s", elapsed, rms, mx));
     }
     if (elapsed >= min_time_s && rms < c.rms_speed_m_s && mx < c.max_speed_m_s) {
@@ -192,16 +200,27 @@ void stop_grains(System& sys) {
   }
 }
 
-void quench(System& sys, double time_s, double interval_s, const BedProgress& progress) {
+void quench(System& sys, double time_s, double interval_s, const BedProgress& progress, const AdaptiveStep& step) {
   const double dt = sys.config().dt_s;
+  const auto report = [&](double done_s) {
+    if (progress) progress(BedPhase::relax, done_s / time_s, fmt::format("quench: {:.3f} of {:.3f} s", done_s, time_s));
+  };
+  if (step.on()) {
+    const auto intervals = std::max<long long>(1, std::llround(time_s / interval_s));
+    for (long long k = 0; k < intervals; ++k) {
+      sys.advance(choose_step(sys, step, dt, interval_s));
+      stop_grains(sys);
+      report(static_cast<double>(k + 1) * interval_s);
+    }
+    sys.set_dt_s(dt);
+    return;
+  }
   const long long chunk = std::max<long long>(1, std::llround(interval_s / dt));
   const auto steps = static_cast<long long>(std::llround(time_s / dt));
   for (long long k = 0; k < steps; k += chunk) {
     sys.advance(std::min(chunk, steps - k));
     stop_grains(sys);
-    if (progress)
-      progress(BedPhase::relax, static_cast<double>(k) / static_cast<double>(steps),
-               fmt::format("quench: {:.3f} of {:.3f} s", static_cast<double>(k) * dt, time_s));
+    report(static_cast<double>(k) * dt);
   }
 }
 
@@ -269,6 +288,7 @@ BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progr
     throw ConfigError("bed: grain diameter_spread_m must be in [0, diameter/2)");
   if (!(spec.container.diameter_m > 4 * spec.grains.diameter_m))
     throw ConfigError("bed: container diameter_m must exceed 4 grain diameters");
+  check_adaptive_step(spec.time_step, sys.config().dt_s, "bed");
   BedReport rep;
   if (progress) progress(BedPhase::fill, 0.0, "placing grains");
   rep.grains_placed = place_grains(sys, spec);
@@ -299,15 +319,17 @@ BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progr
     rep.surface_relax_s = spec.surface_relax_s;
   }
   const bool quenched = spec.quench_interval_s > 0 && spec.quench_time_s > 0;
+  // The adaptive step (when on) applies at the drop's gravity only: after a ramp.
+  const AdaptiveStep relax_step = spec.relax_gravity_m_s2 ? spec.time_step : AdaptiveStep{};
   if (spec.relax_gravity_m_s2)
     ramp_gravity(sys, *spec.relax_gravity_m_s2, spec.gravity_ramp_s, spec.settle.check_interval_s, progress, quenched);
   if (quenched) {
-    quench(sys, spec.quench_time_s, spec.quench_interval_s, progress);
+    quench(sys, spec.quench_time_s, spec.quench_interval_s, progress, relax_step);
     rep.quench_time_s = spec.quench_time_s;
   }
   const double t1 = sys.time_s();
-  rep.relax_end =
-      settle(sys, spec.settle, spec.relax_time_s, progress, BedPhase::relax, &rep.rms_speed_m_s, &rep.max_speed_m_s);
+  rep.relax_end = settle(sys, spec.settle, spec.relax_time_s, progress, BedPhase::relax, &rep.rms_speed_m_s,
+                         &rep.max_speed_m_s, relax_step);
   rep.relax_time_s = sys.time_s() - t1;
   rep.settled = rep.settle_end == SettleEnd::criteria && rep.relax_end == SettleEnd::criteria;
   rep.grains_kept = sys.particles.size();

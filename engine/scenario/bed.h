@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "engine/scenario/time_step.h"
 #include "engine/system/system.h"
 
 namespace gravsweep {
@@ -65,7 +66,11 @@ struct BedSpec {
   double placement_spacing_diameters = kLatticeSpacingDiameters;
   std::uint64_t seed = 1;
   SettleCriteria settle;
-  double relax_time_s = 0.05;  ///< minimum relaxation after flattening
+  /// Minimum free relaxation after flattening (after the ramp and quench, at the drop's gravity),
+  /// even past settle.max_time_s. At low gravity a grain left perched by the ramp rolls off in a few
+  /// sqrt(d / g) (1 s at 0.01 m/s2, growing from 2e-5 to 3e-4 m/s before it lands) and the bed is
+  /// quiet after: give a low-gravity bed several sqrt(d / g) so that it is not caught mid-roll.
+  double relax_time_s = 0.05;
   std::uint8_t grain_material = 0;
   std::uint8_t wall_material = 1;
   /// When set, gravity switches to this value after flattening, before the relaxation (a bed poured
@@ -94,6 +99,10 @@ struct BedSpec {
   /// A pocket that holds at one gravity holds at any (rigid grains: gravity scales every force of
   /// a contact network at rest alike), so the surface is let settle where it is cheap.
   double surface_relax_s = 0;
+  /// Step of the phases at the drop's gravity after the ramp (the quench and the free relaxation);
+  /// off: dt_s throughout. A bed at 0.001 m/s2 relaxes for tens of seconds in which its fastest
+  /// grain moves at mm/s: at 5 us that is millions of steps for contacts that last ms.
+  AdaptiveStep time_step;
 };
 
 /// Phase of bed preparation, for progress reporting.
@@ -127,9 +136,10 @@ void add_container_walls(System& sys, const ContainerSpec& c, double height_m, s
 std::size_t place_grains(System& sys, const BedSpec& spec);
 
 /// Runs until the grains meet the criteria, reach their creep floor (c.plateau_window_s) or the time
-/// cap, after at least min_time_s; returns which ended it.
+/// cap, after at least min_time_s; returns which ended it. With `step` on, the step is chosen
+/// before each check interval (AdaptiveStep) and the system's step is restored at the end.
 SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress, BedPhase phase,
-                 double* rms_out = nullptr, double* max_out = nullptr);
+                 double* rms_out = nullptr, double* max_out = nullptr, const AdaptiveStep& step = {});
 
 /// Takes gravity from its present value to `to_m_s2` geometrically over ramp_s (same direction; in
 /// any other case, or with ramp_s = 0, at once), advancing the system meanwhile.
@@ -140,8 +150,10 @@ void ramp_gravity(System& sys, const Vec3& to_m_s2, double ramp_s, double interv
 /// Stops each free grain moving against its force, and its spin against its torque (BedSpec quench).
 void stop_grains(System& sys);
 
-/// Runs time_s, applying stop_grains every interval_s (BedSpec::quench_interval_s).
-void quench(System& sys, double time_s, double interval_s, const BedProgress& progress = {});
+/// Runs time_s, applying stop_grains every interval_s (BedSpec::quench_interval_s). With `step`
+/// on, the step is chosen before each interval and the system's step is restored at the end.
+void quench(System& sys, double time_s, double interval_s, const BedProgress& progress = {},
+            const AdaptiveStep& step = {});
 
 /// The whole preparation: walls, placement, settling, flattening, relaxation.
 BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progress = {});

@@ -127,7 +127,7 @@ class DropRun {
  public:
   DropRun(System& sys, const ProjectileSpec& ps, const DropStop& stop, double sample_rate_hz,
           const DropProgress& progress, const DropSnapshots& snapshots, const DropCheckpoints& checkpoints,
-          const DropTimeStep& time_step)
+          const AdaptiveStep& time_step)
       : sys_(sys),
         ps_(ps),
         stop_(stop),
@@ -138,10 +138,8 @@ class DropRun {
         dt_floor_s_(sys.config().dt_s) {
     if (!(sample_rate_hz > 0)) throw ConfigError("drop: sample_rate_hz must be > 0");
     const double dt = sys.config().dt_s;
+    check_adaptive_step(time_step, dt, "drop");
     if (adaptive()) {
-      if (!(time_step.dt_max_s >= dt))
-        throw ConfigError(
-            fmt::format("drop: time step cap dt_max_s = {} s must be >= dt_s = {} s", time_step.dt_max_s, dt));
       sample_dt_ = 1.0 / sample_rate_hz;  // the grid; the steps fill each interval
     } else {
       steps_per_sample_ = std::max<long long>(1, std::llround(1.0 / (sample_rate_hz * dt)));
@@ -188,7 +186,7 @@ class DropRun {
   const DropProgress& progress_;
   const DropSnapshots& snapshots_;
   const DropCheckpoints& checkpoints_;
-  const DropTimeStep& time_step_;
+  const AdaptiveStep& time_step_;
   double dt_floor_s_ = 0;  ///< the System's configured step: the adaptive step's floor
   long long steps_per_sample_ = 1, hold_samples_ = 1, max_samples_ = 0, snapshot_every_ = 0;
   double sample_dt_ = 0;
@@ -216,16 +214,11 @@ class DropRun {
     st_.last_snapshot = k;
   }
 
-  bool adaptive() const { return time_step_.steps_per_contact > 0; }
+  bool adaptive() const { return time_step_.on(); }
 
-  /// With the adaptive step: sets the step for the next sample interval (DropTimeStep).
+  /// With the adaptive step: sets the step for the next sample interval (AdaptiveStep).
   void choose_step() {
-    if (!adaptive()) return;
-    const double v_rel_m_s = 2 * sys_.max_particle_speed_m_s();
-    const double target = std::clamp(sys_.shortest_contact_time_s(v_rel_m_s) / time_step_.steps_per_contact,
-                                     dt_floor_s_, time_step_.dt_max_s);
-    steps_per_sample_ = std::max<long long>(1, static_cast<long long>(std::ceil(sample_dt_ / target - 1e-9)));
-    sys_.set_dt_s(sample_dt_ / static_cast<double>(steps_per_sample_));
+    if (adaptive()) steps_per_sample_ = gravsweep::choose_step(sys_, time_step_, dt_floor_s_, sample_dt_);
   }
 
   /// Advances one sample interval and records it; true when the stop criterion ends the drop.
@@ -275,7 +268,7 @@ DropResult DropRun::run() {
 
 DropResult drop_projectile(System& sys, double surface_height_m, const ProjectileSpec& ps, const DropStop& stop,
                            double sample_rate_hz, const DropProgress& progress, const DropSnapshots& snapshots,
-                           const DropCheckpoints& checkpoints, const DropTimeStep& time_step) {
+                           const DropCheckpoints& checkpoints, const AdaptiveStep& time_step) {
   DropRun run(sys, ps, stop, sample_rate_hz, progress, snapshots, checkpoints, time_step);
   if (checkpoints.resume != nullptr)
     run.resume(*checkpoints.resume);

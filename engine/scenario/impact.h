@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/scenario/time_step.h"
 #include "engine/system/system.h"
 
 namespace gravsweep {
@@ -36,19 +37,6 @@ struct DropStop {
   double hold_time_s = 0.005;  ///< the speed must stay below for this long (guards
                                ///< against stopping at the turning point of a bounce)
   double max_time_s = 1.0;     ///< cap on simulated time after release
-};
-
-/// Time step of the drop. Off (steps_per_contact = 0): the System's dt_s throughout. On: before
-/// each sample interval the step becomes the shortest contact time of the pairs present at twice
-/// the fastest particle's speed (an upper bound of any relative normal speed in the next interval,
-/// the projectile's own included) divided by steps_per_contact, never below the System's dt_s
-/// (the validated fixed step) nor above dt_max_s, and shortened so that a whole number of steps
-/// fills the interval (the samples stay on their grid). A Hertz contact lasts longer as the speed
-/// falls (t_H ~ v^(-1/5)): at 0.001 m/s2 and Froude number 1 (0.01 m/s) 2.6 times longer than at
-/// 1.2 m/s. The resulting step depends only on the state, so a resumed drop takes the same steps.
-struct DropTimeStep {
-  double steps_per_contact = 0;  ///< 0: off
-  double dt_max_s = 0;           ///< cap on the step (with steps_per_contact > 0; must be >= dt_s)
 };
 
 /// One sample of the projectile (paper frame: z positive down from the bed surface, velocity
@@ -142,11 +130,12 @@ struct DropCheckpoints {
 /// Adds the projectile to the bed held by `sys` (grains + container walls), releases it and runs
 /// to the stop criterion or the time cap. `surface_height_m` is the bed's mean surface (engine z).
 /// Snapshots of a resumed drop are those from the resume on (the earlier ones were the earlier
-/// run's); its samples are all of them.
+/// run's); its samples are all of them. time_step on: the step is chosen before each sample
+/// interval (AdaptiveStep, a whole number of steps per sample).
 DropResult drop_projectile(System& sys, double surface_height_m, const ProjectileSpec& projectile, const DropStop& stop,
                            double sample_rate_hz, const DropProgress& progress = {},
                            const DropSnapshots& snapshots = {}, const DropCheckpoints& checkpoints = {},
-                           const DropTimeStep& time_step = {});
+                           const AdaptiveStep& time_step = {});
 
 /// Kinetic energy (translational + rotational) of the free grains.
 double grain_kinetic_energy_J(const System& sys);

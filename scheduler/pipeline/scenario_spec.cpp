@@ -494,6 +494,13 @@ ScenarioParams scenario_params(const json& s) {
   }
   // Optional and without a default (0 = none), so that the bed keys of existing beds stay.
   b.surface_relax_s = bj.value("surface_relax_s", 0.0);
+  if (bj.contains("time_step")) {
+    b.time_step.steps_per_contact = bj["/time_step/steps_per_contact"_json_pointer];
+    b.time_step.dt_max_s = bj["/time_step/dt_max_s"_json_pointer];
+    if (b.time_step.dt_max_s < bj.at("dt_s").get<double>())
+      throw ConfigError(fmt::format("/bed/time_step/dt_max_s = {} s is invalid: expected at least /bed/dt_s = {} s",
+                                    b.time_step.dt_max_s, bj.at("dt_s").get<double>()));
+  }
 
   const json& pj = s.at("projectile");
   ProjectileSpec& ps = out.projectile;

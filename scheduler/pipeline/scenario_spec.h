@@ -61,7 +61,7 @@ struct ScenarioParams {
   BedSpec bed;
   ProjectileSpec projectile;  ///< with its random offsets drawn from projectile.seed
   DropStop stop;
-  DropTimeStep time_step;  ///< /time_step (off when absent)
+  AdaptiveStep time_step;  ///< /time_step (off when absent)
   AtRestCriterion at_rest;
   double gravity_m_s2 = 9.81;
   double sample_rate_hz = 1e4;

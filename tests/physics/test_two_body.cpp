@@ -112,7 +112,7 @@ TEST(HertzDuration, DampedTableValues) {
   EXPECT_NEAR(impact(two_material_config("hertz", 0.5, 0.0), 1.2, true).contact_time_s, 227e-6, 0.02 * 227e-6);
 }
 
-// The adaptive drop step (engine/scenario/impact.h, DropTimeStep) rests on the law's shortest
+// The adaptive drop step (engine/scenario/time_step.h, AdaptiveStep) rests on the law's shortest
 // contact time of the pairs present: for two elastic beads it is the measured duration of their
 // collision (within 2 %, as the theory above), the Hertz one growing as v^(-1/5) and the Hooke
 // one the same at every speed.

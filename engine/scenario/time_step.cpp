@@ -1,0 +1,31 @@
+#include "engine/scenario/time_step.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "engine/core/error.h"
+
+namespace gravsweep {
+
+long long choose_step(System& sys, const AdaptiveStep& rule, double fixed_dt_s, double interval_s) {
+  if (!rule.on()) {
+    sys.set_dt_s(fixed_dt_s);
+    return std::max<long long>(1, std::llround(interval_s / fixed_dt_s));
+  }
+  const double v_rel_m_s = 2 * sys.max_particle_speed_m_s();
+  const double target =
+      std::clamp(sys.shortest_contact_time_s(v_rel_m_s) / rule.steps_per_contact, fixed_dt_s, rule.dt_max_s);
+  const auto steps = std::max<long long>(1, static_cast<long long>(std::ceil(interval_s / target - 1e-9)));
+  sys.set_dt_s(interval_s / static_cast<double>(steps));
+  return steps;
+}
+
+void check_adaptive_step(const AdaptiveStep& rule, double fixed_dt_s, const char* what) {
+  if (rule.on() && !(rule.dt_max_s >= fixed_dt_s))
+    throw ConfigError(
+        fmt::format("{}: time step cap dt_max_s = {} s must be >= dt_s = {} s", what, rule.dt_max_s, fixed_dt_s));
+}
+
+}  // namespace gravsweep
