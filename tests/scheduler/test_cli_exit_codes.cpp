@@ -3,7 +3,10 @@
 // std::exit in a callback, and what they printed before is still there. Real processes, real files.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cctype>
 #include <csignal>
+#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -149,4 +152,26 @@ TEST(ExitCodes, UnknownFormatIsRefusedWithExit2AndOneMessageByEveryVerb) {
   EXPECT_EQ(results.err, terms.err);
   EXPECT_TRUE(results.out.empty()) << results.out;
   EXPECT_FALSE(fs::exists(d.path / "absent.db"));
+}
+
+// The code version every run and attempt records is the source tree's at build time: it was taken
+// when CMake configured, so a build after a commit or an edit kept the older version (a campaign
+// binary built from a clean commit said "-dirty" and another commit's hash).
+TEST(Version, IsTheSourceTreesAtBuildTime) {
+  const std::string cmd =
+      std::string("git -C '") + GRAVSWEEP_SOURCE_DIR + "' describe --always --dirty --abbrev=12 2>/dev/null";
+  std::string described;
+  if (FILE* p = popen(cmd.c_str(), "r")) {
+    std::array<char, 256> buf{};
+    while (fgets(buf.data(), buf.size(), p)) described += buf.data();
+    pclose(p);
+  }
+  while (!described.empty() && std::isspace(static_cast<unsigned char>(described.back()))) described.pop_back();
+  if (described.empty()) GTEST_SKIP() << "the source tree is not a git checkout";
+  TempDir dir("gravsweep-version");
+  const CmdResult r = run_cli({"--version"}, dir.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("+" + described), std::string::npos)
+      << "gravsweep --version says " << r.out << "; the tree is " << described
+      << " (rebuild: the version is taken at every build)";
 }
