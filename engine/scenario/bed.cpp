@@ -134,13 +134,8 @@ const char* to_string(SettleEnd e) {
 
 SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress, BedPhase phase,
                  double* rms_out, double* max_out, const AdaptiveStep& step) {
-  const double dt = sys.config().dt_s;
-  // The run's own step is the adaptive step's floor and comes back at the end.
-  struct StepScope {
-    System& sys;
-    double kept_s;
-    ~StepScope() { sys.set_dt_s(kept_s); }
-  } step_scope{sys, dt};
+  const double dt = sys.config().dt_s;  // the adaptive step's floor, and the step after this phase
+  const AdaptiveStepScope step_scope(sys);
   // The settling threshold of rolling friction holds for this phase only (SettleCriteria).
   struct ThresholdScope {
     System& sys;
@@ -206,13 +201,13 @@ void quench(System& sys, double time_s, double interval_s, const BedProgress& pr
     if (progress) progress(BedPhase::relax, done_s / time_s, fmt::format("quench: {:.3f} of {:.3f} s", done_s, time_s));
   };
   if (step.on()) {
+    const AdaptiveStepScope step_scope(sys);
     const auto intervals = std::max<long long>(1, std::llround(time_s / interval_s));
     for (long long k = 0; k < intervals; ++k) {
       sys.advance(choose_step(sys, step, dt, interval_s));
       stop_grains(sys);
       report(static_cast<double>(k + 1) * interval_s);
     }
-    sys.set_dt_s(dt);
     return;
   }
   const long long chunk = std::max<long long>(1, std::llround(interval_s / dt));

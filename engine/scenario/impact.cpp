@@ -255,6 +255,7 @@ bool DropRun::next_sample(long long k) {
 }
 
 DropResult DropRun::run() {
+  const AdaptiveStepScope step_scope(sys_);  // the System leaves the drop at its configured step
   st_.result.samples.reserve(static_cast<std::size_t>(std::min<long long>(max_samples_ + 2, 1 << 22)));
   for (long long k = st_.samples_done + 1; k <= max_samples_; ++k)
     if (next_sample(k)) break;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -9,15 +10,18 @@
 
 namespace gravsweep {
 
+namespace {
+/// Relative slack of the whole-step count, so that an interval that is an exact multiple of the
+/// target in decimal arithmetic is not given one more step by round-off.
+constexpr double kWholeStepSlack = 1e-9;
+}  // namespace
+
 long long choose_step(System& sys, const AdaptiveStep& rule, double fixed_dt_s, double interval_s) {
-  if (!rule.on()) {
-    sys.set_dt_s(fixed_dt_s);
-    return std::max<long long>(1, std::llround(interval_s / fixed_dt_s));
-  }
+  if (!rule.on()) throw std::logic_error("choose_step: the adaptive step is off");
   const double v_rel_m_s = 2 * sys.max_particle_speed_m_s();
   const double target =
       std::clamp(sys.shortest_contact_time_s(v_rel_m_s) / rule.steps_per_contact, fixed_dt_s, rule.dt_max_s);
-  const auto steps = std::max<long long>(1, static_cast<long long>(std::ceil(interval_s / target - 1e-9)));
+  const auto steps = std::max<long long>(1, static_cast<long long>(std::ceil(interval_s / target - kWholeStepSlack)));
   sys.set_dt_s(interval_s / static_cast<double>(steps));
   return steps;
 }

@@ -8,23 +8,37 @@
 
 namespace gravsweep {
 
-/// Before each interval the step becomes the shortest contact time of the pairs present at twice
-/// the fastest particle's speed (an upper bound of any relative normal speed in the interval)
-/// divided by steps_per_contact, never below the run's fixed step (the validated one) nor above
-/// dt_max_s, and shortened so that a whole number of steps fills the interval (samples and checks
-/// stay on their grid). The step depends only on the state, so a resumed run takes the same steps.
-/// Resting contacts oscillate at a period set by their static overlap, which the speed does not
-/// see: dt_max_s bounds the step for them (5e-5 s: more than 10 steps per period of a grain under
-/// 20 layers of grains at 9.81 m/s2, more at lower gravity, where overlaps scale as (m g)^(2/3)).
+/// Before each interval (of the order of a millisecond: a trace sample, a quench, a settling
+/// check) the step target is the shortest contact time of the pairs present at twice the fastest
+/// particle's speed (a bound of any relative normal speed over so short an interval) divided by
+/// steps_per_contact, clamped between the run's fixed step (the validated one) and dt_max_s; the
+/// interval is then filled with the fewest whole steps no longer than the target (so a step may
+/// come out a little below the fixed one; samples and checks stay on their grid). The step depends only on the state,
+/// so a resumed run takes the same steps. Resting contacts oscillate at a period set by their static overlap, which the
+/// speed does not see: dt_max_s bounds the step for them (5e-5 s: more than 10 steps per period of a grain under 20
+/// layers of grains at 9.81 m/s2, more at lower gravity, where overlaps scale as (m g)^(2/3)).
 struct AdaptiveStep {
   double steps_per_contact = 0;  ///< 0: off (the fixed step throughout)
   double dt_max_s = 0;           ///< cap on the step (must be >= the fixed step when on)
   [[nodiscard]] bool on() const { return steps_per_contact > 0; }
 };
 
-/// With the rule on: sets sys's step for the next interval_s (never below fixed_dt_s) and returns
-/// the number of steps that fill it. Off: the fixed step, and interval_s / fixed_dt_s rounded.
+/// Sets sys's step for the next interval_s by the rule (which must be on) and returns the number
+/// of steps that fill it.
 long long choose_step(System& sys, const AdaptiveStep& rule, double fixed_dt_s, double interval_s);
+
+/// Puts the System's configured step back when it goes out of scope (System::end_adaptive_step):
+/// whatever ends a phase run at the adaptive step, the next phase starts at the fixed one.
+class AdaptiveStepScope {
+ public:
+  explicit AdaptiveStepScope(System& sys) : sys_(sys) {}
+  ~AdaptiveStepScope() { sys_.end_adaptive_step(); }
+  AdaptiveStepScope(const AdaptiveStepScope&) = delete;
+  AdaptiveStepScope& operator=(const AdaptiveStepScope&) = delete;
+
+ private:
+  System& sys_;
+};
 
 /// Throws ConfigError naming `what` when the rule is on and dt_max_s < fixed_dt_s.
 void check_adaptive_step(const AdaptiveStep& rule, double fixed_dt_s, const char* what);

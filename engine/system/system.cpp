@@ -115,7 +115,8 @@ void System::initialize() {
     is_wall[m] = false;  // a material used by particles is checked as a particle material
   }
   check_contact_law(config_.contact_law,
-                    LawSetup{config_.materials, pairs_, min_r, min_m, is_wall, config_.dt_s, config_.check_time_step});
+                    LawSetup{config_.materials, pairs_, min_r, min_m, is_wall,
+                             adaptive_step_ ? fixed_dt_s_ : config_.dt_s, config_.check_time_step});
   force_fn_ = select_force_function(config_.contact_law, config_.rolling_model);
   prepare_contact_law(config_.contact_law, pairs_);
   integrator_ = make_integrator(config_.integrator);

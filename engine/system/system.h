@@ -85,9 +85,20 @@ class System {
   }
   /// Changes gravity between steps without re-initialising (gravity enters only the force sum).
   void set_gravity(const Vec3& g_m_s2) { config_.gravity_m_s2 = g_m_s2; }
-  /// Changes the time step between steps without re-initialising (an adaptive step: the law's
-  /// stability check ran at initialisation on the configured dt_s; the caller bounds this one).
-  void set_dt_s(double dt_s) { config_.dt_s = dt_s; }
+  /// Changes the time step between steps without re-initialising (an adaptive step, bounded by
+  /// its caller). The contact law's step check keeps testing the step configured before the first
+  /// change (a re-initialisation mid-run, after grains are removed, must not hold a grown step
+  /// against the fixed-step bound) until end_adaptive_step() puts that step back.
+  void set_dt_s(double dt_s) {
+    if (!adaptive_step_) fixed_dt_s_ = config_.dt_s;
+    adaptive_step_ = true;
+    config_.dt_s = dt_s;
+  }
+  /// Back to the step configured before set_dt_s (no-op when the step was never changed).
+  void end_adaptive_step() {
+    if (adaptive_step_) config_.dt_s = fixed_dt_s_;
+    adaptive_step_ = false;
+  }
   /// The contact law's shortest contact time over the pairs present at relative normal speed
   /// v_rel_m_s (contact registry, shortest_contact_time_s), initialising first if needed.
   [[nodiscard]] double shortest_contact_time_s(double v_rel_m_s);
@@ -127,6 +138,8 @@ class System {
   double time_s_ = 0;
   long long step_ = 0;
   bool initialized_ = false;
+  bool adaptive_step_ = false;  ///< set_dt_s changed the step; fixed_dt_s_ is the configured one
+  double fixed_dt_s_ = 0;
   bool have_forces_ = false;
 
   /// Particle-wall pairs within reach (radius + skin) of the wall at the last list build; only

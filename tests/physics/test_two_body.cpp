@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "engine/core/error.h"
 #include "physics_helpers.h"
 
 using namespace gravsweep;
@@ -133,4 +134,30 @@ TEST(HertzDuration, TheSystemsShortestContactTimeIsTheMeasuredOne) {
   System none(two_material_config("hertz", 1.0, 0.0));
   none.particles.add(Vec3::Zero(), kBeadRadius_m, bead_mass_kg(), 0, SizeClass::grain);
   EXPECT_TRUE(std::isinf(none.shortest_contact_time_s(0.0)));  // nothing moves: no contact to resolve
+}
+
+// A step grown past the fixed-step stability bound (the law's check: 0.3 Rayleigh times, ~15 us
+// for these beads) is the adaptive rule's to bound: when grains are removed mid-run (a grain
+// spilled over the rim) and the System re-initialises, the law's check still tests the configured
+// step, not the grown one; end_adaptive_step() puts the configured step back.
+TEST(HertzDuration, AGrownStepSurvivesAReinitialisationMidRun) {
+  auto cfg = two_material_config("hertz", 1.0, 0.0);
+  cfg.dt_s = 5e-6;
+  System s(cfg);
+  const double m = bead_mass_kg();
+  for (int i = 0; i < 3; ++i) s.particles.add(Vec3(0, 0, 3 * i * kBeadRadius_m), kBeadRadius_m, m, 0, SizeClass::grain);
+  s.advance(1);
+  s.set_dt_s(4e-5);  // what the rule reaches at low gravity with a 50 us cap
+  s.advance(1);
+  s.remove_particles({false, false, true});
+  EXPECT_NO_THROW((void)s.shortest_contact_time_s(0.01));
+  EXPECT_NO_THROW(s.advance(1));
+  EXPECT_EQ(s.config().dt_s, 4e-5);
+  s.end_adaptive_step();
+  EXPECT_EQ(s.config().dt_s, 5e-6);
+  s.set_dt_s(4e-5);
+  s.end_adaptive_step();
+  auto& bad = s.mutable_config();  // a configured step above the bound is still refused
+  bad.dt_s = 4e-5;
+  EXPECT_THROW(s.advance(1), ConfigError);
 }

@@ -322,4 +322,16 @@ TEST(ScenarioSpec, JsonSyntaxErrorsNameFileLineAndColumn) {
 }
 
 }  // namespace
+
+TEST(ScenarioSpec, AnAdaptiveStepsCapBelowTheFixedStepIsRefusedAtValidation) {
+  json s = minimal();
+  s["time_step"] = {{"steps_per_contact", 20}, {"dt_max_s", 5e-7}};  // the default dt_s is 1 us
+  refused_at(s, "/time_step/dt_max_s");
+  s = minimal();
+  s["bed"]["time_step"] = {{"steps_per_contact", 20}, {"dt_max_s", 2e-6}};  // the bed's default is 5 us
+  refused_at(s, "/bed/time_step/dt_max_s");
+  s["bed"]["time_step"]["dt_max_s"] = 5e-5;
+  EXPECT_NO_THROW(validate_scenario(s));
+}
+
 }  // namespace gravsweep

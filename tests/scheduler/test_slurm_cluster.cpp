@@ -212,13 +212,15 @@ TEST_F(ClusterFixture, ATaskKilledAtItsTimeLimitLosesNothing) {
 }
 
 TEST_F(ClusterFixture, ADropLongerThanATaskTimeLimitCompletesAcrossTasksFromItsCheckpoints) {
-  // One drop needing about three times a task's 1-minute limit (90 s simulated at 1 m/s2, about
-  // 1.9 s of wall time each on one thread here; a stop speed no grain jitter falls below, so it
-  // runs to the cap; 200 Hz trace). Tasks are submitted one after the other: each is stopped at its
-  // time limit (SIGTERM), checkpoints the drop and gives its lease back; the next one continues.
+  // One drop needing several times a task's 1-minute limit (180 s simulated at 1 m/s2, about
+  // 1.7-1.9 s of wall time each on one thread here; a stop speed no grain jitter falls below, so
+  // it runs to the cap; 200 Hz trace). Slurm ends a task some time after its limit (its timer
+  // ticks, then SIGTERM and KillWait): two tasks once held 155 s of a drop, so the drop is long
+  // enough to outlast two tasks however late they are stopped. Tasks are submitted one after the other: each is stopped
+  // at its time limit (SIGTERM), checkpoints the drop and gives its lease back; the next one continues.
   json base = json::parse(tiny_base());
   base["gravity_m_s2"] = 1.0;
-  base["stop"] = {{"max_time_s", 90.0}, {"speed_m_s", 1e-12}, {"hold_time_s", 10.0}};
+  base["stop"] = {{"max_time_s", 180.0}, {"speed_m_s", 1e-12}, {"hold_time_s", 10.0}};
   base["at_rest"] = {{"surface_speed_fraction", 1.0}, {"rms_speed_fraction", 1.0}};  // a quick test bed
   base["output"] = {{"sample_rate_hz", 200.0}, {"filter_cutoff_hz", 50.0}};
   json doc = {
