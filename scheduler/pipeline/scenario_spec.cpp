@@ -213,7 +213,7 @@ void engine_checks(const json& s, Checks& ck) {
 
 /// engine_checks of scenarios that agree in every field it reads (and in which of them are sound)
 /// runs once: it builds an engine System four times, and a sweep's points differ in impact speeds,
-/// seeds and offsets, which it does not read (issue 33 item 13: 200,000 points built 800,000
+/// seeds and offsets, which it does not read (a sweep of 200,000 points built 800,000
 /// Systems). The problems it found are kept (up to kEngineCheckMemo scenarios) and given again.
 std::atomic<std::size_t> g_engine_check_runs{0};
 
@@ -255,7 +255,7 @@ void engine_checks_once(const json& s, Checks& ck, std::vector<SpecProblem>& pro
 }
 
 /// Refuses a bed that cannot fit this machine's memory, and time steps too small to finish, before
-/// any work (issue #10 item 10). Grains: random close packing (0.64) of the fill, twice over for
+/// any work. Grains: random close packing (0.64) of the fill, twice over for
 /// the lattice poured above the fill height; ~2 kB per grain (state, Verlet pairs with contact
 /// history, per-thread force buffers).
 void check_size_and_steps(Checks& ck) {

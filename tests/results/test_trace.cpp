@@ -314,7 +314,7 @@ Trace dem_record(const Poncelet& p, double fs, double t_contact) {
 
 }  // namespace
 
-// Issue #11: a DEM drop released 1 mm above the bed falls for 1-6 ms; the 500 Hz filter's edge
+// A DEM drop released 1 mm above the bed falls for 1-6 ms; the 500 Hz filter's edge
 // leaves no -g sample before the peak, so the paper's free-fall rule finds no start. The engine's
 // first contact gives it.
 TEST(Metrics, ADemRecordWithAShortFreeFallStartsAtTheEnginesFirstContact) {
@@ -364,8 +364,8 @@ TraceError error_of(const Trace& tr, const MetricOptions& o) {
 
 }  // namespace
 
-// Issue 10 item 12: no free fall, no contact, a 1e308 sample and a record that ends inside the
-// collision were all "trace shorter than the collision"; each has its own reason and sample.
+// No free fall, no contact, a 1e308 sample and a record that ends inside the collision: each has
+// its own reason and sample, not one "trace shorter than the collision" for all.
 TEST(Metrics, EachUnmeasurableRecordGetsItsOwnReasonAndSample) {
   Poncelet p;
   MetricOptions o;
