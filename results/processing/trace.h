@@ -2,9 +2,9 @@
 // code processes DEM traces (results of `gravsweep run`) and laboratory accelerometer records.
 //
 // Conventions: depth z positive DOWN, zero at the bed surface; velocity positive down;
-// acceleration as the accelerometer format (shared/formats/measurements.md): the projectile's
-// vertical kinematic acceleration, positive UP, so free fall reads -g and rest reads 0.
-// (Equivalently accel_up = -dv_down/dt.)
+// acceleration as the accelerometer format (docs/formats/measurements.md section 3.2): the
+// projectile's vertical kinematic acceleration, positive UP, so free fall reads -g and rest
+// reads 0. (Equivalently accel_up = -dv_down/dt.)
 #pragma once
 #include <cstddef>
 #include <optional>

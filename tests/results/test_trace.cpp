@@ -1,6 +1,7 @@
 // Trace processing (results/processing/trace.h) on analytic Poncelet traces: Sunday et al. 2021
-// Eqs. 2-4 / force-laws.md 2.3-A give apeak, zstop and tstop exactly; the paper's processing
-// (500 Hz Butterworth, free-fall start, 0.1 g end, integration from vc) must recover them.
+// Eqs. 2-4 / docs/physics/force-laws.md section 2.3 A give apeak, zstop and tstop exactly; the
+// paper's processing (500 Hz Butterworth, free-fall start, 0.1 g end, integration from vc) must
+// recover them.
 #include <gtest/gtest.h>
 
 #include <cmath>
