@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Campaign wall time with and without the thread pool (issue 12, "no idle core"): runs SPEC from an
+# Campaign wall time with and without the thread pool ("no idle core"): runs SPEC from an
 # empty database in each mode, ROUNDS times (default 1), alternating which mode goes first, and
 # prints the wall times:
 #   pooled:   gravsweep work --workers 2 --threads 1   (the supervisor passes --pool-threads 2: a bed

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Wall time of the first SECONDS of a drop, for BENCHMARKS.md (issue 12): ROUNDS rounds (default 4)
+# Wall time of the first SECONDS of a drop, for BENCHMARKS.md: ROUNDS rounds (default 4)
 # of `gravsweep run SPEC --bed BED --threads 2 --snapshot-interval 0` with SPEC's /stop/max_time_s
 # cut to SECONDS (default 0.12), interleaved with a second binary when one is given; then the
 # minimum and median wall seconds of each binary and its projectile's deepest point (the same

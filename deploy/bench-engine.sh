@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Engine speed on a settled bed, for BENCHMARKS.md (issue 12): ROUNDS rounds (default 3) of
+# Engine speed on a settled bed, for BENCHMARKS.md: ROUNDS rounds (default 3) of
 # `gravsweep bench --bed BED --steps STEPS --threads 1,2`, interleaved with a second binary when
 # one is given (e.g. a build of main, to compare before/after on the same machine state), then the
 # median ns per particle-step and the bytes per particle of each binary and thread count.

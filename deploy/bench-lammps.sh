@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Side-by-side speed of gravsweep and LAMMPS GRANULAR on the same settled bed (issue 12).
+# Side-by-side speed of gravsweep and LAMMPS GRANULAR on the same settled bed.
 #
 #   deploy/bench-lammps.sh BED.h5 [ROUNDS] [STEPS] [WARMUP]
 #

@@ -7,7 +7,7 @@
 #      import, rank the candidate terms, fit base vs base+depth_friction, write the report,
 #   5. the same questions of the gravity sweep itself: every finished drop of the campaign
 #      database is a trial (model rank, Table 3, report), and the repeats' means per group,
-#   6. figures (issue 15): the campaign's metrics against vc, and one demo drop (`gravsweep run`
+#   6. figures: the campaign's metrics against vc, and one demo drop (`gravsweep run`
 #      on the campaign's 1 g bed at 1 m/s): Fig. 2, Fig. 1 and its ParaView snapshots; the
 #      report's index.html opened in headless chromium when it is installed. Paths are printed;
 #      nothing here is committed (runs/ is not tracked).

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The paper's simulation campaign (Sunday et al. 2021; issue #11), run with gravsweep itself.
+# The paper's simulation campaign (Sunday et al. 2021), run with gravsweep itself.
 #
 #   deploy/reproduce.sh run      submit every part of examples/reproduction/ and run the workers
 #                                (hours on 2 cores; kill it any time, run it again to resume)

@@ -216,7 +216,7 @@ const json& SchemaValidator::resolved(const json& s, json& storage) const {
 void SchemaValidator::check(json& node, const json& schema_in, const std::string& ptr,
                             std::vector<SpecProblem>& problems) const {
   // The schema node itself, not a copy (a copy of every subschema at every node of every
-  // instance was most of a sweep's validation time, issue 33 item 13); a merge only at a $ref.
+  // instance was most of a large sweep's validation time); a merge only at a $ref.
   json merged;
   const json& s = resolved(schema_in, merged);
   if (!check_type(node, s, ptr, problems)) return;  // nothing below a wrong type is checked

@@ -44,7 +44,7 @@ struct FrameHistory {
 
 /// Law-wide switches, shared by all pairs.
 struct ContactOptions {
-  bool clamp_normal = false;         ///< clamp F_n >= 0 (Chrono does not; dem-physics.md 4.2)
+  bool clamp_normal = false;         ///< clamp F_n >= 0 (Chrono does not; docs/physics/contact-laws.md 4.2)
   double min_slip_vel_m_s = 1e-4;    ///< Chrono min_slip_vel
   double min_roll_vel_m_s = 1e-4;    ///< Chrono min_roll_vel
   double min_spin_vel_rad_s = 1e-4;  ///< Chrono min_spin_vel

@@ -2,10 +2,10 @@
 // a time, structure of arrays, so the compiler vectorises the arithmetic across contacts (8
 // doubles per AVX-512 instruction: the square roots and divisions that bound the scalar kernel
 // run 8 at a time). The same formulas as HertzChrono::evaluate and RollingSunday::apply
-// (dem-physics.md 1.3-1.5); every branch is a per-lane select. The force loop fills a batch with
-// the touching pairs (gathering positions, velocities, coefficients and histories), calls
-// compute(), then scatters forces, torques and histories back in the order of the list, so the
-// sums keep the order of the scalar loop. Walls keep the scalar kernel.
+// (docs/physics/contact-laws.md sections 1.3-1.5); every branch is a per-lane select. The force
+// loop fills a batch with the touching pairs (gathering positions, velocities, coefficients and
+// histories), calls compute(), then scatters forces, torques and histories back in the order of the
+// list, so the sums keep the order of the scalar loop. Walls keep the scalar kernel.
 //
 // Rounding differs from the scalar kernel (reciprocals multiplied instead of three divisions,
 // FMA contraction of other expressions): tests/unit/test_hertz_batch.cpp bounds the difference
@@ -50,7 +50,8 @@ struct HertzBatch {
 
   [[nodiscard]] bool full() const { return count == kSize; }
 
-  /// HertzChrono's activation gate t_collision of a new contact (hertz_chrono.h, dem-physics 1.5).
+  /// HertzChrono's activation gate t_collision of a new contact (hertz_chrono.h,
+  /// docs/physics/contact-laws.md section 1.5).
   static double gate_s(double E_eff_Pa, double damping_n, double R_eff_m, double m_eff_kg) {
     const double kn_s = (4.0 / 3.0) * E_eff_Pa * std::sqrt(R_eff_m);
     const double gn_s = damping_n * std::sqrt(2.0 * E_eff_Pa * std::sqrt(R_eff_m) * m_eff_kg);
@@ -135,7 +136,7 @@ void HertzBatch::compute(const ContactOptions& opt, double dt_s) {
     const double vrz = dvz[b] + (bx * s2y - by * s2x) - (ax * s1y - ay * s1x);
     const double v_n = vrx * nx + vry * ny + vrz * nz;
     const double vtx = vrx - v_n * nx, vty = vry - v_n * ny, vtz = vrz - v_n * nz;
-    // Stiffness and damping (dem-physics.md 1.3).
+    // Stiffness and damping (docs/physics/contact-laws.md section 1.3).
     const double sqrt_Rd = std::sqrt(Reff * delta);
     const double Sn = 2.0 * E[b] * sqrt_Rd;
     const double kt = 8.0 * G[b] * sqrt_Rd;

@@ -1,5 +1,6 @@
 // `hertz`: Chrono::Multicore SMC, Hertz law on the material-property path, MultiStep tangential
-// history. Exactly as dem-physics.md 1.3-1.5 (Chrono ChIterativeSolverMulticoreSMC.cpp).
+// history. Exactly as docs/physics/contact-laws.md sections 1.3-1.5
+// (Chrono ChIterativeSolverMulticoreSMC.cpp).
 #pragma once
 #include <fmt/format.h>
 
@@ -41,16 +42,18 @@ struct HertzChrono {
     return (8.0 / 15.0) * c.E_eff_Pa * std::sqrt(g.R_eff_m) * d * d * std::sqrt(d);
   }
 
-  /// Rayleigh time T_R = pi R sqrt(rho/G) / (0.1631 nu + 0.8766), G = E / (2(1+nu)) (dem-physics 4.3).
+  /// Rayleigh time T_R = pi R sqrt(rho/G) / (0.1631 nu + 0.8766), G = E / (2(1+nu))
+  /// (docs/physics/contact-laws.md section 3.1).
   static double rayleigh_time_s(const Material& m, double radius_m) {
     const double G = m.young_modulus_Pa / (2 * (1 + m.poisson_ratio));
     return kPi * radius_m * std::sqrt(m.density_kg_m3 / G) / (0.1631 * m.poisson_ratio + 0.8766);
   }
 
   /// Shortest elastic contact time of the pairs present at relative normal speed v_rel_m_s:
-  /// t_H = 2.868 (m*^2 / (R* E*^2 v))^(1/5) (Johnson 1985; dem-physics.md 4.1), from each
-  /// particle material's smallest radius and mass (a wall: infinite mass and radius). t_H grows
-  /// as v^(-1/5): 2.6 times longer at 0.01 m/s than at 1.2 m/s. Infinite for v_rel_m_s <= 0.
+  /// t_H = 2.868 (m*^2 / (R* E*^2 v))^(1/5)
+  /// (Johnson 1985; docs/physics/contact-laws.md section 4.1), from each particle material's
+  /// smallest radius and mass (a wall: infinite mass and radius). t_H grows as v^(-1/5): 2.6 times
+  /// longer at 0.01 m/s than at 1.2 m/s. Infinite for v_rel_m_s <= 0.
   static double shortest_contact_time_s(const LawSetup& s, double v_rel_m_s) {
     double t = kInf;
     if (!(v_rel_m_s > 0)) return t;
@@ -96,7 +99,7 @@ struct HertzChrono {
     const double v_n = v_rel.dot(n);  // negative while approaching
     const Vec3 v_t = v_rel - v_n * n;
 
-    // Stiffness and damping, dem-physics.md 1.3.
+    // Stiffness and damping, docs/physics/contact-laws.md section 1.3.
     const double sqrt_Rd = std::sqrt(g.R_eff_m * delta);
     const double Sn = 2.0 * c.E_eff_Pa * sqrt_Rd;
     const double St = 8.0 * c.G_eff_Pa * sqrt_Rd;

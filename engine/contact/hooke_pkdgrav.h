@@ -1,6 +1,7 @@
 // `hooke`: pkdgrav SSDEM linear spring-dashpot (Schwartz et al. 2012), exactly as
-// dem-physics.md 2.1-2.2 (pkdgrav smoothfcn.c DoDEM): damping from the normal and tangential
-// restitution, tangential spring rotated with the contact frame and reset to zero on slip.
+// docs/physics/contact-laws.md sections 2.1-2.2 (pkdgrav smoothfcn.c DoDEM): damping from the
+// normal and tangential restitution, tangential spring rotated with the contact frame and reset to
+// zero on slip.
 #pragma once
 #include <fmt/format.h>
 
@@ -20,7 +21,8 @@ struct HookePkdgrav {
   /// Needs FrameHistory stored per contact (contact.h).
   static constexpr bool uses_frame_history = true;
 
-  /// C = 2 |ln e| sqrt(k mu / (pi^2 + ln^2 e)) = prefactor * sqrt(k mu)  (dem-physics.md 2.1).
+  /// C = 2 |ln e| sqrt(k mu / (pi^2 + ln^2 e)) = prefactor * sqrt(k mu)
+  /// (docs/physics/contact-laws.md section 2.1).
   static double damping_prefactor(double cor) {
     const double loge = std::log(cor);
     return 2.0 * std::abs(loge) / std::sqrt(kPi * kPi + loge * loge);
@@ -37,7 +39,8 @@ struct HookePkdgrav {
     return 0.5 * c.kn_N_m * g.overlap_m * g.overlap_m;
   }
 
-  /// Linear-contact duration t_c = pi sqrt(mu/k) sqrt(1 + ln^2 e / pi^2) (dem-physics.md 2.4).
+  /// Linear-contact duration t_c = pi sqrt(mu/k) sqrt(1 + ln^2 e / pi^2)
+  /// (docs/physics/contact-laws.md section 2.4).
   static double contact_time_s(double k_N_m, double m_eff_kg, double cor) {
     const double loge = std::log(cor);
     return kPi * std::sqrt(m_eff_kg / k_N_m) * std::sqrt(1 + loge * loge / (kPi * kPi));

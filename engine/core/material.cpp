@@ -11,7 +11,8 @@ namespace gravsweep {
 
 PairCoefficients compose_pair(const Material& a, const Material& b, const PairOverride* ov) {
   PairCoefficients c;
-  // Hertz composition of elastic moduli (Chrono ChContactMaterialCompositeSMC, dem-physics.md 1.2).
+  // Hertz composition of elastic moduli (Chrono ChContactMaterialCompositeSMC,
+  // docs/physics/contact-laws.md section 1.2).
   const double inv_E = (1 - a.poisson_ratio * a.poisson_ratio) / a.young_modulus_Pa +
                        (1 - b.poisson_ratio * b.poisson_ratio) / b.young_modulus_Pa;
   const double inv_G = 2 * (2 - a.poisson_ratio) * (1 + a.poisson_ratio) / a.young_modulus_Pa +

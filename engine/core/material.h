@@ -2,7 +2,7 @@
 //
 // Each particle and each wall has a material. Contact coefficients are stored per *pair* of
 // materials (grain-grain, grain-wall, grain-projectile, projectile-wall, ...), built in one of two
-// ways (dem-physics.md 1.2):
+// ways (docs/physics/contact-laws.md section 1.2):
 //   - explicit_pair: the user gives restitution and friction per pair type; elastic moduli combine
 //     with the Hertz formulas;
 //   - chrono_min: Chrono's default ChContactMaterialCompositionStrategy, min(a, b) of the two
@@ -39,7 +39,7 @@ enum class Composition { explicit_pair, chrono_min };
 
 /// Coefficients of one contact between materials a and b; symmetric in (a, b).
 struct PairCoefficients {
-  double E_eff_Pa = 0;  ///< 1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2 (Chrono, dem-physics.md 1.2)
+  double E_eff_Pa = 0;  ///< 1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2 (docs/physics/contact-laws.md 1.2)
   double G_eff_Pa = 0;  ///< 1/G* = 2(2-nu1)(1+nu1)/E1 + 2(2-nu2)(1+nu2)/E2
   double kn_N_m = 0;    ///< Hooke normal stiffness
   double kt_N_m = 0;    ///< Hooke tangential stiffness
@@ -54,7 +54,7 @@ struct PairCoefficients {
   /// prefactor x sqrt(stiffness x m*): Hertz (Chrono) gn = damping_prefactor_n sqrt(Sn m*) and
   /// gt = damping_prefactor_t sqrt(Sn m*) (the sqrt(4 G*/E*) of St/Sn is folded into the
   /// prefactor); Hooke (pkdgrav) C_N = damping_prefactor_n sqrt(k_N m*), C_T =
-  /// damping_prefactor_t sqrt(k_T m*) (dem-physics.md 1.3, 2.1-2.2).
+  /// damping_prefactor_t sqrt(k_T m*) (docs/physics/contact-laws.md sections 1.3, 2.1-2.2).
   double damping_prefactor_n = 0;
   double damping_prefactor_t = 0;
 };

@@ -27,7 +27,8 @@ inline constexpr double kPi = std::numbers::pi;
 /// values that are scaled with gravity (stop speed, rolling threshold).
 inline constexpr double kEarthGravity_m_s2 = 9.81;
 inline constexpr double kInf = std::numeric_limits<double>::infinity();
-/// Small-number guard used by Chrono for |delta_t| and contact-circle radii (dem-physics.md 1.4).
+/// Small-number guard used by Chrono for |delta_t| and contact-circle radii
+/// (docs/physics/contact-laws.md sections 1.4, 1.5).
 inline constexpr double kTinyLength_m = 1e-12;
 
 /// Mass of a solid sphere, rho pi d^3 / 6.

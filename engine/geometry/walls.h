@@ -20,7 +20,7 @@ struct Wall {
   double radius_m = kInf;       ///< disk radius or cylinder radius
   double height_m = kInf;       ///< cylinder extent along its axis from point_m
   /// Concave cylinder: R* = R Rc / (Rc - R) (true curvature). False: flat-face R* = R, as Chrono's
-  /// container built from boxes (dem-physics.md 1.1).
+  /// container built from boxes (docs/physics/contact-laws.md section 1.1).
   bool concave_curvature = true;
 
   static Wall plane(std::string name, const Vec3& point, const Vec3& inward_normal, std::uint8_t mat);

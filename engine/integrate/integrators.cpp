@@ -40,7 +40,8 @@ void closing_half_kick(Particles& p, double dt, const StepCheck& check, std::siz
   });
 }
 
-/// Chrono::Multicore: v_{n+1} = v_n + h a(x_n, v_n); x_{n+1} = x_n + h v_{n+1} (dem-physics.md 1.6).
+/// Chrono::Multicore: v_{n+1} = v_n + h a(x_n, v_n); x_{n+1} = x_n + h v_{n+1}
+/// (docs/physics/contact-laws.md section 1.6).
 class SemiImplicitEuler final : public Integrator {
  public:
   void begin_step(Particles&, double) override {}
@@ -77,7 +78,7 @@ class VelocityVerlet final : public Integrator {
 };
 
 /// pkdgrav: kick-drift-kick leapfrog; forces at x_{n+1} with predicted velocities
-/// v_pred = v_n + dt a_n, w_pred = w_n + dt wdot_n (dem-physics.md 2.4).
+/// v_pred = v_n + dt a_n, w_pred = w_n + dt wdot_n (docs/physics/contact-laws.md section 2.4).
 class LeapfrogKdk final : public Integrator {
  public:
   bool needs_initial_forces() const override { return true; }

@@ -1,6 +1,7 @@
 // `sunday`: Chrono/Sunday et al. 2020 constant-magnitude rolling and spinning torques
-// (Schwartz et al. 2012 style), exactly as dem-physics.md 1.5. Direction from the relative
-// rotation; off below the speed thresholds and during the first t_collision of a contact.
+// (Schwartz et al. 2012 style), exactly as docs/physics/contact-laws.md section 1.5. Direction from
+// the relative rotation; off below the speed thresholds and during the first t_collision of a
+// contact.
 #pragma once
 #include <algorithm>
 #include <cmath>

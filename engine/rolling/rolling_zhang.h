@@ -1,6 +1,6 @@
 // `zhang`: pkdgrav / Zhang et al. 2017 rolling and twisting spring-dashpot-sliders with shape
-// parameter beta, exactly as dem-physics.md 2.3. The springs rotate with the contact frame and
-// the step's increment is undone when a slider slips.
+// parameter beta, exactly as docs/physics/contact-laws.md section 2.3. The springs rotate with the
+// contact frame and the step's increment is undone when a slider slips.
 #pragma once
 #include <cmath>
 

@@ -11,7 +11,7 @@ inline constexpr std::uint8_t kProjectileMaterial = 2;
 
 /// The three materials of the paper's set-ups from the grain's: the wall and the projectile are
 /// made of it, the wall with its own normal COR and sliding friction, which explicit pair values
-/// for grain-wall and projectile-wall make act (dem-physics.md 1.2).
+/// for grain-wall and projectile-wall make act (docs/physics/contact-laws.md section 1.2).
 inline void set_paper_materials(SystemConfig& c, const Material& grain, double wall_cor_normal, double wall_mu_static) {
   Material wall = grain;
   wall.name = "wall";
@@ -50,9 +50,10 @@ inline SystemConfig chrono_table1_config(double mu_rolling = 0.09) {
 
 /// pkdgrav column of Table 1 as part 5 of the reproduction uses it
 /// (examples/reproduction/part5_pkdgrav_1g.json): Hooke with k_N = 7.48e5 N/m (the paper gives no
-/// k_N; about 1 % overlap of a bead at 1.2 m/s, dem-physics.md 2.4) and k_T = 2/7 k_N, COR grain/wall
-/// 0.9/0.5, eps_t = 1, mu_s = 1.0 (grain and wall), Zhang rolling and twisting with mu_t = 1.3,
-/// leapfrog (KDK), dt = 1 us. Table 2's calibration varies mu_r and beta.
+/// k_N; about 1 % overlap of a bead at 1.2 m/s, docs/physics/contact-laws.md section 2.4) and
+/// k_T = 2/7 k_N, COR grain/wall 0.9/0.5, eps_t = 1, mu_s = 1.0 (grain and wall), Zhang rolling
+/// and twisting with mu_t = 1.3, leapfrog (KDK), dt = 1 us. Table 2's calibration varies mu_r and
+/// beta.
 inline SystemConfig pkdgrav_table1_config(double mu_rolling = 1.05, double shape_beta = 0.05) {
   SystemConfig c;
   c.contact_law = "hooke";

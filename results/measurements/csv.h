@@ -1,5 +1,5 @@
-// RFC 4180 CSV records (measurement campaigns, shared/formats/measurements.md): an optional UTF-8
-// byte-order mark, comma separators, fields in double quotes may hold commas, line breaks and
+// RFC 4180 CSV records (measurement campaigns, docs/formats/measurements.md section 4): an optional
+// UTF-8 byte-order mark, comma separators, fields in double quotes may hold commas, line breaks and
 // doubled quotes (""), CRLF or LF line ends. Unquoted fields are trimmed of spaces and tabs.
 #pragma once
 #include <istream>

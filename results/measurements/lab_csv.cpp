@@ -1,4 +1,4 @@
-// Reader of lab campaign folders (shared/formats/measurements.md): trials.csv and traces/*.csv,
+// Reader of lab campaign folders (docs/formats/measurements.md): trials.csv and traces/*.csv,
 // RFC 4180 CSV (csv.h). Every problem names the file, the line and the column.
 #include <fmt/format.h>
 

@@ -1,5 +1,5 @@
 // The one trial record: what is known about one impact before its trace is processed, whether a
-// laboratory record (trials.csv, shared/formats/measurements.md) or a DEM drop (trace.h5 of
+// laboratory record (trials.csv, docs/formats/measurements.md section 2) or a DEM drop (trace.h5 of
 // `gravsweep run` or of a campaign's drop job). Every representation of these fields (CSV header,
 // SQLite column of the imported `trials` table, HDF5 attribute of trace.h5, JSON key) comes from
 // the one table trial_fields(); nothing else lists them.
@@ -64,7 +64,7 @@ struct TrialField {
   const char* key;        ///< JSON key, CSV header and SQLite column (one name: units in it)
   const char* hdf5_attr;  ///< attribute of /trace in trace.h5 that holds it, nullptr if none
   const char* unit;       ///< SI unit ("" for text)
-  bool csv_required;      ///< required column of trials.csv (measurements.md)
+  bool csv_required;      ///< required column of trials.csv (docs/formats/measurements.md 2.1)
   double Trial::*number;  ///< nullptr for text fields
   std::string Trial::*text;
 };

@@ -1,6 +1,6 @@
 // Collision models as sums of registered terms (term.h), their fits to measurement campaigns,
 // held-out errors, residual analysis and the ranking of candidate terms ("which effect is
-// missing"). Formulas: Sunday et al. 2021 Eqs. 1-5, shared/reference/force-laws.md 2.1-2.6.
+// missing"). Formulas: Sunday et al. 2021 Eqs. 1-5, docs/physics/force-laws.md section 2.
 #pragma once
 #include <Eigen/Dense>
 #include <cmath>

@@ -1,5 +1,5 @@
 // Predictions of a fitted model (see model.h): Eq. 1 integrated by RK4 from the impact speed to
-// the stop, and the metrics of a trial predicted the way the trial was measured (issue 13 item 2):
+// the stop, and the metrics of a trial predicted the way the trial was measured:
 // the model's record on the trial's own sample grid, processed like the data, so that apeak is
 // read off the filtered model record exactly as off the filtered measurement.
 #include <fmt/format.h>

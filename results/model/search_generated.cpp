@@ -1,4 +1,4 @@
-// The search beyond the named library (issue 13 item 4; model_internal.h): a forward step over the
+// The search beyond the named library (model_internal.h): a forward step over the
 // generated family (generated.h) judged by nested grouped cross-validation, so that choosing one
 // form out of many is itself what the held-out test judges.
 #include <algorithm>

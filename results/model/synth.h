@@ -1,6 +1,6 @@
-// A synthetic impact laboratory: writes measurement campaigns (shared/formats/measurements.md)
+// A synthetic impact laboratory: writes measurement campaigns (docs/formats/measurements.md)
 // from any model spec plus a noise model, so analyses can be tested on data with a known hidden
-// effect (force-laws.md 2.4 step 4).
+// effect (docs/physics/force-laws.md section 2.4, step 4).
 #pragma once
 #include <string>
 #include <vector>

@@ -1,7 +1,7 @@
 // Collision-model terms: m dv/dt = m g - R(z, v, g, ...), R = sum over terms of
-// theta_j * phi_j(state) (Sunday et al. 2021 Eq. 1 and the library of shared/reference/
-// force-laws.md 2.2). Each term is linear in its parameters, so trace-level fits are (weighted)
-// least squares and every candidate can be compared on the same footing.
+// theta_j * phi_j(state) (Sunday et al. 2021 Eq. 1 and the library of
+// docs/physics/force-laws.md section 2.2). Each term is linear in its parameters, so trace-level
+// fits are (weighted) least squares and every candidate can be compared on the same footing.
 //
 // Adding a term = one file in results/model/terms/ defining `TermInfo <name>_term()` and one row
 // in the GRAVSWEEP_MODEL_TERMS list below (see ARCHITECTURE.md, "Collision-model terms").

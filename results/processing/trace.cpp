@@ -176,7 +176,7 @@ PassResult collision_pass(const Trace& trace, const MetricOptions& o, const std:
   ec.v_end_m_s = o.end_speed_fraction * std::abs(vc_pass);
   std::optional<std::size_t> j;
   if (!v_pass.empty() && o.end_from_rest) {
-    // A lab record (velocity integrated from the impact speed, issue 13): the end level of the
+    // A lab record (velocity integrated from the impact speed): the end level of the
     // local g raised above the noise, the end searched back from the rest at the record's end,
     // accepted where the integrated speed is down too. That speed is known to within g times the
     // start's uncertainty (an edge width; 0.01 m/s for a slow impact at 1 g, 1/10 of its vc), so

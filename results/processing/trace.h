@@ -2,9 +2,9 @@
 // code processes DEM traces (results of `gravsweep run`) and laboratory accelerometer records.
 //
 // Conventions: depth z positive DOWN, zero at the bed surface; velocity positive down;
-// acceleration as the accelerometer format (shared/formats/measurements.md): the projectile's
-// vertical kinematic acceleration, positive UP, so free fall reads -g and rest reads 0.
-// (Equivalently accel_up = -dv_down/dt.)
+// acceleration as the accelerometer format (docs/formats/measurements.md section 3.2): the
+// projectile's vertical kinematic acceleration, positive UP, so free fall reads -g and rest
+// reads 0. (Equivalently accel_up = -dv_down/dt.)
 #pragma once
 #include <cstddef>
 #include <optional>
@@ -45,8 +45,8 @@ struct MetricOptions {
   /// stops as Eq. 1 does (speed to zero at the end) is not affected.
   double end_speed_fraction = 0.1;
   /// Records whose velocity is integrated (lab records): the end searched back from the rest at
-  /// the record's end, at a level raised above the noise (issue 13; trace_steps.h). false: the
-  /// forward search alone, as before issue 13 (kept to measure what the change does).
+  /// the record's end, at a level raised above the noise (trace_steps.h). false: the
+  /// forward search alone, the earlier rule (kept to measure what the change does).
   bool end_from_rest = true;
   /// Speed at first contact, used to integrate a into v and z when the trace has none.
   std::optional<double> impact_velocity_m_s;

@@ -148,7 +148,7 @@ CollisionStart free_fall_start(const std::vector<double>& t, const std::vector<d
   const bool step = ramp_s <= kStepRampRises * step_rise_s;
   if (!step) {
     // Slower than the filter: the threshold crossing lags the ramp's foot by thr over its slope
-    // (issue 13: in high gravity g times that lag, carried through the integration, is several %
+    // (in high gravity g times that lag, carried through the integration, is several %
     // of a slow impact's zstop). The ramp extrapolated back to -g from its crossings of 20 and
     // 40 % of its height (at least thr and 2 thr), above the foot that the filter rounds.
     const double d1 = std::max(thr, 0.2 * (top + g)), d2 = std::max(2.0 * thr, 0.4 * (top + g));

@@ -37,7 +37,7 @@ std::size_t contact_peak(const std::vector<double>& af, double g_m_s2);
 /// fall); its median over the samples check_starts_in_free_fall probes (up to
 /// kFreeFallProbeSamples, at most a third of the way to the peak). Not the whole first third: a
 /// slow low-gravity collision peaks late, and that third held more collision than free fall
-/// (issue 13: the bias came out 1.4 m/s2 at 1.2 m/s2 and the start was placed inside the collision).
+/// (measured: the bias came out 1.4 m/s2 at 1.2 m/s2 and the start was placed inside the collision).
 double initial_bias(const std::vector<double>& af, std::size_t ipk, double g_m_s2);
 
 /// A lab record starts in free fall and ends at rest: its first samples read about g below its
@@ -99,7 +99,7 @@ std::optional<std::size_t> end_sample(const std::vector<double>& a, std::size_t 
 /// std of Gaussian noise, unmoved by a minority of outliers). 0 when fewer than 3 samples.
 double robust_sigma(const std::vector<double>& x, std::size_t b, std::size_t e);
 
-/// Noise-aware end level (issue 13): the paper's end_threshold_g of the local g, raised to
+/// Noise-aware end level: the paper's end_threshold_g of the local g, raised to
 /// kEndNoiseSigmas times the filtered record's noise where 0.1 g drowns in it (low gravity), so
 /// that noise alone never reads as the projectile still decelerating.
 inline constexpr double kEndNoiseSigmas = 5.0;
@@ -155,7 +155,7 @@ BiasEstimate bias_from_segments(const std::vector<double>& af, double g_m_s2, st
 void integrate_from_start(const std::vector<double>& t, const std::vector<double>& a, std::size_t i_start,
                           double t_start_s, double v0_m_s, std::vector<double>& v, std::vector<double>& z);
 
-/// Lab records (issue 13): the integrated velocity brought to rest. After the collision the
+/// Lab records: the integrated velocity brought to rest. After the collision the
 /// projectile rests, so the speed integrated from the reported impact speed must read zero over
 /// the rest segment [rest_begin, n). What it reads is, to first order, a constant offset from the
 /// contact on: the reported speed's own error (0.5 % of vc is 5 % of zstop in low gravity, where

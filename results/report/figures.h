@@ -1,4 +1,4 @@
-// Figures of one drop (issue #15), drawn by results/report/plots.py from data prepared here:
+// Figures of one drop, drawn by results/report/plots.py from data prepared here:
 //  - Fig. 2 of Sunday et al. 2021: acceleration, velocity and depth against time, raw and
 //    processed as the paper does (500 Hz Butterworth; velocity and depth re-integrated from the
 //    filtered acceleration, the paper's green line), vc, apeak, zstop and tstop marked. A DEM

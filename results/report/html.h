@@ -1,4 +1,4 @@
-// The report you can send (issue 15): one self-contained HTML page, REPORT/index.html, with the
+// The report you can send: one self-contained HTML page, REPORT/index.html, with the
 // verdict, the tables and every figure (PNG, base64-embedded) with a one-line caption. Nothing is
 // linked: the file opens in any browser, mailed or copied alone.
 #pragma once

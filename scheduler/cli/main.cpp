@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
   // runs anything else (other workers, a build): measured 2,000 vs 214 ns per particle-step with
   // 2 threads on a busy 2-core machine. Passive waiting with a short spin first (kBarrierSpins)
   // keeps most of that and wins back the futex sleep/wake of a quiet machine's barriers: 46.0 vs
-  // 51.4 ns quiet, 98 vs 90 ns beside a busy process (BENCHMARKS.md, issue 12). libgomp reads both
+  // 51.4 ns quiet, 98 vs 90 ns beside a busy process (BENCHMARKS.md). libgomp reads both
   // when it loads, so set them and re-execute once; a user's own OMP_WAIT_POLICY or
   // GOMP_SPINCOUNT is kept.
   constexpr const char* kBarrierSpins = "500";

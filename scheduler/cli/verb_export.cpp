@@ -1,5 +1,5 @@
 // `gravsweep export`: a campaign's finished drops as a measurement campaign on disk
-// (shared/formats/measurements.md): trials.csv, traces/<job>.csv at a lower sample rate,
+// (docs/formats/measurements.md section 6): trials.csv, traces/<job>.csv at a lower sample rate,
 // scenarios/<job>.json, and results.csv (the campaign's own metrics from the full-rate traces).
 // `gravsweep model rank DIR` then works on the folder without rerunning anything, and it is
 // small enough to keep in git (the reproduction dataset, REPRODUCTION.md).

@@ -1,5 +1,5 @@
 // `gravsweep measurements import DIR --db FILE`: reads a measurement campaign (trials.csv and
-// traces, shared/formats/measurements.md), processes every trace as Sunday et al. 2021 Sect. 2.3
+// traces, docs/formats/measurements.md), processes every trace as Sunday et al. 2021 Sect. 2.3
 // and stores trials, processed samples and metrics in SQLite.
 #include <fmt/format.h>
 

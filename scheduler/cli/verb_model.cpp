@@ -85,7 +85,7 @@ results::Table error_table(const std::vector<results::ComparedModel>& cm) {
   return t;
 }
 
-/// Issue 13: when a term is added every reported error should fall, or the report says why one
+/// When a term is added every reported error should fall, or the report says why one
 /// does not. Compares the last model with `base` metric by metric (RMS in units, and relative).
 void explain_rises(const std::vector<results::ComparedModel>& cm) {
   const results::ComparedModel* before = nullptr;

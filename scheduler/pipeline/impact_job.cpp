@@ -272,7 +272,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   load_bed(sys, bed);
   require_at_rest(sys, bed, p, bed_in);
 
-  // Grain snapshots (issue 15): the grains keep the order of bed.h5, the projectile comes last.
+  // Grain snapshots: the grains keep the order of bed.h5, the projectile comes last.
   std::unique_ptr<results::SnapshotWriter> snaps;
   DropSnapshots ds;
   if (p.snapshot_interval_s > 0) {

@@ -213,7 +213,7 @@ void engine_checks(const json& s, Checks& ck) {
 
 /// engine_checks of scenarios that agree in every field it reads (and in which of them are sound)
 /// runs once: it builds an engine System four times, and a sweep's points differ in impact speeds,
-/// seeds and offsets, which it does not read (issue 33 item 13: 200,000 points built 800,000
+/// seeds and offsets, which it does not read (a sweep of 200,000 points built 800,000
 /// Systems). The problems it found are kept (up to kEngineCheckMemo scenarios) and given again.
 std::atomic<std::size_t> g_engine_check_runs{0};
 

@@ -1,8 +1,8 @@
-// The job queue on SQLite (see shared/reference/job-queue.md): jobs with content-addressed ids,
-// dependencies (drop jobs wait for their bed job), claims in BEGIN IMMEDIATE with UPDATE ...
-// RETURNING, leases renewed by heartbeats that carry progress, completion fenced by the lease
-// token, retries with exponential backoff, a `dead` state after max_attempts, one attempts row per
-// try, and a results table with one column per swept parameter and per metric.
+// The job queue on SQLite (see scheduler/queue/README.md; the reasons: docs/queue.md): jobs with
+// content-addressed ids, dependencies (drop jobs wait for their bed job), claims in BEGIN IMMEDIATE
+// with UPDATE ... RETURNING, leases renewed by heartbeats that carry progress, completion fenced by
+// the lease token, retries with exponential backoff, a `dead` state after max_attempts, one
+// attempts row per try, and a results table with one column per swept parameter and per metric.
 //
 // Job states: waiting (dependencies not done) -> queued -> running -> done
 //                                                         \-> failed (backoff) -> running ...

@@ -1,4 +1,4 @@
-// A throwaway PostgreSQL server for tests (shared/reference/cluster-local.md): initdb in a
+// A throwaway PostgreSQL server for tests (docs/queue.md section 7.1): initdb in a
 // temporary folder, pg_ctl start on 127.0.0.1 with its own port and socket folder, stopped and
 // removed when the test process ends. Started once per test process, on first use; each test
 // gets a new database of its own. As root, the server runs as the `postgres` user (initdb

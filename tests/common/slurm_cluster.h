@@ -1,4 +1,4 @@
-// A throwaway single-node Slurm cluster for tests (shared/reference/cluster-local.md): its own
+// A throwaway single-node Slurm cluster for tests (docs/queue.md section 7.2): its own
 // munged (own key and socket, so a system munge is never touched), slurmctld and slurmd on
 // random ports with their state, spool and logs in a temporary folder, one node of this
 // machine's CPUs and one partition `debug`. Started once per test process, on first use; the

@@ -25,7 +25,7 @@ inline SystemConfig two_material_config(const std::string& law, double cor, doub
     m.mu_static = mu;
     m.mu_rolling = 0;
     m.mu_twisting = 0;
-    m.kn_N_m = 7.48e5;  // pkdgrav-style k_N for 1 % overlap at 1.2 m/s (dem-physics.md 2.4)
+    m.kn_N_m = 7.48e5;  // pkdgrav-style k_N for 1 % overlap at 1.2 m/s (docs/physics/contact-laws.md section 2.4)
   }
   c.pair_overrides.clear();
   c.composition = Composition::chrono_min;
@@ -36,7 +36,8 @@ inline SystemConfig two_material_config(const std::string& law, double cor, doub
   return c;
 }
 
-/// Hertz elastic contact time t_H = 2.868 (m*^2 / (R* E*^2 v))^(1/5) (dem-physics.md 4.1).
+/// Hertz elastic contact time t_H = 2.868 (m*^2 / (R* E*^2 v))^(1/5)
+/// (docs/physics/contact-laws.md section 4.1).
 inline double hertz_contact_time_s(double m_eff, double R_eff, double E_eff, double v) {
   return 2.868 * std::pow(m_eff * m_eff / (R_eff * E_eff * E_eff * v), 0.2);
 }

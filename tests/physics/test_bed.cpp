@@ -109,7 +109,7 @@ TEST(Bed, GravityRampUnloadsTheBedGently) {
   EXPECT_LT(3 * ramped, sudden);
 }
 
-// Issue 12, the creep-floor stop (/bed/settle/plateau_window_s): a poured column whose criteria are
+// The creep-floor stop (/bed/settle/plateau_window_s): a poured column whose criteria are
 // out of reach (rms 1e-7 m/s) ends its settling at the floor, after the pour has landed and with
 // the bed quiet (rms below the fastest-grain criterion), long before the cap; settling on for
 // another 0.2 s does not lower the RMS speed much below that floor, so the cap would buy nothing.
@@ -228,9 +228,9 @@ double monodisperse_core_packing(double spacing_diameters) {
 
 }  // namespace
 
-// Issue 11, part 5: monodisperse grains placed on the default lattice (1.04 d) keep it through the
-// pour and pack denser than random packing (the pkdgrav bed's core: 0.683); a wider, jittered
-// lattice (bed.placement_spacing_diameters) lets the pour randomise them.
+// The reproduction's part 5 (REPRODUCTION.md): monodisperse grains placed on the default lattice
+// (1.04 d) keep it through the pour and pack denser than random packing (the pkdgrav bed's core:
+// 0.683); a wider, jittered lattice (bed.placement_spacing_diameters) lets the pour randomise them.
 TEST(Bed, AWiderPlacementLatticeKeepsAMonodisperseBedFromCrystallising) {
   const double lattice = monodisperse_core_packing(kLatticeSpacingDiameters);
   const double wide = monodisperse_core_packing(1.5);

@@ -1,4 +1,4 @@
-// Memory layout of the contact histories (issue 12): the per-pair ContactHistory (48 bytes), the
+// Memory layout of the contact histories: the per-pair ContactHistory (48 bytes), the
 // FrameHistory kept only for hooke / zhang, and the sparse wall histories stored beside the wall
 // candidates. Each test compares a run with a reference run that must give bit-identical states;
 // a history lost, reset or attached to the wrong pair at a rebuild, a renumbering or a switch of

@@ -1,5 +1,6 @@
-// Two-body normal impacts against theory (dem-physics.md 4.1, 4.2): restitution, Hertz contact
-// duration and peak overlap, grain-grain and grain-wall, for both contact laws.
+// Two-body normal impacts against theory (docs/physics/contact-laws.md sections 4.1, 4.2):
+// restitution, Hertz contact duration and peak overlap, grain-grain and grain-wall, for both
+// contact laws.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -75,7 +76,7 @@ INSTANTIATE_TEST_SUITE_P(Laws, RestitutionTest,
                          ::testing::Combine(::testing::Values("hertz", "hooke"), ::testing::Values(0.25, 0.5, 0.9, 1.0),
                                             ::testing::Values(0.01, 1.2), ::testing::Values(false, true)));
 
-// Clamping F_n >= 0 changes the COR to 0.9021 for 0.9 (dem-physics.md 4.2).
+// Clamping F_n >= 0 changes the COR to 0.9021 for 0.9 (docs/physics/contact-laws.md section 4.2).
 TEST(Restitution, ClampedHertzGives0902) {
   auto cfg = two_material_config("hertz", 0.9, 0.0);
   cfg.options.clamp_normal = true;
@@ -105,7 +106,8 @@ TEST_P(HertzDurationTest, MatchesTheory) {
 INSTANTIATE_TEST_SUITE_P(Speeds, HertzDurationTest,
                          ::testing::Combine(::testing::Values(0.1, 1.2), ::testing::Values(false, true)));
 
-// Damped Chrono contacts reproduce the model durations of dem-physics.md 4.1 (dt = 1 us) within 2 %.
+// Damped Chrono contacts reproduce the model durations of docs/physics/contact-laws.md section 4.1
+// (dt = 1 us) within 2 %.
 TEST(HertzDuration, DampedTableValues) {
   EXPECT_NEAR(impact(two_material_config("hertz", 0.9, 0.0), 0.1, false).contact_time_s, 301e-6, 0.02 * 301e-6);
   EXPECT_NEAR(impact(two_material_config("hertz", 0.9, 0.0), 1.2, false).contact_time_s, 183e-6, 0.02 * 183e-6);

@@ -1,5 +1,6 @@
-// Exact Poncelet kinematics (Sunday et al. 2021 Eqs. 2-4, force-laws.md 2.3-A) for the results/
-// tests: apeak, zstop and tstop in closed form, the state at any time after contact.
+// Exact Poncelet kinematics (Sunday et al. 2021 Eqs. 2-4, docs/physics/force-laws.md section 2.3 A)
+// for the results/ tests: apeak, zstop and tstop in closed form, the state at any time after
+// contact.
 #pragma once
 #include <cmath>
 

@@ -1,4 +1,4 @@
-// A corpus of bad measurement campaigns (issue 10): for each, `gravsweep measurements import`
+// A corpus of bad measurement campaigns: for each, `gravsweep measurements import`
 // exits 2, names the file and the line (and column where there is one), and writes nothing.
 #include <gtest/gtest.h>
 
@@ -124,7 +124,7 @@ std::vector<Case> corpus() {
          for (std::size_t i = 1; i < tr.size(); ++i) tr[i] = tr[i].substr(0, tr[i].find(',')) + ",-9.81";
        },
        "trials.csv line 2", "never makes contact"},
-      // Issue 10 item 12: each unmeasurable record gets its own reason, at the line it is about.
+      // Each unmeasurable record gets its own reason, at the line it is about.
       {"1e308 in a trace", [](V&, V& tr, const fs::path&) { tr[30] = tr[30].substr(0, tr[30].find(',')) + ",1e308"; },
        "traces/A.csv:31:2", "beyond any accelerometer's range"},
       {"no free fall (starts at rest)",

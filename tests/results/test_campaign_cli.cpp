@@ -1,4 +1,4 @@
-// A gravity sweep feeds the model comparison directly (issue 9): a real tiny campaign (`submit` +
+// A gravity sweep feeds the model comparison directly: a real tiny campaign (`submit` +
 // `work`, 2 gravities x 2 speeds x 2 repeats, 8 drops on 2 beds), then `model table3|rank`,
 // `report`, `measurements import --where` and `from-runs` on it, `results --group-by` against
 // means computed here, and a drop that cannot be measured listed with the reason.

@@ -67,7 +67,7 @@ TEST(Cli, ModelFitPrintsBeforeAndAfterAsCsvAndJson) {
   EXPECT_GT(j[0]["f0_N"].get<double>(), 0);
 }
 
-// Issue 13 item 2: where an error does not fall when the term is added, the report says why. On the
+// Where an error does not fall when the term is added, the report says why. On the
 // dev campaign the apeak RMS (m/s2) rises a little while the relative apeak error halves.
 TEST(Cli, ModelFitSaysWhyAnErrorDoesNotFall) {
   GRAVSWEEP_REQUIRE_DEV_CAMPAIGN();
@@ -169,7 +169,7 @@ TEST(Cli, CheckDetectionCountsRankedFirstAndNullReports) {
   EXPECT_NE(r.out.find("(nothing hidden),1,-,-,0"), std::string::npos) << r.out;
 }
 
-// Issue 13: `synth --rest-tail` sets how long the record runs on after the stop, truth.csv holds
+// `synth --rest-tail` sets how long the record runs on after the stop, truth.csv holds
 // each trial's true stop, and `--fixed-range-sensor` keeps the noise in units of 9.81 m/s2 at a
 // low-gravity level instead of scaling it down with g.
 TEST(Cli, SynthRestTailFixedRangeSensorAndTruth) {

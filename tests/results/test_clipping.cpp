@@ -1,4 +1,4 @@
-// Issue 33 item 12: a saturated accelerometer (a flat top at its range on the fast impacts) is
+// A saturated accelerometer (a flat top at its range on the fast impacts) is
 // found at import, flagged in the trial record, its apeak left out of the apeak fits (Eq. 2) and
 // errors, its flat top out of the trace fits, tstop kept, zstop kept while the clip moves it by
 // at most kClipDepthTolerance; the flag survives SQLite, the import table and the report say so.

@@ -1,4 +1,4 @@
-// Discovery beyond the named library (issue 13 items 3-4): generated forms parse and fit like
+// Discovery beyond the named library: generated forms parse and fit like
 // named terms; a hidden effect outside the library gets a humble verdict ("partly explained" /
 // "structure left"), and the search over the generated family names its form in most seeds; on
 // campaigns with nothing hidden the search reports nothing.

@@ -1,4 +1,4 @@
-// Issue 13 item 1: the collision end of lab records found robustly in low gravity. Campaigns from
+// The collision end of lab records found robustly in low gravity. Campaigns from
 // `synth` (short rest tails, noise and bias scaled with g, grain-scale force fluctuations) at
 // 9.81, 1.2, 0.4 and 0.1 m/s2: no trial that holds its collision may be lost, and the measured
 // tstop and zstop must match synth's truth (truth.csv: the integrated motion before noise and

@@ -278,7 +278,7 @@ TEST(Discovery, StructureNoCandidateExplainsIsReportedWithWhereItLies) {
   write_synthetic_campaign(d.str(), truth, o);
   const Campaign c = load_campaign(d.str());
   const Discovery disc = discover(c, parse_model("base"));
-  // Humble (issue 13 item 3): a named term may take part of it, but the verdict says what is left.
+  // Humble: a named term may take part of it, but the verdict says what is left.
   EXPECT_TRUE(disc.verdict.find("structure left that no named term explains") != std::string::npos ||
               disc.verdict.find("partly explained by") != std::string::npos)
       << disc.verdict;
@@ -289,7 +289,7 @@ TEST(Discovery, StructureNoCandidateExplainsIsReportedWithWhereItLies) {
 
 namespace {
 
-/// Every held-out error of base+term below that of base (issue 13 item 2), with the figures. The
+/// Every held-out error of base+term below that of base, with the figures. The
 /// metrics named in `within_5pct` need only stay within 5 % of base (an RMS in absolute units that
 /// the trials where the term does not matter, or a few fluctuation maxima, dominate; the caller
 /// says why); their relative errors must still fall.
@@ -321,8 +321,8 @@ void expect_every_error_falls(const Campaign& c, const std::string& term, const 
 
 }  // namespace
 
-// Issue 13 item 2: on the dev campaign the held-out apeak error rose from 22 % to 28 % when depth
-// friction was added: the model's apeak was the smooth peak of Eq. 1, the measured one the
+// On the dev campaign the held-out apeak error rose from 22 % to 28 % when depth friction was
+// added while the model's apeak was the smooth peak of Eq. 1, the measured one the
 // largest value of a record that fluctuates by ~20 % (1.3-2 times the smooth peak), read off the
 // 500 Hz filtered record. Predicted as measured (the model's record with the other trials'
 // fluctuations laid over it, processed like the trial), every relative error falls (apeak 40 ->
@@ -367,7 +367,7 @@ TEST(HeldOut, HiddenCohesionIsAbsorbedByThePerLevelFrictionSoNoErrorMoves) {
     EXPECT_NEAR(after, before, 0.01 * before);
 }
 
-// Issue 13: two hidden terms at once are both found, in two rounds, over several seeds, and the
+// Two hidden terms at once are both found, in two rounds, over several seeds, and the
 // search beyond the named library adds nothing to them (the verdict stays "missing effect"). 72
 // trials each (3 levels x 8 speeds x 3 repeats; with 48 the second term is sometimes not significant).
 TEST(Discovery, TwoHiddenTermsAreBothFoundInTwoRounds) {

@@ -1,4 +1,4 @@
-// The committed reproduction dataset (data/reproduction/, REPRODUCTION.md, issue #11): `model
+// The committed reproduction dataset (data/reproduction/, REPRODUCTION.md): `model
 // table3` and `model rank` on it must keep giving the values REPRODUCTION.md states, so that a
 // change to processing or fitting that moves them fails here.
 #include <gtest/gtest.h>
@@ -82,7 +82,7 @@ TEST(Reproduction, ChronoOneGTable3RowWithASitePerDrop) {
 }
 
 // Beyond the paper: the Poncelet law misses a depth-dependent friction in our DEM data at 1 g, and
-// (the search beyond the named library, issue 13) a small speed-dependent part is left after it:
+// (the search beyond the named library) a small speed-dependent part is left after it:
 // the verdict is "partly explained", and held-out zstop and tstop errors fall with the form found.
 TEST(Reproduction, ModelRankNamesDepthFrictionOnTheChronoOneGDrops) {
   const auto r = gravsweep::testing::run_gravsweep("model rank '" + dataset("chrono_1g") + "'", true);

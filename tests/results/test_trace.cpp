@@ -1,6 +1,7 @@
 // Trace processing (results/processing/trace.h) on analytic Poncelet traces: Sunday et al. 2021
-// Eqs. 2-4 / force-laws.md 2.3-A give apeak, zstop and tstop exactly; the paper's processing
-// (500 Hz Butterworth, free-fall start, 0.1 g end, integration from vc) must recover them.
+// Eqs. 2-4 / docs/physics/force-laws.md section 2.3 A give apeak, zstop and tstop exactly; the
+// paper's processing (500 Hz Butterworth, free-fall start, 0.1 g end, integration from vc) must
+// recover them.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -314,7 +315,7 @@ Trace dem_record(const Poncelet& p, double fs, double t_contact) {
 
 }  // namespace
 
-// Issue #11: a DEM drop released 1 mm above the bed falls for 1-6 ms; the 500 Hz filter's edge
+// A DEM drop released 1 mm above the bed falls for 1-6 ms; the 500 Hz filter's edge
 // leaves no -g sample before the peak, so the paper's free-fall rule finds no start. The engine's
 // first contact gives it.
 TEST(Metrics, ADemRecordWithAShortFreeFallStartsAtTheEnginesFirstContact) {
@@ -364,8 +365,8 @@ TraceError error_of(const Trace& tr, const MetricOptions& o) {
 
 }  // namespace
 
-// Issue 10 item 12: no free fall, no contact, a 1e308 sample and a record that ends inside the
-// collision were all "trace shorter than the collision"; each has its own reason and sample.
+// No free fall, no contact, a 1e308 sample and a record that ends inside the collision: each has
+// its own reason and sample, not one "trace shorter than the collision" for all.
 TEST(Metrics, EachUnmeasurableRecordGetsItsOwnReasonAndSample) {
   Poncelet p;
   MetricOptions o;

@@ -90,7 +90,7 @@ TEST(TraceSteps, FreeFallStartAtTheThresholdForARampAndAtHalfHeightForAStep) {
   EXPECT_THROW(free_fall_start(t, none, 60, kG, thr, 4, jump_s), std::invalid_argument);
 }
 
-// Issue 13: on the filtered record (1400 Hz, 500 Hz), a step contact starts at its half height
+// On the filtered record (1400 Hz, 500 Hz), a step contact starts at its half height
 // (the filter's ringing crosses the threshold about two samples early) and a contact that ramps
 // in over 4 ms (a slow impact in high gravity) where its ramp begins, not 2 ms later at its half
 // height.
@@ -192,7 +192,7 @@ TEST(TraceSteps, IntegrationIsExactForConstantDeceleration) {
   }
 }
 
-// Issue 13: the integrated speed at rest reads zero. A reported impact speed 1 % high shifts v
+// The integrated speed at rest reads zero. A reported impact speed 1 % high shifts v
 // by 0.01 vc from the contact on and makes zstop deep by 0.01 vc tstop; brought to rest, both are
 // as the true motion's, except for the part a step at the end explains (end_tolerance).
 TEST(TraceSteps, BringToRestRemovesAConstantSpeedOffsetFromVAndZ) {
@@ -269,7 +269,7 @@ TEST(TraceSteps, ReboundIsARiseFromTheDeepestPointOthersAreNotes) {
   EXPECT_NE(floor.note.find("within one grain of the floor"), std::string::npos) << floor.note;
 }
 
-// Issue 13: the pieces of the collision end of lab records in low gravity.
+// The pieces of the collision end of lab records in low gravity.
 TEST(TraceSteps, RobustSigmaIsTheNoiseWhateverAFewOutliers) {
   std::mt19937 rng(3);
   std::normal_distribution<double> n01(0.0, 1.0);

@@ -1,4 +1,4 @@
-// Issue 33 item 14: `measurements import` stores a trace once, by content. Trials that point at
+// `measurements import` stores a trace once, by content. Trials that point at
 // one trace file share its rows (5 trials of one 93 MB trace made a 1.87 GB database); samples no
 // trial names are removed on re-import; a database of the per-trial layout before is read as it is
 // and moved to the shared layout when a campaign is stored into it.

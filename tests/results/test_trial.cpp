@@ -119,7 +119,7 @@ TEST(TrialRecord, OneFieldTableGivesCsvSqlHdf5AndJsonNamesAndRoundTrips) {
       EXPECT_NE(f.number, nullptr) << f.key;
     }
   }
-  // The required columns of shared/formats/measurements.md, no more, no less.
+  // The required columns of docs/formats/measurements.md section 2.1, no more, no less.
   std::set<std::string> required;
   for (const auto& f : trial_fields())
     if (f.csv_required) required.insert(f.key);

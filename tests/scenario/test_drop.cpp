@@ -101,7 +101,7 @@ TEST(Drop, RefusesAmbiguousOrUnreachableStarts) {
   EXPECT_THROW(drop_projectile(c.sys, 0.05, q, DropStop{}, 1e4), ConfigError);
 }
 
-// Issue #11: the start gap is measured from the first grain the projectile would touch at its
+// The start gap is measured from the first grain the projectile would touch at its
 // lateral offset, not from the mean surface; a grain standing 1 cm proud of the "surface" is met
 // at the requested speed, and a release that would overlap it is refused with that reason.
 TEST(Drop, StartGapIsMeasuredFromTheGrainUnderTheFootprint) {
@@ -132,9 +132,9 @@ TEST(Drop, StartGapIsMeasuredFromTheGrainUnderTheFootprint) {
   EXPECT_NEAR(res.samples[k - 1].velocity_down_m_s, 0.3, 2e-3);
 }
 
-// Issue #11 (part 2, 0.1 m/s2 at 1.2 m/s): an ejected grain flew over the 0.3 m wall and the drop
-// died with "left the container" when it crossed the domain's side. A grain over the rim, moving
-// out, is removed instead; the projectile's index follows; grains still inside are kept.
+// The reproduction's part 2 (0.1 m/s2), at 1.2 m/s: an ejected grain flew over the 0.3 m wall and
+// the drop died with "left the container" when it crossed the domain's side. A grain over the rim,
+// moving out, is removed instead; the projectile's index follows; grains still inside are kept.
 TEST(Drop, AGrainThatGoesOverTheRimIsRemovedNotAFailure) {
   EmptyContainer c(0.1);  // container radius 0.1 m, wall 0.3 m high
   const double r = 0.005;

@@ -82,7 +82,7 @@ TEST_F(ImpactPipeline, DropIsRecordedAndMeasured) {
   const auto tr = results::read_trace(drop_->trace_path);
   ASSERT_GT(tr.size(), 100u);
   EXPECT_NEAR(tr.sample_rate_hz, 1e4, 1e-6);
-  // Starts 5 mm above the first grain under the projectile (issue #11: not above the mean
+  // Starts 5 mm above the first grain under the projectile (not above the mean
   // surface, which a proud grain may stand above), in free fall: accel_up reads -g.
   const double touch_m = m["first_touch_height_above_surface_m"].get<double>();
   EXPECT_GT(touch_m, -0.01);
@@ -288,7 +288,7 @@ TEST(RunVerb, WritesBedTraceAndMetricsThenReusesTheBed) {
   EXPECT_NEAR(m2["vc_m_s"].get<double>(), 1.3, 0.08);
 }
 
-// Issue 12: with /bed/settle/plateau_window_s a bed whose criteria are out of reach stops at the
+// With /bed/settle/plateau_window_s a bed whose criteria are out of reach stops at the
 // creep floor, long before the 2 s caps, and the bed line and report say so.
 TEST(RunVerb, ABedOutOfReachOfItsCriteriaStopsAtTheCreepFloorAndSaysSo) {
   test::TempDir dir;

@@ -1,4 +1,4 @@
-// The bad-input corpus of sweep specs (issue #10): each case is refused by `gravsweep submit`
+// The bad-input corpus of sweep specs: each case is refused by `gravsweep submit`
 // with exit code 2, a message naming the file and the JSON pointer (or line) of the problem, and
 // nothing written (no database, no files folder). Plus the cases that must be accepted.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// A bed named on the command line (issue #10 items 4 and 12): `run --bed` verifies the bed against
+// A bed named on the command line: `run --bed` verifies the bed against
 // the checksum `run` wrote beside it (bed.h5.sha256, the SHA-256 campaigns record for their beds)
 // and refuses every changed bit with exit 2 naming the file; a corrupt bed file (cut short, random
 // bytes, an HDF5 file that is not a bed or lacks a dataset) is refused the same way by `run --bed`

@@ -120,7 +120,7 @@ const std::filesystem::path& tiny_run() {
 
 }  // namespace
 
-// Issue #15's Fig. 2 for one drop, from a real `gravsweep run` of the tiny scenario; `run` draws it.
+// Fig. 2 of Sunday et al. 2021 for one drop, from a real `gravsweep run` of the tiny scenario; `run` draws it.
 TEST(CliPlot, TraceDrawsFig2NextToTheRun) {
   const auto& d = tiny_run();
   expect_figure(d / "r" / "fig2.png", 30000u);  // written by `run` itself

@@ -1,5 +1,5 @@
 // A worker that fills the disk exits 1 with "database or disk is full", not with a segfault in
-// HDF5's exit handler (issue #10 item 7), and what it finished stays intact. Runs in a 1 MB
+// HDF5's exit handler, and what it finished stays intact. Runs in a 1 MB
 // tmpfs when this process may mount one (root in a permissive container); skipped with the
 // reason otherwise.
 #include <gtest/gtest.h>

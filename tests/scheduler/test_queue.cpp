@@ -299,7 +299,7 @@ TEST_P(QueueTest, ResumeRequeuesExpiredAndFailedAndRemovesOrphans) {
   std::filesystem::create_directories(paths.tmp());
   test::write_text(paths.abs(a->output_rel), "lost");
   test::write_text(paths.root / "noop" / "ffffffffffffffffffff.a9.json", "orphan");
-  // An orphan is moved only when it is older than the resume's snapshot (issue #10 item 1): this
+  // An orphan is moved only when it is older than the resume's snapshot: this
   // one was left an hour ago.
   std::filesystem::last_write_time(paths.root / "noop" / "ffffffffffffffffffff.a9.json",
                                    std::filesystem::file_time_type::clock::now() - std::chrono::hours(1));

@@ -1,4 +1,4 @@
-// `resume` never loses data (issue #10, items 1-3), with real processes on real files:
+// `resume` never loses data, with real processes on real files:
 // - a loop of `resume` beside `work --workers 8` on 400 no-op jobs loses no finished output;
 // - a 0-byte or foreign database next to a full files folder is refused by every verb but submit;
 // - a renamed copy of a campaign (backup + copied folder) resumes without removing anything, and a

@@ -1,4 +1,4 @@
-// Issue 33 item 13: a large sweep. Its points are validated without building an engine System per
+// A large sweep: its points are validated without building an engine System per
 // point (the engine's checks run once per distinct set of the fields they read), a long expansion
 // shows its progress with an ETA on stderr, and the cap is about cost: a sweep whose expansion would
 // not fit the machine is refused with the memory and time it would take and what is allowed.

@@ -117,7 +117,7 @@ TEST(SweepSpec, MalformedSpecNamesPointerValueAndExpectedType) {
   EXPECT_TRUE(has_problem(ps, "/sweep", "\"bad name!\" (string)", "sweep name")) << ps.size();
   EXPECT_TRUE(has_problem(ps, "/axes/0/values/1", "\"1.62\" (string)", "a number"));
   EXPECT_TRUE(has_problem(ps, "/axes/1/pointer", "\"/gravty\"", "present in the base scenario"));
-  // Numbers are numbers (issue #10 item 11): 2.5 may replace an integer base value; the
+  // Numbers are numbers: 2.5 may replace an integer base value; the
   // scenario schema of an impact sweep still refuses a non-integer where it needs one.
   EXPECT_FALSE(has_problem(ps, "/axes/2/values/1", "2.5 (number)", "an integer"));
   EXPECT_TRUE(has_problem(ps, "/axes/3/range/step", "-1 (integer)", "a positive number"));

@@ -42,7 +42,7 @@ TEST(Failure, OverlapWithAWallNamesTheWall) {
       cfg.contact_law = "hooke";
       cfg.rolling_model = "none";
       cfg.integrator = "leapfrog_kdk";
-      for (auto& m : cfg.materials) m.kn_N_m = 7.48e5;  // dem-physics.md 2.4
+      for (auto& m : cfg.materials) m.kn_N_m = 7.48e5;  // docs/physics/contact-laws.md section 2.4
     }
     System s(cfg);
     s.walls.push_back(Wall::plane("floor", Vec3(0, 0, 0), Vec3(0, 0, 1), 1));

@@ -88,7 +88,7 @@ TEST(VerletList, HistorySurvivesRebuild) {
   EXPECT_GT(kept, 0);
 }
 
-// Issue 12: the rows of the pair loop are split between threads by work, not by count. The work
+// The rows of the pair loop are split between threads by work, not by count. The work
 // prefix of a build weighs a touching pair (an active history) kTouchingWork more than a listed
 // one, plus kRowWork per row, and goes when the rows change (extend, remap, clear).
 TEST(VerletList, WorkPrefixWeighsTouchingPairsAndGoesWhenTheRowsChange) {

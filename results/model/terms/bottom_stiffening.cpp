@@ -1,5 +1,6 @@
-// Bottom-boundary stiffening R = F_b exp(-(H_fill - z)/lambda), lambda = 1 cm (force-laws.md 2.2
-// row 5; Stone et al. 2004; Seguin, Bertho & Gondret 2008). Parameter F_b (N), shared.
+// Bottom-boundary stiffening R = F_b exp(-(H_fill - z)/lambda), lambda = 1 cm
+// (docs/physics/force-laws.md section 2.2; Stone et al. 2004; Seguin, Bertho & Gondret 2008).
+// Parameter F_b (N), shared.
 #include <cmath>
 
 #include "results/model/term.h"

@@ -1,6 +1,6 @@
 // Cohesion: a constant resisting force f_c that does not scale with g, shared by all gravity
-// levels (force-laws.md 2.2 row 9; Yeo et al. 2025). Identifiable only against a baseline whose
-// friction is gravity-scaled; against per-gravity f0 it is absorbed and never ranks.
+// levels (docs/physics/force-laws.md section 2.2; Yeo et al. 2025). Identifiable only against a
+// baseline whose friction is gravity-scaled; against per-gravity f0 it is absorbed and never ranks.
 #include "results/model/term.h"
 
 namespace gravsweep::results {

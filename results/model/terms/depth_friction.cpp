@@ -1,5 +1,5 @@
-// Depth-linear quasi-static friction R = k z (force-laws.md 2.2 row 1; Katsuragi & Durian 2007,
-// Tsimring & Volfson 2005). Parameter k (N/m), per gravity level.
+// Depth-linear quasi-static friction R = k z (docs/physics/force-laws.md section 2.2; Katsuragi &
+// Durian 2007, Tsimring & Volfson 2005). Parameter k (N/m), per gravity level.
 #include "results/model/term.h"
 
 namespace gravsweep::results {

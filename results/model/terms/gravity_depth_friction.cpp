@@ -1,5 +1,6 @@
 // Gravity-loaded depth friction R = kappa g z with one kappa for all gravity levels
-// (force-laws.md 2.2 row 2; Brzinski et al. 2013; Altshuler et al. 2014). Parameter kappa (kg/m).
+// (docs/physics/force-laws.md section 2.2; Brzinski et al. 2013; Altshuler et al. 2014). Parameter
+// kappa (kg/m).
 #include "results/model/term.h"
 
 namespace gravsweep::results {

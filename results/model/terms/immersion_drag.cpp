@@ -1,6 +1,6 @@
-// Partial-immersion inertial drag (force-laws.md 2.2 row 4; Goldman & Umbanhowar 2008; Clark &
-// Behringer 2013): h(z) = (m/d1) A(z)/A_max with A(z) = pi (D z - z^2) for z < D/2. As a
-// correction to the baseline's constant m/d1: R = c m v^2 (A(z)/A_max - 1), c in 1/m (c = 1/d1
+// Partial-immersion inertial drag (docs/physics/force-laws.md section 2.2; Goldman & Umbanhowar
+// 2008; Clark & Behringer 2013): h(z) = (m/d1) A(z)/A_max with A(z) = pi (D z - z^2) for z < D/2.
+// As a correction to the baseline's constant m/d1: R = c m v^2 (A(z)/A_max - 1), c in 1/m (c = 1/d1
 // gives the full cross-section law).
 #include <algorithm>
 

@@ -1,4 +1,5 @@
-// Rate-linear (viscous) drag R = b v (force-laws.md 2.2 row 3; de Bruyn & Walsh 2004).
+// Rate-linear (viscous) drag R = b v (docs/physics/force-laws.md section 2.2;
+// de Bruyn & Walsh 2004).
 #include "results/model/term.h"
 
 namespace gravsweep::results {
