@@ -130,8 +130,8 @@ TEST(LevelOut, AFroudeScaledTruthIsPredictedAtEachInnerHeldOutLevelWithinTheNois
 
 // The same lab with a hidden 0.5 N cohesion, a resistance that does not follow g: the law fitted on
 // the other levels misses every inner held-out level far beyond the same noise bound, and by at
-// least three times the error of the Froude-scaled truth at that level (8 seeds: zstop 33-37 % at
-// 0.1 m/s2 and 84-87 % at 1.62, against 3-11 %).
+// least three times the error of the Froude-scaled truth at that level (8 seeds: zstop 33-38 % at
+// 0.1 m/s2 and 84-87 % at 1.62, against 3-12 %).
 TEST(LevelOut, AResistanceThatDoesNotFollowGravityIsMissedAtTheHeldOutLevels) {
   for (unsigned seed = 1; seed <= kSeeds; ++seed) {
     TempDir d_scaled, d_cohesion;
