@@ -80,7 +80,10 @@ void run_lolo(const LawOptions& o) {
                     "verdict"});
   for (const auto& r : rows) {
     std::string fitted;
-    for (double g : r.fitted_g_m_s2) fitted += (fitted.empty() ? "" : ",") + num(g);
+    for (double g : r.fitted_g_m_s2) {
+      if (!fitted.empty()) fitted += ',';  // appended, not "," + num(g): GCC 12 warns on the latter (-Wrestrict)
+      fitted += num(g);
+    }
     t.add({num(r.g_m_s2), std::to_string(r.trials), fitted, r.inside ? "inside" : "outside",
            num(r.zstop_median_abs_err_pct, 3), num(r.tstop_median_abs_err_pct, 3), num(r.apeak_median_abs_err_pct, 3),
            num(r.zstop_all_levels_median_abs_err_pct, 3), num(r.tstop_all_levels_median_abs_err_pct, 3),
