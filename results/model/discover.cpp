@@ -306,8 +306,7 @@ Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds, doub
   // A gravity-scaled baseline (no parameter per gravity level, e.g. scaled_base) is tested only
   // against terms that are one law for all levels too: a per-level term would absorb, level by
   // level, the very effect whose size does not follow g that this mode is meant to find.
-  d.gravity_scaled =
-      std::none_of(baseline.terms.begin(), baseline.terms.end(), [](const ModelTerm& t) { return t.per_gravity; });
+  d.gravity_scaled = one_law_for_all_levels(baseline);
   for (int round = 0; round < max_rounds; ++round) {
     std::vector<ModelTerm> named;
     for (const auto& term : term_registry())

@@ -38,6 +38,10 @@ bool ModelSpec::has(const std::string& term_name) const {
   return std::any_of(terms.begin(), terms.end(), [&](const ModelTerm& t) { return t.term->name == term_name; });
 }
 
+bool one_law_for_all_levels(const ModelSpec& spec) {
+  return std::none_of(spec.terms.begin(), spec.terms.end(), [](const ModelTerm& t) { return t.per_gravity; });
+}
+
 namespace {
 
 /// The terms of a model file (schemas/model.schema.json, checked by spec/schemas.h; then each name
@@ -245,8 +249,12 @@ int FittedModel::gravity_index(double g) const {
 }
 
 double FittedModel::force(const TermContext& c) const {
-  const int gi = gravity_index(c.g_m_s2);
-  if (gi < 0) throw std::invalid_argument(fmt::format("model has no gravity level {} m/s2", c.g_m_s2));
+  int gi = gravity_index(c.g_m_s2);
+  // A law without a parameter per gravity level holds at any g, a level it was not fitted on
+  // included (the prediction of a held-out level); one with per-level parameters does not.
+  if (gi < 0 && !one_law_for_all_levels(spec))
+    throw std::invalid_argument(fmt::format("model has no gravity level {} m/s2", c.g_m_s2));
+  gi = std::max(gi, 0);
   const Layout L = layout(spec, static_cast<int>(gravity_levels.size()));
   std::vector<double> row(static_cast<std::size_t>(L.cols));
   feature_row(spec, L, gi, c, row.data());

@@ -30,6 +30,9 @@ struct ModelSpec {
 /// spec::SpecError (a ConfigError) names the file and the JSON pointer of every problem; a bad name
 /// in the text form throws std::invalid_argument.
 ModelSpec parse_model(const std::string& text_or_path);
+/// No term of the spec has a parameter per gravity level (scaled_base, terms with ":shared"): the
+/// fitted law holds at any g, levels it was not fitted on included.
+bool one_law_for_all_levels(const ModelSpec& spec);
 
 /// A model with fitted coefficients for the gravity levels of a campaign.
 struct FittedModel {
@@ -40,7 +43,8 @@ struct FittedModel {
   Eigen::MatrixXd cov;  ///< cluster-robust (trials as clusters)
   int trials_used = 0;
   std::size_t samples_used = 0;
-  /// Resisting force R (N) at a state.
+  /// Resisting force R (N) at a state; throws std::invalid_argument at a gravity level the model
+  /// was not fitted on, unless it is one law for all levels (one_law_for_all_levels).
   [[nodiscard]] double force(const TermContext& c) const;
   [[nodiscard]] int gravity_index(double g) const;  ///< -1 when unknown
 };

@@ -1,5 +1,6 @@
 // Helpers shared by the files of results/model/ (model.cpp, table3.cpp, discover.cpp); not API.
 #pragma once
+#include <functional>
 #include <vector>
 
 #include "results/measurements/campaign.h"
@@ -12,6 +13,11 @@ namespace gravsweep::results::detail {
 TermContext context(const MeasuredTrial& t, std::size_t k);
 /// The state at first contact (impact speed, no depth).
 TermContext context(const Trial& i);
+/// Called at the start of each step of the integrated motion (predict): time since contact, depth
+/// and downward speed there, and the step's length (the last step ends at the stop).
+using MotionVisitor = std::function<void(double t_s, double z_m, double v_m_s, double dt_s)>;
+/// predict(m, c0, t_max_s), calling `visit` (when set) at every step.
+Prediction integrate_motion(const FittedModel& m, const TermContext& c0, double t_max_s, const MotionVisitor& visit);
 /// P(X >= k), X ~ Binomial(n, 1/2).
 double binom_tail_half(int k, int n);
 /// One-sided Wilcoxon signed-rank p-value that the per-trial values are centred above 0.

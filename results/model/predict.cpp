@@ -48,6 +48,12 @@ void rk4(Eq1& acc, double& z, double& v, double t, double dt) {
 Prediction predict(const FittedModel& m, const Trial& info) { return predict(m, context(info)); }
 
 Prediction predict(const FittedModel& m, const TermContext& c0, double t_max_s) {
+  return integrate_motion(m, c0, t_max_s, nullptr);
+}
+
+namespace detail {
+
+Prediction integrate_motion(const FittedModel& m, const TermContext& c0, double t_max_s, const MotionVisitor& visit) {
   // RK4 on (z, v), z down: dv/dt = g - R/m (Eq. 1), from z = 0, v = vc.
   Prediction p;
   const double dt = rk4_step_s(c0.g_m_s2);
@@ -59,6 +65,7 @@ Prediction predict(const FittedModel& m, const TermContext& c0, double t_max_s) 
     rk4(acc, zn, vn, t, dt);
     if (vn <= 0) {
       const double f = v / (v - vn);
+      if (visit) visit(t, z, v, f * dt);
       p.tstop_s = t + f * dt;
       p.zstop_m = z + f * (zn - z);
       p.stopped = true;
@@ -66,6 +73,7 @@ Prediction predict(const FittedModel& m, const TermContext& c0, double t_max_s) 
       p.apeak_m_s2 = apeak;
       return p;
     }
+    if (visit) visit(t, z, v, dt);
     z = zn;
     v = vn;
     t += dt;
@@ -75,6 +83,8 @@ Prediction predict(const FittedModel& m, const TermContext& c0, double t_max_s) 
   p.apeak_m_s2 = apeak;
   return p;
 }
+
+}  // namespace detail
 
 namespace {
 

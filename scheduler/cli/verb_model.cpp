@@ -174,6 +174,7 @@ void setup_model(CLI::App& app) {
                                  "measurement campaign. Run `gravsweep model terms` for the term library.");
   sub->require_subcommand(1);
   setup_model_collapse(*sub);
+  setup_model_lolo(*sub);
 
   auto* terms = sub->add_subcommand("terms", "List the registered model terms.\n\nExample:\n  gravsweep model terms");
   auto tf = std::make_shared<std::string>("table");

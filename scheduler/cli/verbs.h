@@ -11,6 +11,8 @@ void setup_measurements(CLI::App& app);
 void setup_model(CLI::App& app);
 /// `model collapse`, a sub-verb of `model` (verb_model_collapse.cpp).
 void setup_model_collapse(CLI::App& model);
+/// `model lolo` and `model regimes`, sub-verbs of `model` (verb_model_lolo.cpp).
+void setup_model_lolo(CLI::App& model);
 void setup_synth(CLI::App& app);
 void setup_report(CLI::App& app);
 void setup_run(CLI::App& app);

@@ -87,7 +87,8 @@ TEST(Cli, BadModelNameIsAUsageError) {
 }
 
 TEST(Cli, HelpTeachesWithExamples) {
-  for (const char* v : {"synth", "report", "model fit", "model rank", "model collapse", "measurements import"}) {
+  for (const char* v : {"synth", "report", "model fit", "model rank", "model collapse", "model lolo", "model regimes",
+                        "measurements import"}) {
     const auto r = run(std::string(v) + " --help");
     EXPECT_EQ(r.code, 0) << v;
     EXPECT_NE(r.out.find("Example"), std::string::npos) << v;
@@ -114,6 +115,24 @@ TEST(Cli, ModelCollapsePrintsItsNumbersAndDrawsTheFroudeFigure) {
   const auto refused = run("model collapse '" + one + "'", true);
   EXPECT_EQ(refused.code, 2) << refused.out;
   EXPECT_NE(refused.out.find("at least two levels"), std::string::npos) << refused.out;
+}
+
+TEST(Cli, ModelLoloPrintsOneRowPerHeldOutLevelAndRefusesAPerLevelLaw) {
+  TempDir d;
+  const std::string c = d.str() + "/c";
+  ASSERT_EQ(run("synth --out '" + c + "' --gravity 9.81,1.62,0.1 --speeds 0.2,0.5,1.0 --repeats 2").code, 0);
+  const auto r = run("model lolo '" + c + "' --format csv");
+  ASSERT_EQ(r.code, 0) << r.out;
+  EXPECT_EQ(r.out.rfind("held_out_g_m_s2,trials,fitted_g_m_s2,range,", 0), 0u) << r.out;
+  EXPECT_NE(r.out.find("\r\n9.81,6,\"1.62,0.1\",outside,"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\r\n1.62,6,\"9.81,0.1\",inside,"), std::string::npos) << r.out;
+  const auto regimes = run("model regimes '" + c + "' --format json");
+  ASSERT_EQ(regimes.code, 0) << regimes.out;
+  EXPECT_EQ(nlohmann::json::parse(regimes.out).size(), 18u) << regimes.out;
+  // A law with a parameter per level cannot predict a level left out of its fit: a usage error.
+  const auto refused = run("model lolo '" + c + "' --law base", true);
+  EXPECT_EQ(refused.code, 2) << refused.out;
+  EXPECT_NE(refused.out.find("has a parameter per gravity level"), std::string::npos) << refused.out;
 }
 
 TEST(Cli, ReportWritesFiguresAndSummary) {

@@ -1,0 +1,102 @@
+// The regime map of a fitted collision law (see regimes.h).
+#include "results/model/regimes.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "results/model/model_internal.h"
+
+namespace gravsweep::results {
+
+using namespace detail;
+
+ResistanceSplit split_resistance(const FittedModel& law, const TermContext& at) {
+  TermContext at_rest = at;
+  at_rest.v_m_s = 0;
+  ResistanceSplit s;
+  s.quasi_static_N = law.force(at_rest);
+  s.dynamic_N = law.force(at) - s.quasi_static_N;
+  return s;
+}
+
+double surface_crossover_froude(const FittedModel& law, const TermContext& at) {
+  TermContext c = at;
+  c.z_m = 0;
+  c.t_since_contact_s = 0;
+  const double scale_m_s = std::sqrt(c.g_m_s2 * c.diameter_m);
+  // dynamic - quasi-static at the surface, at speed v
+  auto excess = [&](double v) {
+    c.v_m_s = v;
+    const ResistanceSplit s = split_resistance(law, c);
+    return s.quasi_static_N > 0 ? s.dynamic_N - s.quasi_static_N : NAN;
+  };
+  double lo = 0, hi = kCrossoverMaxFroude * scale_m_s;
+  if (!(excess(lo) < 0) || !(excess(hi) > 0)) return NAN;
+  for (int i = 0; i < 100 && hi - lo > 1e-12 * scale_m_s; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (excess(mid) > 0 ? hi : lo) = mid;
+  }
+  return 0.5 * (lo + hi) / scale_m_s;
+}
+
+namespace {
+
+/// The motion of one drop under the law, with the impulse and the work of each part and the first
+/// state where the dynamic part is no longer the larger.
+RegimeTrial regimes_of(const FittedModel& law, const MeasuredTrial& t) {
+  RegimeTrial r;
+  const TermContext c0 = context(t.info);
+  r.g_m_s2 = c0.g_m_s2;
+  r.vc_m_s = c0.vc_m_s;
+  const double scale_m_s = std::sqrt(c0.g_m_s2 * c0.diameter_m);
+  r.impact_froude = c0.vc_m_s / scale_m_s;
+  r.surface_crossover_froude = surface_crossover_froude(law, c0);
+  double impulse_qs = 0, impulse_all = 0, work_qs = 0, work_all = 0;
+  double prev_excess = NAN, prev_v = NAN, prev_z = NAN;
+  bool first = true, starts_dynamic = false, crossed = false;
+  // The first state where the dynamic part is no longer the larger, interpolated linearly between
+  // steps; none when the drop starts in the quasi-static regime.
+  auto watch = [&](double z, double v, double excess) {
+    if (first)
+      starts_dynamic = excess > 0;
+    else if (starts_dynamic && !crossed && !(excess > 0)) {
+      const double f = prev_excess / (prev_excess - excess);
+      r.crossover_froude = (prev_v + f * (v - prev_v)) / scale_m_s;
+      r.crossover_depth_m = prev_z + f * (z - prev_z);
+      crossed = true;
+    }
+    first = false;
+    prev_excess = excess, prev_v = v, prev_z = z;
+  };
+  TermContext c = c0;
+  const Prediction p = integrate_motion(law, c0, 10.0, [&](double t_s, double z, double v, double dt) {
+    c.z_m = z, c.v_m_s = v, c.t_since_contact_s = t_s;
+    const ResistanceSplit s = split_resistance(law, c);
+    impulse_qs += s.quasi_static_N * dt, impulse_all += (s.quasi_static_N + s.dynamic_N) * dt;
+    work_qs += s.quasi_static_N * v * dt, work_all += (s.quasi_static_N + s.dynamic_N) * v * dt;
+    watch(z, v, s.dynamic_N - s.quasi_static_N);
+  });
+  r.stopped = p.stopped;
+  if (p.stopped) {
+    c.z_m = p.zstop_m, c.v_m_s = 0, c.t_since_contact_s = p.tstop_s;
+    const ResistanceSplit s = split_resistance(law, c);
+    watch(p.zstop_m, 0.0, s.dynamic_N - s.quasi_static_N);
+  }
+  if (impulse_all > 0) r.quasi_static_impulse_pct = 100 * impulse_qs / impulse_all;
+  if (work_all > 0) r.quasi_static_work_pct = 100 * work_qs / work_all;
+  return r;
+}
+
+}  // namespace
+
+std::vector<RegimeTrial> regime_map(const FittedModel& law, const Campaign& c) {
+  std::vector<RegimeTrial> out;
+  for (std::size_t i = 0; i < c.trials.size(); ++i) {
+    RegimeTrial r = regimes_of(law, c.trials[i]);
+    r.trial = i;
+    out.push_back(r);
+  }
+  return out;
+}
+
+}  // namespace gravsweep::results
