@@ -246,7 +246,7 @@ Campaign load_campaign(const std::string& directory, double cutoff_hz) {
   if (!in)
     throw std::runtime_error(
         fmt::format("{}: cannot open (a campaign folder holds trials.csv and "
-                    "traces/, see shared/formats/measurements.md)",
+                    "traces/, see docs/formats/measurements.md)",
                     csv.string()));
   CsvReader reader(in);
   std::vector<std::string> head, f;

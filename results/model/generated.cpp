@@ -159,7 +159,7 @@ TermInfo make_term(const std::vector<Factor>& fs) {
   t.name = name_of(fs);
   t.generated = true;
   t.meaning = fmt::format("generated form c * {} ({}): not a named effect", t.name, words_of(fs));
-  t.references = "generated family (issue 13 item 4; shared/reference/force-laws.md 2.6)";
+  t.references = "generated family (docs/physics/force-laws.md 2.6)";
   t.signature = "found by the search beyond the named library";
   t.params = {"c_N_per_phi"};
   t.per_gravity = true;

@@ -174,7 +174,7 @@ void setup_export(CLI::App& app) {
   auto o = std::make_shared<ExportOptions>();
   auto* sub = app.add_subcommand(
       "export",
-      "Write a campaign's finished drops as a measurement campaign (shared/formats/measurements.md):\n"
+      "Write a campaign's finished drops as a measurement campaign (docs/formats/measurements.md):\n"
       "OUT/trials.csv (one row per drop: gravity, impact speed, fill, projectile, grains, sample rate,\n"
       "source = dem, the engine's first-contact time, sweep, job, code version), OUT/traces/<job>.csv\n"
       "(t_s, accel_m_s2, position_m, velocity_m_s at --rate-hz after a 4th-order anti-alias low-pass\n"

@@ -319,7 +319,7 @@ void setup_model(CLI::App& app) {
   auto od = std::make_shared<DetectOptions>();
   auto* det = sub->add_subcommand(
       "check-detection",
-      "Validate `model rank` on synthetic laboratories (force-laws.md 2.4 step 4): for each hidden\n"
+      "Validate `model rank` on synthetic laboratories (docs/physics/force-laws.md 2.4 step 4): for each hidden\n"
       "term, write --seeds campaigns with `synth` (72 trials each, default noise), rank, and count\n"
       "how often the hidden term is ranked first and significant; then --null-seeds campaigns with\n"
       "nothing hidden, counting how often anything is reported. Campaigns go to a temporary folder.\n\n"

@@ -19,7 +19,7 @@ void setup_synth(CLI::App& app) {
   auto out = std::make_shared<std::string>();
   auto* sub =
       app.add_subcommand("synth",
-                         "Write a synthetic measurement campaign (shared/formats/measurements.md) from a model\n"
+                         "Write a synthetic measurement campaign (docs/formats/measurements.md) from a model\n"
                          "(terms with their typical values, see `gravsweep model terms`) plus a noise model: sensor\n"
                          "noise and bias (scaled with g, or fixed for one sensor range at every level), grain-scale\n"
                          "force fluctuations (correlated, multiplicative), per-trial bed spread, a contact ramp over\n"
