@@ -9,9 +9,8 @@
 #include "results/model/collapse.h"
 #include "results/report/figures.h"
 #include "results/report/table.h"
-#include "scheduler/cli/campaign_input.h"
 #include "scheduler/cli/exit_codes.h"
-#include "scheduler/cli/format_option.h"
+#include "scheduler/cli/model_inputs.h"
 #include "scheduler/cli/verbs.h"
 
 namespace gravsweep::cli {
@@ -19,16 +18,12 @@ namespace gravsweep::cli {
 namespace {
 
 struct CollapseOptions {
-  std::vector<std::string> inputs;
-  std::vector<std::string> where;
-  std::string format = "table";
-  std::string plot;
-  std::string files;
+  ModelInputs in;
+  std::string plot;  ///< the figure's PNG; empty: none
 };
 
 void run_collapse(const CollapseOptions& o) {
-  const auto in = load_campaign_inputs(o.inputs, o.where, 500.0, o.files);
-  const auto& c = in.campaign;
+  const auto c = load_model_campaign(o.in, 0);
   if (c.gravity_levels().size() < 2)
     throw UsageError(fmt::format("{} trials on {} gravity level(s): a collapse needs at least two levels",
                                  c.trials.size(), c.gravity_levels().size()));
@@ -38,11 +33,11 @@ void run_collapse(const CollapseOptions& o) {
     t.add({r.metric, std::to_string(r.levels), std::to_string(r.trials), results::num(r.common_scatter_pct, 3),
            results::num(r.within_scatter_pct, 3), results::num(r.between_levels_pct, 3),
            results::num(r.collapse_ratio, 3)});
-  t.print(o.format);
+  t.print(o.in.format);
   if (!o.plot.empty()) {
     results::draw_collapse(c, o.plot,
                            fmt::format("{} trials, {} gravity levels", c.trials.size(), c.gravity_levels().size()));
-    if (o.format == "table") fmt::print("wrote {}\n", o.plot);
+    if (o.in.format == "table") fmt::print("wrote {}\n", o.plot);
   }
 }
 
@@ -61,13 +56,8 @@ void setup_model_collapse(CLI::App& model) {
       "Examples:\n"
       "  gravsweep model collapse data/gravity_sweep/g9.81 data/gravity_sweep/g1.62 --plot collapse.png\n"
       "  gravsweep model collapse runs/gravity_sweep/sweep.db --where 'sweep~gravity_sweep_' --format csv");
-  sub->add_option("inputs", o->inputs,
-                  "campaign database, imported SQLite file or lab campaign folder; several are read as one")
-      ->required();
-  sub->add_option("--where", o->where, "filter the trials, grammar of `gravsweep results`; repeatable");
-  add_input_files_option(sub, o->files);
+  add_model_inputs(sub, o->in);
   sub->add_option("--plot", o->plot, "also draw the three scaled metrics against Fr, coloured by g (PNG)");
-  add_format_option(sub, o->format);
   sub->callback([o]() { run_collapse(*o); });
 }
 

@@ -13,9 +13,8 @@
 #include "results/model/level_out.h"
 #include "results/model/regimes.h"
 #include "results/report/table.h"
-#include "scheduler/cli/campaign_input.h"
 #include "scheduler/cli/exit_codes.h"
-#include "scheduler/cli/format_option.h"
+#include "scheduler/cli/model_inputs.h"
 #include "scheduler/cli/verbs.h"
 
 namespace gravsweep::cli {
@@ -24,35 +23,14 @@ namespace {
 
 using results::num;
 
-constexpr const char* kInputsHelp =
-    "campaign database, imported SQLite file or lab campaign folder; several are read as one (e.g. one exported "
-    "dataset per gravity level)";
 constexpr const char* kLawHelp =
     "the law: scaled_base (phi m g + m v^2/d1, one law for all levels) or a term list whose terms are all shared, "
     "e.g. 'scaled_base+cohesion' or 'scaled_base+gravity_depth_friction'";
 
 struct LawOptions {
-  std::vector<std::string> inputs;
-  std::vector<std::string> where;
-  std::string files;
+  ModelInputs in;
   std::string law = "scaled_base";
-  std::string format = "table";
 };
-
-results::Campaign load_levels(const LawOptions& o) {
-  auto in = load_campaign_inputs(o.inputs, o.where, 500.0, o.files);
-  if (in.campaign.trials.size() < 6)
-    throw UsageError(fmt::format("{} usable trials; at least 6 are needed", in.campaign.trials.size()));
-  return std::move(in.campaign);
-}
-
-results::ModelSpec law_of(const std::string& text) {
-  try {
-    return results::parse_model(text);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
-}
 
 /// The fitted constants of a law, "phi=1.59 inv_d1_1_m=24.8".
 std::string constants(const results::FittedModel& m) {
@@ -66,8 +44,8 @@ std::string constants(const results::FittedModel& m) {
 }
 
 void run_lolo(const LawOptions& o) {
-  const auto c = load_levels(o);
-  const auto spec = law_of(o.law);
+  const auto c = load_model_campaign(o.in);
+  const auto spec = model_of(o.law);
   std::vector<results::LevelOutRow> rows;
   try {
     rows = results::leave_level_out(spec, c);
@@ -89,12 +67,12 @@ void run_lolo(const LawOptions& o) {
            num(r.zstop_all_levels_median_abs_err_pct, 3), num(r.tstop_all_levels_median_abs_err_pct, 3),
            num(r.zstop_law_sd_pct, 2), num(r.tstop_law_sd_pct, 2), constants(r.law), r.verdict});
   }
-  if (o.format == "table")
+  if (o.in.format == "table")
     fmt::print(
         "Leave one gravity level out: {} fitted on the other levels, each drop of the held-out level predicted "
         "(median |error| over its drops; targets zstop {:g} %, tstop {:g} % inside the fitted range):\n",
         spec.name(), results::kLevelOutZstopTargetPct, results::kLevelOutTstopTargetPct);
-  t.print(o.format);
+  t.print(o.in.format);
 }
 
 /// The summary under the regime table: the law's crossover at the surface, the median along the
@@ -117,8 +95,8 @@ std::string crossover_summary(const results::FittedModel& law, const std::vector
 }
 
 void run_regimes(const LawOptions& o) {
-  const auto c = load_levels(o);
-  const auto law = results::fit_model(law_of(o.law), c);
+  const auto c = load_model_campaign(o.in);
+  const auto law = results::fit_model(model_of(o.law), c);
   const auto map = results::regime_map(law, c);
   results::Table t({"trial_id", "gravity_m_s2", "vc_m_s", "impact_fr", "quasi_static_impulse_pct", "drag_impulse_pct",
                     "quasi_static_work_pct", "drag_work_pct", "crossover_fr", "crossover_depth_mm", "law_crossover_fr",
@@ -130,22 +108,19 @@ void run_regimes(const LawOptions& o) {
            std::isfinite(r.crossover_froude) ? num(r.crossover_froude, 3) : "-",
            std::isfinite(r.crossover_depth_m) ? num(1e3 * r.crossover_depth_m, 3) : "-",
            num(r.surface_crossover_froude, 3), num(results::kPaperIICrossoverFroude)});
-  if (o.format == "table")
+  if (o.in.format == "table")
     fmt::print("Regime map of {} fitted on all {} trials (quasi-static: R(z, v=0); drag: the speed-dependent rest):\n",
                law.spec.name(), law.trials_used);
-  t.print(o.format);
-  if (o.format == "table")
+  t.print(o.in.format);
+  if (o.in.format == "table")
     fmt::print("\n{}\n", crossover_summary(law, map));
   else
     std::fprintf(stderr, "%s\n", crossover_summary(law, map).c_str());
 }
 
 CLI::App* add_law_inputs(CLI::App* sub, LawOptions& o) {
-  sub->add_option("inputs", o.inputs, kInputsHelp)->required();
-  sub->add_option("--where", o.where, "filter the trials, grammar of `gravsweep results`; repeatable");
-  add_input_files_option(sub, o.files);
+  add_model_inputs(sub, o.in);
   sub->add_option("--law", o.law, kLawHelp)->capture_default_str();
-  add_format_option(sub, o.format);
   return sub;
 }
 

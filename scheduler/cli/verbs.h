@@ -9,9 +9,13 @@ namespace gravsweep::cli {
 void setup_bench(CLI::App& app);
 void setup_measurements(CLI::App& app);
 void setup_model(CLI::App& app);
-/// `model collapse`, a sub-verb of `model` (verb_model_collapse.cpp).
+// The sub-verbs of `model`, one file each (verb_model_<name>.cpp; lolo also adds `regimes`).
+void setup_model_table3(CLI::App& model);
+void setup_model_fit(CLI::App& model);
+void setup_model_residuals(CLI::App& model);
+void setup_model_check_detection(CLI::App& model);
+void setup_model_rank(CLI::App& model);
 void setup_model_collapse(CLI::App& model);
-/// `model lolo` and `model regimes`, sub-verbs of `model` (verb_model_lolo.cpp).
 void setup_model_lolo(CLI::App& model);
 void setup_synth(CLI::App& app);
 void setup_report(CLI::App& app);

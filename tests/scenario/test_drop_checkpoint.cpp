@@ -43,6 +43,7 @@ class DropCheckpoint : public ::testing::Test {
 
   fs::path ckpt_ = dir_->path / "checkpoints" / "job.ckpt.h5";
   std::vector<std::string> warnings_;
+  json scenario_ = test::tiny_scenario();  ///< the drop every attempt() runs
 
   pipeline::DropCheckpointing checkpointing() {
     pipeline::DropCheckpointing c;
@@ -60,7 +61,7 @@ class DropCheckpoint : public ::testing::Test {
       if (f >= stop_at && f < 1) stop.store(true);  // 1: the drop has ended
     };
     try {
-      const auto r = pipeline::run_drop_job(test::tiny_scenario(), bed(), trace, 1, progress, &stop, checkpointing());
+      const auto r = pipeline::run_drop_job(scenario_, bed(), trace, 1, progress, &stop, checkpointing());
       if (metrics) *metrics = r.metrics;
       return true;
     } catch (const pipeline::Interrupted& e) {
@@ -115,6 +116,25 @@ TEST_F(DropCheckpoint, ResumedThreeTimesTheTraceIsTheUninterruptedOne) {
   EXPECT_EQ(m["checkpoint_resumes"], 3);
   EXPECT_EQ(m["resumed_at_s"].get<double>(), t3);
   EXPECT_NO_FATAL_FAILURE(expect_same_trace(reference(), dir_->path / "resumed.h5"));
+}
+
+// The same at the adaptive step of /time_step (engine/scenario/time_step.h): the step is chosen
+// again before each sample interval from the state, so a drop resumed at a sample continues with
+// the step an uninterrupted one takes there. The step must really grow: fewer steps than fixed.
+TEST_F(DropCheckpoint, AtTheAdaptiveStepTheResumedTraceIsTheUninterruptedOne) {
+  scenario_["time_step"] = {{"steps_per_contact", 10}, {"dt_max_s", 4e-5}};
+  json uninterrupted;
+  ASSERT_TRUE(attempt(dir_->path / "adaptive_reference.h5", 2.0, &uninterrupted));
+  const json fixed = json::parse(results::read_trace(reference()).metrics_json);
+  EXPECT_LT(uninterrupted["steps"].get<long>(), fixed["steps"].get<long>() * 3 / 4)
+      << "the adaptive step never grew past the fixed step: this test would not test it";
+  ASSERT_NO_FATAL_FAILURE(interrupted_once(0.04));
+  EXPECT_FALSE(attempt(dir_->path / "never.h5", 0.12));
+  json m;
+  ASSERT_TRUE(attempt(dir_->path / "adaptive_resumed.h5", 2.0, &m));
+  EXPECT_TRUE(warnings_.empty()) << warnings_.front();
+  EXPECT_EQ(m["checkpoint_resumes"], 2);
+  EXPECT_NO_FATAL_FAILURE(expect_same_trace(dir_->path / "adaptive_reference.h5", dir_->path / "adaptive_resumed.h5"));
 }
 
 // The file holds the drop exactly: every array and counter read back equals what was written.
