@@ -1,5 +1,5 @@
 // The type of the force pass a (contact law, rolling model) pair compiles to: the registry
-// (engine/contact/registry.cpp) makes them, the System calls the one it selected. Kept apart so
+// (engine/system/law_registry.cpp) makes them, the System calls the one it selected. Kept apart so
 // that neither header includes the other.
 #pragma once
 

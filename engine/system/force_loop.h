@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "engine/contact/hertz_batch.h"
+#include "engine/system/hertz_batch.h"
 #include "engine/core/particles.h"
 #include "engine/geometry/walls.h"
 #include "engine/neighbor/verlet_list.h"

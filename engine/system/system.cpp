@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "engine/contact/registry.h"
+#include "engine/system/law_registry.h"
 #include "engine/core/error.h"
 #include "engine/system/force_loop.h"
 

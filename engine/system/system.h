@@ -20,8 +20,8 @@
 namespace gravsweep {
 
 struct SystemConfig {
-  std::string contact_law = "hertz";               ///< see contact_law_names() (contact/registry.h)
-  std::string rolling_model = "sunday";            ///< see rolling_model_names() (contact/registry.h)
+  std::string contact_law = "hertz";               ///< see contact_law_names() (system/law_registry.h)
+  std::string rolling_model = "sunday";            ///< see rolling_model_names() (system/law_registry.h)
   std::string integrator = "semi_implicit_euler";  ///< see integrator_table()
   double dt_s = 1e-6;
   Vec3 gravity_m_s2 = Vec3(0, 0, -9.81);

@@ -3,7 +3,7 @@
 
 #include <stdexcept>
 
-#include "engine/contact/registry.h"
+#include "engine/system/law_registry.h"
 #include "engine/system/system.h"
 
 namespace gravsweep {

@@ -11,7 +11,7 @@
 #include "results/io/hdf5.h"
 #include "results/io/trace_file.h"
 #include "results/measurements/campaign.h"
-#include "results/report/table.h"
+#include "results/io/table.h"
 
 namespace gravsweep::results {
 

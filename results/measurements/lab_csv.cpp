@@ -12,7 +12,7 @@
 #include <stdexcept>
 
 #include "results/measurements/campaign.h"
-#include "results/measurements/csv.h"
+#include "results/io/csv.h"
 
 namespace gravsweep::results {
 

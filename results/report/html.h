@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "results/report/table.h"
+#include "results/io/table.h"
 
 namespace gravsweep::results {
 

@@ -12,7 +12,7 @@
 #include <stdexcept>
 
 #include "results/report/plots_py.h"
-#include "results/report/table.h"
+#include "results/io/table.h"
 
 namespace gravsweep::results {
 

@@ -1,4 +1,4 @@
-// --format, the same in every verb: one of the formats of the table writer (results/report/table.h),
+// --format, the same in every verb: one of the formats of the table writer (results/io/table.h),
 // an unknown value refused while parsing (exit code 2) with the same message in every verb, e.g.
 // "--format: xml not in {table,csv,json}".
 #pragma once
@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "results/report/table.h"
+#include "results/io/table.h"
 
 namespace gravsweep::cli {
 

@@ -5,7 +5,7 @@
 
 #include <stdexcept>
 
-#include "results/report/table.h"
+#include "results/io/table.h"
 #include "scheduler/cli/campaign_input.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/format_option.h"

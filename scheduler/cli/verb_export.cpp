@@ -20,7 +20,7 @@
 #include "results/measurements/campaign.h"
 #include "results/measurements/trial.h"
 #include "results/processing/resample.h"
-#include "results/report/table.h"
+#include "results/io/table.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "results/measurements/campaign.h"
-#include "results/report/table.h"
+#include "results/io/table.h"
 #include "scheduler/cli/campaign_input.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/format_option.h"

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "results/model/model.h"
-#include "results/report/table.h"
+#include "results/io/table.h"
 #include "scheduler/cli/format_option.h"
 #include "scheduler/cli/verbs.h"
 

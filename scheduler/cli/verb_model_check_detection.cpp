@@ -10,7 +10,7 @@
 
 #include "results/model/model.h"
 #include "results/model/synth.h"
-#include "results/report/table.h"
+#include "results/io/table.h"
 #include "scheduler/cli/format_option.h"
 #include "scheduler/cli/model_inputs.h"
 #include "scheduler/cli/verbs.h"

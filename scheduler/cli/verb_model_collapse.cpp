@@ -8,7 +8,7 @@
 
 #include "results/model/collapse.h"
 #include "results/report/figures.h"
-#include "results/report/table.h"
+#include "results/io/table.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/model_inputs.h"
 #include "scheduler/cli/verbs.h"

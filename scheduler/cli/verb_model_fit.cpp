@@ -12,7 +12,7 @@
 
 #include "results/model/model.h"
 #include "results/report/report.h"
-#include "results/report/table.h"
+#include "results/io/table.h"
 #include "scheduler/cli/model_inputs.h"
 #include "scheduler/cli/verbs.h"
 

@@ -12,7 +12,7 @@
 
 #include "results/model/level_out.h"
 #include "results/model/regimes.h"
-#include "results/report/table.h"
+#include "results/io/table.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/model_inputs.h"
 #include "scheduler/cli/verbs.h"

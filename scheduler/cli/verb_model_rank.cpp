@@ -9,7 +9,7 @@
 #include <string>
 
 #include "results/model/model.h"
-#include "results/report/table.h"
+#include "results/io/table.h"
 #include "scheduler/cli/model_inputs.h"
 #include "scheduler/cli/verbs.h"
 

@@ -12,7 +12,7 @@
 #include "engine/scenario/paper_params.h"
 #include "engine/scenario/pile.h"
 #include "scheduler/cli/progress.h"
-#include "results/report/table.h"
+#include "results/io/table.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/format_option.h"
 #include "scheduler/cli/verbs.h"

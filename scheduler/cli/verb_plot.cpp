@@ -15,7 +15,7 @@
 
 #include "results/report/figures.h"
 #include "results/report/report.h"
-#include "results/report/table.h"
+#include "results/io/table.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"

@@ -14,7 +14,7 @@
 #include "results/model/model.h"
 #include "results/report/html.h"
 #include "results/report/report.h"
-#include "results/report/table.h"
+#include "results/io/table.h"
 #include "scheduler/cli/campaign_input.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"

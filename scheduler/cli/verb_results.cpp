@@ -12,7 +12,7 @@
 #include "results/measurements/trial.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/campaign_options.h"
-#include "results/report/table.h"
+#include "results/io/table.h"
 #include "scheduler/cli/format_option.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/filter.h"

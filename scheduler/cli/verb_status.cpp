@@ -11,7 +11,7 @@
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/progress.h"
 #include "scheduler/cli/campaign_options.h"
-#include "results/report/table.h"
+#include "results/io/table.h"
 #include "scheduler/cli/format_option.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/pipeline/stop.h"

@@ -14,7 +14,7 @@
 #include <random>
 #include <sstream>
 
-#include "engine/contact/registry.h"
+#include "engine/system/law_registry.h"
 #include "engine/integrate/integrators.h"
 #include "engine/scenario/paper_params.h"
 #include "scheduler/sweep/canonical.h"

@@ -14,7 +14,7 @@
 
 #include "engine/scenario/bed.h"
 #include "results/io/bed_file.h"
-#include "results/measurements/csv.h"
+#include "results/io/csv.h"
 #include "results_helpers.h"
 #include "tests/common/temp_dir.h"
 

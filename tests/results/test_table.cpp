@@ -1,4 +1,4 @@
-// The one table writer of every verb (results/report/table.h): aligned text, CSV (RFC 4180), JSON.
+// The one table writer of every verb (results/io/table.h): aligned text, CSV (RFC 4180), JSON.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "results/measurements/csv.h"
-#include "results/report/table.h"
+#include "results/io/csv.h"
+#include "results/io/table.h"
 
 using namespace gravsweep::results;
 

@@ -12,8 +12,8 @@
 #include "poncelet.h"
 #include "results/io/trace_file.h"
 #include "results/measurements/campaign.h"
-#include "results/measurements/csv.h"
-#include "results/report/table.h"
+#include "results/io/csv.h"
+#include "results/io/table.h"
 #include "results_helpers.h"
 
 using namespace gravsweep::results;
@@ -175,7 +175,7 @@ TEST(Csv, Rfc4180QuotingAndAByteOrderMark) {
   EXPECT_EQ(csv_field("x, \"y\""), "\"x, \"\"y\"\"\"");
 }
 
-// The verbs' table writer (results/report/table.h) writes CSV that the reader reads back: a comma
+// The verbs' table writer (results/io/table.h) writes CSV that the reader reads back: a comma
 // or a quote in a value does not shift the columns (it wrote them bare before).
 TEST(Csv, TableWriterQuotesCommasAndQuotesAndReadsBack) {
   Table t({"trial_id", "note"});

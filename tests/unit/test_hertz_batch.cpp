@@ -8,7 +8,7 @@
 #include <cmath>
 #include <random>
 
-#include "engine/contact/hertz_batch.h"
+#include "engine/system/hertz_batch.h"
 #include "engine/contact/hertz_chrono.h"
 #include "engine/rolling/rolling_none.h"
 #include "engine/rolling/rolling_sunday.h"

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "engine/contact/registry.h"
+#include "engine/system/law_registry.h"
 #include "engine/core/error.h"
 #include "engine/scenario/paper_params.h"
 #include "engine/system/system.h"

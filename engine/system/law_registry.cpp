@@ -1,4 +1,4 @@
-#include "engine/contact/registry.h"
+#include "engine/system/law_registry.h"
 
 #include <fmt/format.h>
 

@@ -1,11 +1,11 @@
-#include "results/report/table.h"
+#include "results/io/table.h"
 
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
 
-#include "results/measurements/csv.h"
+#include "results/io/csv.h"
 
 namespace gravsweep::results {
 

@@ -1,4 +1,4 @@
-#include "results/measurements/csv.h"
+#include "results/io/csv.h"
 
 namespace gravsweep::results {
 
