@@ -105,7 +105,7 @@ for lv in levels:
     def pick(kind):
         mine = [r for r in rows if r[0] == lv and r[1] == kind]
         return (statistics.median(float(r[2]) for r in mine), statistics.median(float(r[3]) for r in mine),
-                statistics.median(int(r[4]) for r in mine), mine[-1][5] == "true")
+                statistics.median(int(r[4]) for r in mine), mine[-1][5].lower() == "true")
     mw, ms, mn, mstop = pick("main")
     tw, ts, tn, _ = pick("this")
     mrate, trate = 60 * ms / mw, 60 * ts / tw

@@ -133,6 +133,7 @@ done
 median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print (NR%2) ? a[(NR+1)/2] : 0.5*(a[NR/2]+a[NR/2+1])}'; }
 mg1="$(median "${g1[@]}")"; mg2="$(median "${g2[@]}")"; ml1="$(median "${l1[@]}")"; ml2="$(median "${l2[@]}")"
 echo
+echo "host: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores; gravsweep $("$gravsweep" --version); LAMMPS $(lmp -h 2>/dev/null | grep -m1 -o '[0-9]* [A-Z][a-z]* [0-9]\{4\}[^$]*' || true)"
 echo "medians of $rounds interleaved rounds, $steps steps after $warmup warm-up, dt 1 us, $(wc -l <"$work/bed.data" | awk '{print "bed.data " $1 " lines"}'); load average $(cut -d' ' -f1-3 /proc/loadavg)"
 printf '%-28s %10s %10s\n' "ns per particle-step" "1 core" "2 cores"
 printf '%-28s %10.1f %10.1f\n' "gravsweep (bench --bed)" "$mg1" "$mg2"
