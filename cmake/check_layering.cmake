@@ -6,12 +6,14 @@
 # the folders before it:
 #   engine/:  core geometry integrate contact rolling neighbor system scenario
 #   results/: processing io measurements model report
-# (scheduler/'s folders are not layered yet: sweep/ and queue/ include each other.)
+#   scheduler/: queue sweep pipeline cli (the queue knows job kinds by name; the impact kinds
+#               register their runners from pipeline/)
 # gravsweep_check_layering(<source dir>) stops with FATAL_ERROR naming each file and include
 # that points the wrong way. Run as a script (cmake -DROOT=<dir> -P check_layering.cmake) from CTest.
 set(GRAVSWEEP_FOLDER_ORDER
     "engine:core,geometry,integrate,contact,rolling,neighbor,system,scenario"
-    "results:processing,io,measurements,model,report")
+    "results:processing,io,measurements,model,report"
+    "scheduler:queue,sweep,pipeline,cli")
 
 # Appends to `problems` (in the caller) each include in <root>/<lib>/ that reaches a later folder
 # of the same library than the including file's.
@@ -65,7 +67,7 @@ function(gravsweep_check_layering root)
     endforeach()
   endforeach()
   if(problems)
-    message(FATAL_ERROR "layering: includes against the dependency direction (scheduler -> results -> spec -> engine; results -> db; inside engine/ and results/ the folder order above):${problems}")
+    message(FATAL_ERROR "layering: includes against the dependency direction (scheduler -> results -> spec -> engine; results -> db; inside each library the folder order above):${problems}")
   endif()
 endfunction()
 

@@ -1,5 +1,5 @@
 // SHA-256 (FIPS 180-4): the one content hash of the project (job ids and bed checksums in
-// scheduler/sweep/canonical.h, stored traces in results/measurements/campaign.cpp).
+// scheduler/queue/canonical.h, stored traces in results/measurements/campaign.cpp).
 #pragma once
 #include <cstddef>
 #include <cstdint>

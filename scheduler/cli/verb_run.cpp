@@ -17,7 +17,7 @@
 #include "scheduler/cli/verbs.h"
 #include "scheduler/pipeline/impact_job.h"
 #include "scheduler/pipeline/scenario_spec.h"
-#include "scheduler/pipeline/stop.h"
+#include "scheduler/queue/stop.h"
 
 namespace gravsweep::cli {
 
@@ -148,7 +148,7 @@ void run_impact(const RunOptions& o) {
   std::filesystem::create_directories(out, ec);
   if (ec) throw std::runtime_error(fmt::format("{}: cannot create the output folder: {}", out.string(), ec.message()));
 
-  const pipeline::ScopedStopSignals stop_signals;  // SIGINT/SIGTERM end the job cleanly (exit 130)
+  const queue::ScopedStopSignals stop_signals;  // SIGINT/SIGTERM end the job cleanly (exit 130)
 
   ProgressBar bar(!o.quiet);
   auto progress = [&](const std::string& phase, double f, const std::string& d) { bar.update(phase, f, d); };
@@ -157,7 +157,7 @@ void run_impact(const RunOptions& o) {
     nlohmann::json bed_report;
     if (o.bed.empty()) {
       bed_path = out / "bed.h5";
-      const auto b = pipeline::run_bed_job(scenario, bed_path, o.threads, progress, &pipeline::stop_requested());
+      const auto b = pipeline::run_bed_job(scenario, bed_path, o.threads, progress, &queue::stop_requested());
       bar.finish();
       pipeline::write_bed_checksum(bed_path);
       bed_report = b.report;
@@ -172,7 +172,7 @@ void run_impact(const RunOptions& o) {
       fmt::print("bed: reusing {}\n", bed_path.string());
     }
     const auto d =
-        pipeline::run_drop_job(scenario, bed_path, out / "trace.h5", o.threads, progress, &pipeline::stop_requested());
+        pipeline::run_drop_job(scenario, bed_path, out / "trace.h5", o.threads, progress, &queue::stop_requested());
     bar.finish();
     nlohmann::json metrics = d.metrics;
     metrics["scenario"] = std::filesystem::absolute(o.scenario).string();

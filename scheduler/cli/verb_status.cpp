@@ -14,7 +14,7 @@
 #include "results/io/table.h"
 #include "scheduler/cli/format_option.h"
 #include "scheduler/cli/verbs.h"
-#include "scheduler/pipeline/stop.h"
+#include "scheduler/queue/stop.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
 #include "scheduler/queue/worker.h"
@@ -142,7 +142,7 @@ nlohmann::json status_json(const queue::Status& s) {
 
 void run_status(const StatusOptions& o) {
   db::Database db = queue::open_campaign(o.db, queue::OpenMode::read);
-  if (o.watch_s > 0) pipeline::install_stop_signals();
+  if (o.watch_s > 0) queue::install_stop_signals();
   do {
     const auto t0 = std::chrono::steady_clock::now();
     const auto s = queue::status(db, static_cast<std::size_t>(o.max_running));
@@ -173,9 +173,9 @@ void run_status(const StatusOptions& o) {
     std::fflush(stdout);
     if (o.watch_s <= 0) break;
     const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.watch_s);
-    while (!pipeline::stop_requested().load() && std::chrono::steady_clock::now() < until)
+    while (!queue::stop_requested().load() && std::chrono::steady_clock::now() < until)
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  } while (!pipeline::stop_requested().load());
+  } while (!queue::stop_requested().load());
 }
 
 }  // namespace

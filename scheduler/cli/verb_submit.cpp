@@ -13,7 +13,7 @@
 #include "scheduler/cli/progress.h"
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
-#include "scheduler/queue/impact.h"
+#include "scheduler/pipeline/impact_runners.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/filter.h"
 #include "scheduler/queue/queue.h"
@@ -33,10 +33,10 @@ struct SubmitOptions {
 
 /// `--where` on the swept parameters: drops (or noop jobs) that fail a condition are not
 /// submitted, nor any bed that no kept drop needs. Returns how many points were left out.
-std::size_t keep_matching(const std::string& path, std::vector<sweep::PlannedJob>& jobs,
+std::size_t keep_matching(const std::string& path, std::vector<queue::PlannedJob>& jobs,
                           const std::vector<std::string>& where) {
   if (where.empty()) return 0;
-  std::vector<sweep::PlannedJob> kept;
+  std::vector<queue::PlannedJob> kept;
   std::set<std::string> beds_needed;
   std::size_t left_out = 0;
   try {
@@ -53,7 +53,7 @@ std::size_t keep_matching(const std::string& path, std::vector<sweep::PlannedJob
   } catch (const std::invalid_argument& e) {
     throw UsageError(fmt::format("{}: {} (the sweep's axis columns)", path, e.what()));
   }
-  std::vector<sweep::PlannedJob> out;
+  std::vector<queue::PlannedJob> out;
   for (auto& j : jobs)  // beds first, in their planned order, as expand() gives them
     if (j.kind == queue::JobKind::bed && beds_needed.count(j.job_id)) out.push_back(std::move(j));
   for (auto& j : kept) out.push_back(std::move(j));
@@ -62,7 +62,7 @@ std::size_t keep_matching(const std::string& path, std::vector<sweep::PlannedJob
 }
 
 /// Expands and validates a sweep; a large one shows its progress with an ETA on stderr.
-std::vector<sweep::PlannedJob> expand_with_progress(const sweep::SweepSpec& spec) {
+std::vector<queue::PlannedJob> expand_with_progress(const sweep::SweepSpec& spec) {
   constexpr std::size_t kProgressFromPoints = 20000;
   ProgressBar bar(spec.points() >= kProgressFromPoints);
   if (spec.points() >= kProgressFromPoints) {
@@ -70,7 +70,7 @@ std::vector<sweep::PlannedJob> expand_with_progress(const sweep::SweepSpec& spec
     std::fprintf(stderr, "sweep %s: expanding and validating %zu points (about %.2g GB and %s estimated)\n",
                  spec.name.c_str(), spec.points(), c.memory_bytes / 1e9, format_duration(c.seconds).c_str());
   }
-  auto jobs = sweep::expand(spec, queue::impact_bed_key(), [&](std::size_t done, std::size_t total) {
+  auto jobs = sweep::expand(spec, pipeline::impact_bed_key(), [&](std::size_t done, std::size_t total) {
     bar.update("expand", static_cast<double>(done) / static_cast<double>(total),
                fmt::format("{} of {} points validated", done, total));
   });
@@ -82,7 +82,7 @@ void run_submit(const SubmitOptions& o) {
   // Validate and expand every spec before the database is even opened: a bad spec writes nothing.
   struct Planned {
     sweep::SweepSpec spec;
-    std::vector<sweep::PlannedJob> jobs;
+    std::vector<queue::PlannedJob> jobs;
   };
   std::vector<Planned> planned;
   for (const auto& path : o.specs) {
@@ -109,7 +109,7 @@ void run_submit(const SubmitOptions& o) {
   db::Database db = queue::open_campaign(o.db, queue::OpenMode::create, o.files);
   queue::bind_files_root(db, queue::CampaignPaths(o.db, o.files));  // the marker naming this campaign
   for (const auto& p : planned) {
-    const auto r = queue::submit(db, p.spec, p.jobs);
+    const auto r = queue::submit(db, sweep::record(p.spec), p.jobs);
     fmt::print("sweep {} ({}): {} jobs planned ({} bed, {} {}): {} new, {} already present\n", r.sweep,
                r.sweep_new ? "new sweep" : "existing sweep", r.planned,
                std::count_if(p.jobs.begin(), p.jobs.end(), [](const auto& j) { return j.kind == queue::JobKind::bed; }),

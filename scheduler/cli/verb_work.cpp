@@ -18,8 +18,8 @@
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/pipeline/drop_checkpoint.h"
-#include "scheduler/pipeline/stop.h"
-#include "scheduler/queue/impact.h"
+#include "scheduler/queue/stop.h"
+#include "scheduler/pipeline/impact_runners.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
 #include "scheduler/queue/spawn.h"
@@ -170,7 +170,7 @@ int run_work(const WorkOptions& o) {
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int threads = o.threads > 0 ? o.threads : std::max(1, cores / std::max(1, o.workers));
   if (o.workers > 1) return supervise(o, threads);
-  pipeline::install_stop_signals();
+  queue::install_stop_signals();
   queue::WorkerOptions w;
   w.db_path = o.db;
   w.files = o.files;
@@ -189,7 +189,7 @@ int run_work(const WorkOptions& o) {
   w.verbose = !o.quiet;
   w.bed_cache = o.bed_cache;
   w.checkpoint_interval_s = o.checkpoint_interval_s;
-  const auto rep = queue::run_worker(w, queue::all_runners());
+  const auto rep = queue::run_worker(w, pipeline::all_runners());
   if (!o.quiet)
     fmt::print(stderr,
                "worker {}: {} done, {} failed (will retry), {} dead, {} released, {} fenced out, {} expired leases "

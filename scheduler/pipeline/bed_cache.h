@@ -1,5 +1,5 @@
 // A folder of prepared beds shared between campaigns and machines (`gravsweep work --bed-cache DIR`).
-// A bed is named by its bed job id (sweep::job_id("bed", bed_key)): <DIR>/<bed job id>.h5 with its
+// A bed is named by its bed job id (queue::job_id("bed", bed_key)): <DIR>/<bed job id>.h5 with its
 // checksum file <bed job id>.h5.sha256 (bed_checksum_path). A bed job whose bed is in the folder
 // copies it instead of preparing it again (a paper-sized bed takes minutes to an hour); a bed job
 // that prepared its bed stores it there. The file is verified on the way in (checksum and bed key):

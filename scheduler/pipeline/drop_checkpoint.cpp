@@ -8,7 +8,7 @@
 
 #include "scheduler/pipeline/build_version.h"
 #include "scheduler/pipeline/impact_job.h"
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/queue/canonical.h"
 
 namespace gravsweep::pipeline {
 
@@ -29,7 +29,7 @@ std::string utc_time_of_day() { return fmt::format("{:%H:%M:%S}Z", fmt::gmtime(s
 }  // namespace
 
 json drop_identity(const json& validated_scenario, const fs::path& bed, int threads) {
-  return json{{"scenario", validated_scenario}, {"bed_sha256", sweep::sha256_file(bed)}, {"threads", threads}};
+  return json{{"scenario", validated_scenario}, {"bed_sha256", queue::sha256_file(bed)}, {"threads", threads}};
 }
 
 DropCheckpointer::DropCheckpointer(DropCheckpointing cfg, json identity, const std::atomic<bool>* stop)

@@ -18,7 +18,7 @@
 #include "results/processing/trace.h"
 #include "scheduler/pipeline/build_version.h"
 #include "scheduler/pipeline/scenario_spec.h"
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/queue/canonical.h"
 
 namespace gravsweep::pipeline {
 
@@ -187,7 +187,7 @@ void write_bed_checksum(const std::filesystem::path& bed, const std::filesystem:
   const auto path = bed_checksum_path(as), tmp = std::filesystem::path(path.string() + ".tmp");
   {
     std::ofstream f(tmp);
-    f << sweep::sha256_file(bed) << "  " << as.filename().string() << "\n";
+    f << queue::sha256_file(bed) << "  " << as.filename().string() << "\n";
     if (!f.flush()) throw std::runtime_error(fmt::format("{}: cannot write", tmp.string()));
   }
   std::filesystem::rename(tmp, path);
@@ -207,7 +207,7 @@ results::BedData read_user_bed(const std::filesystem::path& bed, std::string* un
     if (recorded.size() != kHexDigits || recorded.find_first_not_of("0123456789abcdef") != std::string::npos)
       throw ConfigError(fmt::format("bed {}: its checksum file {} does not hold a SHA-256 (64 hex digits)",
                                     bed.string(), sum_path.string()));
-    const std::string found = sweep::sha256_file(bed);
+    const std::string found = queue::sha256_file(bed);
     if (found != recorded)
       throw ConfigError(fmt::format(
           "bed {} does not match its checksum ({}): sha256 {}, recorded {} when it was written; the file "

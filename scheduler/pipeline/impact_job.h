@@ -62,7 +62,7 @@ DropJobResult run_drop_job(const nlohmann::json& scenario, const std::filesystem
 nlohmann::json bed_key(const nlohmann::json& scenario);
 
 /// `<bed>.sha256`, beside a bed that `gravsweep run` prepared: the bed file's SHA-256, the checksum
-/// a campaign records for its beds (sweep::sha256_file), as sha256sum writes it ("<hex>  <name>").
+/// a campaign records for its beds (queue::sha256_file), as sha256sum writes it ("<hex>  <name>").
 std::filesystem::path bed_checksum_path(const std::filesystem::path& bed);
 /// Writes bed_checksum_path(named) (temporary name, then rename) with the SHA-256 of `bed`;
 /// `named` empty: bed_checksum_path(bed).

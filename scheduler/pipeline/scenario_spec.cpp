@@ -17,7 +17,7 @@
 #include "engine/system/law_registry.h"
 #include "engine/integrate/integrators.h"
 #include "engine/scenario/paper_params.h"
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/queue/canonical.h"
 #include "scheduler/sweep/spec.h"
 #include "spec/schemas.h"
 
@@ -451,7 +451,7 @@ std::uint64_t site_seed(const json& s) {
                    {"projectile", pj},
                    {"grains", s.at("grains")},
                    {"container", s.at("container")}};
-  const std::string hex = sweep::sha256_hex(sweep::canonical_json(point));
+  const std::string hex = queue::sha256_hex(queue::canonical_json(point));
   return std::stoull(hex.substr(0, 16), nullptr, 16);
 }
 

@@ -8,7 +8,7 @@
 
 #include "scheduler/queue/exit_codes.h"
 #include "scheduler/queue/queue_internal.h"
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/queue/canonical.h"
 
 namespace gravsweep::queue {
 
@@ -55,7 +55,7 @@ bool complete(Database& db, const Claim& c, const Completion& done) {
     Statement st(db,
                  "UPDATE attempts SET outcome='done', ended_at=?1, runtime_s=?1-started_at, exit_code=0, "
                  "report_json=?2, output_path=?3 WHERE attempt_id=?4 RETURNING code_version");
-    st.bind(1, now).bind(2, sweep::canonical_json(done.report.is_null() ? json::object() : done.report));
+    st.bind(1, now).bind(2, queue::canonical_json(done.report.is_null() ? json::object() : done.report));
     st.bind(3, done.output_rel).bind(4, c.attempt_row);
     if (st.step()) code_version = st.get_text(0);
     st.run();

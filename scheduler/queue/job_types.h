@@ -2,9 +2,12 @@
 // what the database stores: jobs.kind, jobs.state). A kind's folder under the files root and its
 // output file extension live in the same table row.
 #pragma once
+#include <nlohmann/json.hpp>
+
 #include <ostream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace gravsweep::queue {
 
@@ -37,5 +40,15 @@ inline bool operator==(JobState s, std::string_view name) { return name == state
 inline bool operator!=(JobState s, std::string_view name) { return !(s == name); }
 inline std::ostream& operator<<(std::ostream& os, JobKind k) { return os << kind_name(k); }
 inline std::ostream& operator<<(std::ostream& os, JobState s) { return os << state_name(s); }
+
+/// One job to submit: what a sweep's expansion (scheduler/sweep/spec.h) plans.
+struct PlannedJob {
+  std::string job_id;
+  JobKind kind = JobKind::noop;
+  nlohmann::json scenario;        ///< canonical scenario the job runs
+  nlohmann::json params;          ///< swept parameter values {column name: value}
+  std::vector<std::string> deps;  ///< job ids this job waits for
+  int priority = 0;
+};
 
 }  // namespace gravsweep::queue

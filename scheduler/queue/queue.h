@@ -16,11 +16,11 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "db/database.h"
 #include "scheduler/queue/job_types.h"
-#include "scheduler/sweep/spec.h"
 
 namespace gravsweep::queue {
 
@@ -62,9 +62,20 @@ struct SubmitReport {
   bool sweep_new = false;
 };
 
+/// A sweep as the queue stores it (sweeps table, results columns); scheduler/sweep/spec.h makes
+/// one from a spec (sweep::record).
+struct SweepRecord {
+  std::string name;       ///< unique within a campaign
+  std::string job_kind;   ///< "impact" or "noop"
+  nlohmann::json source;  ///< the spec as read, stored canonical and hashed
+  int max_attempts = 3;
+  /// Each swept parameter's results column and every value it takes (the column's SQL type fits them all).
+  std::vector<std::pair<std::string, std::vector<nlohmann::json>>> columns;
+};
+
 /// Writes the sweep and its jobs in one transaction: INSERT ... ON CONFLICT DO NOTHING, so a
 /// second submit of the same spec adds nothing and an extended axis adds only the new points.
-SubmitReport submit(db::Database& db, const sweep::SweepSpec& spec, const std::vector<sweep::PlannedJob>& jobs);
+SubmitReport submit(db::Database& db, const SweepRecord& sweep, const std::vector<PlannedJob>& jobs);
 
 // ---- workers --------------------------------------------------------------------------------
 struct WorkerIdentity {

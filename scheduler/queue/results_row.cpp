@@ -7,7 +7,7 @@
 
 #include "scheduler/queue/dialect.h"
 #include "scheduler/queue/queue_internal.h"
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/queue/canonical.h"
 
 namespace gravsweep::queue {
 
@@ -50,7 +50,7 @@ void bind_json_value(Statement& st, int idx, const json& v) {
   else if (v.is_string())
     st.bind(idx, v.get<std::string>());
   else
-    st.bind(idx, sweep::canonical_json(v));
+    st.bind(idx, queue::canonical_json(v));
 }
 
 std::string sanitize_metric(const std::string& key) {
@@ -68,7 +68,7 @@ void flatten(const json& j, const std::string& prefix, std::vector<std::pair<std
     for (auto it = j.begin(); it != j.end(); ++it)
       flatten(it.value(), prefix.empty() ? it.key() : prefix + "_" + it.key(), out);
   } else if (j.is_array()) {
-    out.emplace_back(prefix, json(sweep::canonical_json(j)));
+    out.emplace_back(prefix, json(queue::canonical_json(j)));
   } else {
     out.emplace_back(prefix, j);
   }

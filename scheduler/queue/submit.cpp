@@ -1,6 +1,6 @@
 // Sweep expansion into the queue: idempotent inserts, dependencies and sweep memberships.
 #include "scheduler/queue/queue_internal.h"
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/queue/canonical.h"
 
 namespace gravsweep::queue {
 
@@ -10,12 +10,12 @@ using db::Transaction;
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-SubmitReport submit(Database& db, const sweep::SweepSpec& spec, const std::vector<sweep::PlannedJob>& jobs) {
+SubmitReport submit(Database& db, const SweepRecord& spec, const std::vector<PlannedJob>& jobs) {
   SubmitReport rep;
   rep.sweep = spec.name;
   rep.planned = jobs.size();
   const double now = clock_s(db);
-  const std::string spec_text = sweep::canonical_json(spec.source);
+  const std::string spec_text = queue::canonical_json(spec.source);
   Transaction tx(db);
   {
     Statement exists(db, "SELECT 1 FROM sweeps WHERE sweep_id=?");
@@ -27,20 +27,18 @@ SubmitReport submit(Database& db, const sweep::SweepSpec& spec, const std::vecto
                  "INSERT INTO sweeps(sweep_id, job_kind, spec_json, spec_sha256, submitted_at, updated_at) "
                  "VALUES(?1, ?2, ?3, ?4, ?5, ?5) ON CONFLICT(sweep_id) DO UPDATE SET spec_json=excluded.spec_json, "
                  "spec_sha256=excluded.spec_sha256, updated_at=excluded.updated_at, submits=sweeps.submits+1");
-    st.bind(1, spec.name).bind(2, spec.job_kind).bind(3, spec_text).bind(4, sweep::sha256_hex(spec_text)).bind(5, now);
+    st.bind(1, spec.name).bind(2, spec.job_kind).bind(3, spec_text).bind(4, queue::sha256_hex(spec_text)).bind(5, now);
     st.run();
   }
   // One results column per swept parameter, of a type that fits every value of the axis: 1, 1.5
   // (canonical 1 is an integer) needs REAL, and so does 2.5 added to an axis that had 1, 2.
   auto cols = detail::result_extra_columns(db);
-  for (const auto& g : spec.groups) {
-    for (const auto& a : g.axes) {
-      if (!cols.count(a.name)) {
-        detail::add_result_column(db, a.name, "param", detail::sql_type_of(a.values.front()));
-        cols[a.name] = {"param", detail::sql_type_of(a.values.front())};
-      }
-      for (const auto& v : a.values) detail::widen_result_column(db, a.name, cols[a.name], v);
+  for (const auto& [name, values] : spec.columns) {
+    if (!cols.count(name)) {
+      detail::add_result_column(db, name, "param", detail::sql_type_of(values.front()));
+      cols[name] = {"param", detail::sql_type_of(values.front())};
     }
+    for (const auto& v : values) detail::widen_result_column(db, name, cols[name], v);
   }
   Statement ins(db,
                 "INSERT INTO jobs(job_id, kind, sweep_id, state, priority, deps_pending, max_attempts, params_json, "
@@ -65,7 +63,7 @@ SubmitReport submit(Database& db, const sweep::SweepSpec& spec, const std::vecto
     ins.bind(1, j.job_id).bind(2, kind_name(j.kind)).bind(3, spec.name);
     ins.bind(4, state_name(j.deps.empty() ? JobState::queued : JobState::waiting));
     ins.bind(5, j.priority).bind(6, static_cast<std::int64_t>(j.deps.size())).bind(7, spec.max_attempts);
-    ins.bind(8, sweep::canonical_json(j.params)).bind(9, sweep::canonical_json(j.scenario)).bind(10, now);
+    ins.bind(8, queue::canonical_json(j.params)).bind(9, queue::canonical_json(j.scenario)).bind(10, now);
     ins.run();
     const bool added = db.changes() == 1;
     if (added) {

@@ -17,10 +17,10 @@
 #include <thread>
 
 #include "engine/core/error.h"
-#include "scheduler/pipeline/stop.h"
+#include "scheduler/queue/stop.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/exit_codes.h"
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/queue/canonical.h"
 
 namespace gravsweep::queue {
 
@@ -40,7 +40,7 @@ bool supervisor_gone() {
 
 void sleep_interruptible(double seconds) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (!pipeline::stop_requested().load() && std::chrono::steady_clock::now() < end)
+  while (!queue::stop_requested().load() && std::chrono::steady_clock::now() < end)
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
 }
 
@@ -77,7 +77,7 @@ class Reconnecting {
     std::fprintf(stderr, "worker %d: database connection lost (%s); reconnecting for up to %.0f s\n",
                  static_cast<int>(getpid()), lost.what(), outage_s_);
     for (;;) {
-      if (std::chrono::steady_clock::now() >= give_up || pipeline::stop_requested().load()) throw lost;
+      if (std::chrono::steady_clock::now() >= give_up || queue::stop_requested().load()) throw lost;
       sleep_interruptible(wait_s);
       wait_s = std::min(2 * wait_s, 5.0);
       try {
@@ -149,8 +149,8 @@ void heartbeat_loop(const WorkerOptions& o, const Claim& c, JobSignals& sig, dou
   auto next = std::chrono::steady_clock::now();  // first beat at once: the job has started
   std::unique_lock lock(sig.m);
   while (!sig.finished) {
-    if (supervisor_gone()) pipeline::stop_requested().store(true);
-    if (pipeline::stop_requested().load()) sig.stop.store(true);
+    if (supervisor_gone()) queue::stop_requested().store(true);
+    if (queue::stop_requested().load()) sig.stop.store(true);
     if (std::chrono::steady_clock::now() >= next) {
       const std::string phase = sig.phase, detail = sig.detail;
       const double f = sig.fraction;
@@ -269,10 +269,10 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
                  rep.disk_full.c_str());
   };
   long ran = 0;
-  while (!pipeline::stop_requested().load() && (o.max_jobs < 0 || ran < o.max_jobs)) {
+  while (!queue::stop_requested().load() && (o.max_jobs < 0 || ran < o.max_jobs)) {
     if (supervisor_gone()) {
       std::fprintf(stderr, "worker %d: its supervisor is gone; stopping\n", who.pid);
-      pipeline::stop_requested().store(true);
+      queue::stop_requested().store(true);
       break;
     }
     if (const std::string full = disk_full(paths, o.min_free_bytes, largest); !full.empty() || !rep.disk_full.empty()) {
@@ -335,7 +335,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
     if (!c->dep_output_rel.empty() && !c->dep_sha256.empty()) {
       // The bed is verified before the drop uses it: a changed bit changes every drop's results.
       const fs::path bed = paths.abs(c->dep_output_rel);
-      const std::string found = fs::exists(bed, ec) ? sweep::sha256_file(bed) : std::string("missing");
+      const std::string found = fs::exists(bed, ec) ? queue::sha256_file(bed) : std::string("missing");
       if (found != c->dep_sha256) {
         stop_beat();
         const std::string why = fmt::format(
@@ -396,7 +396,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
       ++rep.fenced_out;
       continue;
     }
-    if (pipeline::stop_requested().load() && (!error.empty() || !fs::exists(tmp))) {
+    if (queue::stop_requested().load() && (!error.empty() || !fs::exists(tmp))) {
       remove_tmp_of(paths.tmp(), prefix);
       const std::string state = with_db([&] {
         return release(db, *c,
@@ -443,7 +443,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
       fsync_path(final_path.parent_path());
       remove_tmp_of(paths.tmp(), prefix);
       done.output_rel = c->output_rel;
-      done.sha256 = sweep::sha256_file(final_path);
+      done.sha256 = queue::sha256_file(final_path);
       done.bytes = static_cast<std::int64_t>(fs::file_size(final_path));
     } catch (const std::exception& e) {
       // The file vanished or the disk is full: this attempt fails, the worker goes on.
@@ -481,7 +481,7 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
                    c->job_id.c_str());
     }
   }
-  if (pipeline::stop_requested().load()) rep.interrupted = true;
+  if (queue::stop_requested().load()) rep.interrupted = true;
   return rep;
 }
 

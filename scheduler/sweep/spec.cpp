@@ -12,7 +12,7 @@
 
 #include <unistd.h>
 
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/queue/canonical.h"
 #include "spec/json_pointer.h"
 #include "spec/schemas.h"
 
@@ -99,9 +99,9 @@ std::optional<std::vector<json>> range_values(const json& r, const std::string& 
   if (r.contains("num")) {
     const long num = r["num"].get<long>();
     for (long i = 0; i < num; ++i)
-      values.emplace_back(
-          num == 1 ? start
-                   : round_decimal(start + (stop - start) * static_cast<double>(i) / static_cast<double>(num - 1)));
+      values.emplace_back(num == 1 ? start
+                                   : queue::round_decimal(start + (stop - start) * static_cast<double>(i) /
+                                                                      static_cast<double>(num - 1)));
     return values;
   }
   const double step = r["step"].get<double>();
@@ -117,7 +117,7 @@ std::optional<std::vector<json>> range_values(const json& r, const std::string& 
   }
   const bool ints = is_int(r["start"]) && is_int(r["stop"]) && is_int(r["step"]) && integer_base;
   for (long i = 0; i < static_cast<long>(n); ++i) {
-    const double v = round_decimal(start + static_cast<double>(i) * step);
+    const double v = queue::round_decimal(start + static_cast<double>(i) * step);
     values.push_back(ints ? json(static_cast<std::int64_t>(std::llround(v))) : json(v));
   }
   return values;
@@ -145,7 +145,7 @@ std::optional<std::vector<json>> repeat_values(const json& a, const std::string&
       values.emplace_back(static_cast<std::int64_t>(std::llround(start.get<double>())) +
                           i * static_cast<std::int64_t>(std::llround(step.get<double>())));
     else
-      values.emplace_back(round_decimal(start.get<double>() + static_cast<double>(i) * step.get<double>()));
+      values.emplace_back(queue::round_decimal(start.get<double>() + static_cast<double>(i) * step.get<double>()));
   }
   return values;
 }
@@ -201,8 +201,8 @@ std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json
       ok = false;
       continue;
     }
-    axis.values[i] = canonicalize(v);
-    if (ok && !seen.insert(canonical_json(axis.values[i])).second) {
+    axis.values[i] = queue::canonicalize(v);
+    if (ok && !seen.insert(queue::canonical_json(axis.values[i])).second) {
       ck.add(vp, axis.values[i], "values that differ from each other (this one repeats an earlier value)");
       ok = false;
     }
@@ -363,10 +363,10 @@ SweepSpec parse_spec(const json& doc_in, const std::string& file, const std::fil
   if (sound("/base")) base = read_base(doc, base_dir, ck);
   if (base) {
     try {
-      spec.base = canonicalize(*base);
+      spec.base = queue::canonicalize(*base);
       if (spec.job_kind == "noop")
         for (auto& p : noop_problems(spec.base, "/base")) ck.problems.push_back(std::move(p));
-    } catch (const CanonicalError& e) {
+    } catch (const queue::CanonicalError& e) {
       ck.add_text("/base", e.what(), "finite numbers only");
       base.reset();
     }
@@ -425,8 +425,8 @@ class PointProblems {
 };
 
 /// The scenario and swept values of point p: its mixed-radix digits, last group fastest.
-PlannedJob point_job(const SweepSpec& spec, std::size_t p) {
-  PlannedJob job;
+queue::PlannedJob point_job(const SweepSpec& spec, std::size_t p) {
+  queue::PlannedJob job;
   job.scenario = spec.base;
   job.params = json::object();
   std::size_t rem = p;
@@ -465,7 +465,7 @@ void check_base(const SweepSpec& spec, const BedKeyFn& bed_key) {
 }
 
 /// The bed key of a drop's scenario; nothing (its problems added) when the point is invalid.
-std::optional<json> point_bed_key(const BedKeyFn& bed_key, const PlannedJob& job, PointProblems& problems) {
+std::optional<json> point_bed_key(const BedKeyFn& bed_key, const queue::PlannedJob& job, PointProblems& problems) {
   try {
     if (!bed_key) throw std::runtime_error("no bed key function (the impact pipeline is not built in)");
     return bed_key(job.scenario);
@@ -486,12 +486,12 @@ std::optional<json> point_bed_key(const BedKeyFn& bed_key, const PlannedJob& job
 
 /// Adds the drop `job` to its bed (the bed job made at its first drop); parameters that differ
 /// between drops of one bed are not bed parameters (null, dropped at the end).
-void add_to_bed(const SweepSpec& spec, const json& key, PlannedJob& job, std::vector<PlannedJob>& beds,
+void add_to_bed(const SweepSpec& spec, const json& key, queue::PlannedJob& job, std::vector<queue::PlannedJob>& beds,
                 std::map<std::string, std::size_t>& bed_index) {
-  const std::string bed_id = job_id(queue::kind_name(queue::JobKind::bed), key);
+  const std::string bed_id = queue::job_id(queue::kind_name(queue::JobKind::bed), key);
   auto [it, inserted] = bed_index.emplace(bed_id, beds.size());
   if (inserted) {
-    PlannedJob bed;
+    queue::PlannedJob bed;
     bed.kind = queue::JobKind::bed;
     bed.job_id = bed_id;
     bed.scenario = job.scenario;  // any scenario with this key prepares the same bed
@@ -508,8 +508,15 @@ void add_to_bed(const SweepSpec& spec, const json& key, PlannedJob& job, std::ve
 
 }  // namespace
 
-std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key, const ExpandProgress& progress) {
-  std::vector<PlannedJob> beds, drops;
+queue::SweepRecord record(const SweepSpec& spec) {
+  queue::SweepRecord r{spec.name, spec.job_kind, spec.source, spec.max_attempts, {}};
+  for (const auto& g : spec.groups)
+    for (const auto& a : g.axes) r.columns.emplace_back(a.name, a.values);
+  return r;
+}
+
+std::vector<queue::PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key, const ExpandProgress& progress) {
+  std::vector<queue::PlannedJob> beds, drops;
   std::map<std::string, std::size_t> bed_index;
   const std::size_t n = spec.points();
   const bool noop = spec.job_kind == "noop";
@@ -518,17 +525,17 @@ std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key, c
   drops.reserve(n);
   for (std::size_t p = 0; p < n; ++p) {
     if (progress && p % kExpandProgressEvery == 0) progress(p, n);
-    PlannedJob job = point_job(spec, p);
+    queue::PlannedJob job = point_job(spec, p);
     if (noop) {
       for (auto& np : noop_problems(job.scenario, "/base"))
         problems.add(std::move(np), job.params, [](const SpecProblem&) { return false; });
       job.kind = queue::JobKind::noop;
-      job.job_id = job_id(queue::kind_name(job.kind), job.scenario);
+      job.job_id = queue::job_id(queue::kind_name(job.kind), job.scenario);
       drops.push_back(std::move(job));
       continue;
     }
     job.kind = queue::JobKind::drop;
-    job.job_id = job_id(queue::kind_name(job.kind), job.scenario);
+    job.job_id = queue::job_id(queue::kind_name(job.kind), job.scenario);
     const auto key = point_bed_key(bed_key, job, problems);
     if (!key) continue;
     add_to_bed(spec, *key, job, beds, bed_index);

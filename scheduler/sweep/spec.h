@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "scheduler/queue/job_types.h"
+#include "scheduler/queue/queue.h"
 #include "spec/json_schema.h"
 
 namespace gravsweep::sweep {
@@ -60,14 +61,9 @@ SweepSpec parse_spec(const nlohmann::json& doc, const std::string& file, const s
 /// Reads the file (JSON parse errors are SpecError with line/column) and parses it.
 SweepSpec load_spec(const std::filesystem::path& path);
 
-struct PlannedJob {
-  std::string job_id;
-  queue::JobKind kind = queue::JobKind::noop;
-  nlohmann::json scenario;        ///< canonical scenario the job runs
-  nlohmann::json params;          ///< swept parameter values {column name: value}
-  std::vector<std::string> deps;  ///< job ids this job waits for
-  int priority = 0;
-};
+/// The sweep as the queue stores it: name, job kind, source, retry budget and one results column
+/// per axis with its values.
+queue::SweepRecord record(const SweepSpec& spec);
 
 /// bed key of a scenario: drops with equal keys share a bed job.
 using BedKeyFn = std::function<nlohmann::json(const nlohmann::json& scenario)>;
@@ -80,7 +76,8 @@ inline constexpr std::size_t kExpandProgressEvery = 1000;
 /// Expands the spec. Bed jobs come first (in order of first use), then drops in product order.
 /// `bed_key` is required for impact sweeps. Errors from bed_key (invalid scenario) become
 /// SpecError naming the point.
-std::vector<PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key, const ExpandProgress& progress = {});
+std::vector<queue::PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key,
+                                      const ExpandProgress& progress = {});
 
 /// What expanding and validating a sweep takes, estimated from its points and the size of its
 /// scenario before any of it is done: memory held by its planned jobs (each point's scenario as a

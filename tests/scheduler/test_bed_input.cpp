@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "results/io/bed_file.h"
-#include "scheduler/queue/impact.h"
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/pipeline/impact_runners.h"
+#include "scheduler/queue/canonical.h"
 #include "scheduler_test_helpers.h"
 
 using namespace gravsweep;
@@ -83,7 +83,7 @@ TEST(BedInput, RunWritesTheBedsChecksumBesideIt) {
   std::ifstream f(p.bed.string() + ".sha256");
   std::string hex, name;
   f >> hex >> name;
-  EXPECT_EQ(hex, sweep::sha256_file(p.bed)) << "the checksum campaigns record for a bed";
+  EXPECT_EQ(hex, queue::sha256_file(p.bed)) << "the checksum campaigns record for a bed";
   EXPECT_EQ(name, "bed.h5") << "sha256sum's format";
 }
 
@@ -237,7 +237,7 @@ TEST(BedInput, ABedWithAGrainOutsidePhysicalRangesExitsTwoNamingTheFileAndGrain)
     const fs::path dir = p.dir.path / fmt::format("range_{}_{}", fs::path(c.dataset).filename().string(), c.element);
     const fs::path bed = copy_bed(dir, false);
     scale_element(bed, c.dataset, c.element, c.factor);
-    write_text(bed.string() + ".sha256", sweep::sha256_file(bed) + "  bed.h5\n");  // the checksum regenerated
+    write_text(bed.string() + ".sha256", queue::sha256_file(bed) + "  bed.h5\n");  // the checksum regenerated
     const std::string name(c.dataset);
     const bool per_axis = name.find("position") != std::string::npos || name.find("velocity") != std::string::npos;
     const std::size_t grain = per_axis ? c.element / 3 : c.element;

@@ -4,12 +4,12 @@
 #include <nlohmann/json.hpp>
 
 #include "spec/json_pointer.h"
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/queue/canonical.h"
 
-using gravsweep::sweep::canonical_json;
-using gravsweep::sweep::job_id;
-using gravsweep::sweep::round_decimal;
-using gravsweep::sweep::sha256_hex;
+using gravsweep::queue::canonical_json;
+using gravsweep::queue::job_id;
+using gravsweep::queue::round_decimal;
+using gravsweep::queue::sha256_hex;
 using nlohmann::json;
 
 TEST(Sha256, KnownVectors) {
@@ -53,7 +53,7 @@ TEST(Canonical, RejectsNonFinite) {
   try {
     canonical_json(j);
     FAIL() << "NaN accepted";
-  } catch (const gravsweep::sweep::CanonicalError& e) {
+  } catch (const gravsweep::queue::CanonicalError& e) {
     EXPECT_NE(std::string(e.what()).find("/a/b"), std::string::npos) << e.what();
   }
 }
@@ -76,7 +76,7 @@ TEST(Canonical, RejectsNonFiniteNamingAnEscapedPointer) {
   try {
     canonical_json(j);
     FAIL() << "NaN accepted";
-  } catch (const gravsweep::sweep::CanonicalError& e) {
+  } catch (const gravsweep::queue::CanonicalError& e) {
     EXPECT_NE(std::string(e.what()).find("/a~1b/c~0d"), std::string::npos) << e.what();
   }
 }

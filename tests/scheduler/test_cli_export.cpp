@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "scheduler/queue/impact.h"
+#include "scheduler/pipeline/impact_runners.h"
 #include "scheduler_test_helpers.h"
 
 using namespace gravsweep;

@@ -7,7 +7,7 @@
 #include <thread>
 
 #include "db/database.h"
-#include "scheduler/queue/impact.h"
+#include "scheduler/pipeline/impact_runners.h"
 #include "scheduler_test_helpers.h"
 
 using namespace gravsweep;

@@ -19,8 +19,8 @@
 #include <thread>
 
 #include "db/database.h"
-#include "scheduler/queue/impact.h"
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/pipeline/impact_runners.h"
+#include "scheduler/queue/canonical.h"
 #include "campaign_store.h"
 #include "scheduler_test_helpers.h"
 
@@ -185,7 +185,7 @@ void crash_campaign(Store store_kind, const json& doc, std::int64_t total, std::
       referenced.insert(fs::weakly_canonical(p).string());
       ASSERT_TRUE(fs::exists(p)) << "missing output " << p;
       EXPECT_EQ(fs::file_size(p), static_cast<std::uintmax_t>(st.get_int(2)));
-      EXPECT_EQ(sweep::sha256_file(p), st.get_text(1)) << p;
+      EXPECT_EQ(queue::sha256_file(p), st.get_text(1)) << p;
     }
   }
   std::vector<std::string> orphans;
@@ -293,7 +293,7 @@ TEST_P(CrashCampaign, SigkilledSupervisorTakesItsWorkersDownAndLosesNothing) {
   while (st.step()) {
     const fs::path p = store.root() / st.get_text(0);
     ASSERT_TRUE(fs::exists(p)) << p;
-    EXPECT_EQ(sweep::sha256_file(p), st.get_text(1));
+    EXPECT_EQ(queue::sha256_file(p), st.get_text(1));
   }
 }
 

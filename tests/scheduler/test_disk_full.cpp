@@ -11,8 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "db/database.h"
-#include "scheduler/queue/impact.h"
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/pipeline/impact_runners.h"
+#include "scheduler/queue/canonical.h"
 #include "scheduler_test_helpers.h"
 
 using namespace gravsweep;
@@ -45,7 +45,7 @@ TEST(DiskFull, WorkerExitsOneCleanlyAndFinishedWorkStaysIntact) {
   while (st.step()) {
     const fs::path p = campaign_file(mnt, "c", st.get_text(0));
     ASSERT_TRUE(fs::exists(p)) << p;
-    EXPECT_EQ(sweep::sha256_file(p), st.get_text(1)) << p;
+    EXPECT_EQ(queue::sha256_file(p), st.get_text(1)) << p;
     ++done;
   }
   std::printf("disk full after %d finished job(s): exit %d\n", done, r.code);

@@ -10,7 +10,7 @@
 
 #include "campaign_store.h"
 #include "db/database.h"
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/queue/canonical.h"
 #include "scheduler_test_helpers.h"
 
 using namespace gravsweep;
@@ -53,7 +53,7 @@ TEST(PostgresCampaign, EightWorkersDoTwoHundredJobsEachExactlyOnce) {
   while (st.step()) {
     const fs::path p = store.files / st.get_text(0);
     ASSERT_TRUE(fs::exists(p)) << p;
-    EXPECT_EQ(sweep::sha256_file(p), st.get_text(1));
+    EXPECT_EQ(queue::sha256_file(p), st.get_text(1));
     ++files;
   }
   EXPECT_EQ(files, 200);
@@ -253,5 +253,5 @@ TEST(PostgresCampaign, WorkersRideOutServerRestartsAndAnOutage) {
   EXPECT_EQ(sql_int(db, "SELECT count(DISTINCT job_id) FROM results"), kJobs);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='running'"), 0);
   db::Statement st(db, "SELECT output_path, output_sha256 FROM jobs");
-  while (st.step()) EXPECT_EQ(sweep::sha256_file(root / st.get_text(0)), st.get_text(1)) << st.get_text(0);
+  while (st.step()) EXPECT_EQ(queue::sha256_file(root / st.get_text(0)), st.get_text(1)) << st.get_text(0);
 }

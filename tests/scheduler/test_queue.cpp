@@ -63,7 +63,7 @@ struct QueueTest : ::testing::TestWithParam<test::Store> {
     return out;
   }
   SubmitReport submit_spec(const sweep::SweepSpec& s, const sweep::BedKeyFn& key = {}) {
-    return submit(db, s, sweep::expand(s, key));
+    return submit(db, sweep::record(s), sweep::expand(s, key));
   }
   Completion done_for(const Claim& c, double value = 1.0) {
     Completion d;

@@ -12,8 +12,8 @@
 #include <thread>
 
 #include "db/database.h"
-#include "scheduler/queue/impact.h"
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/pipeline/impact_runners.h"
+#include "scheduler/queue/canonical.h"
 #include "scheduler_test_helpers.h"
 
 using namespace gravsweep;
@@ -40,7 +40,7 @@ int lost_outputs(db::Database& db, const fs::path& dir, const std::string& stem,
   db::Statement st(db, "SELECT output_path, output_sha256 FROM jobs WHERE state='done'");
   while (st.step()) {
     const fs::path p = campaign_file(dir, stem, st.get_text(0));
-    if (!fs::exists(p) || sweep::sha256_file(p) != st.get_text(1)) {
+    if (!fs::exists(p) || queue::sha256_file(p) != st.get_text(1)) {
       if (first && lost == 0) *first = p.string();
       ++lost;
     }
@@ -269,7 +269,7 @@ TEST(BedChecksum, AFlippedBitInAFinishedBedFailsTheDropAndRebuildsTheBed) {
   // Every drop used the rebuilt bed, whose file matches its new checksum.
   const fs::path rebuilt = campaign_file(d.path, "c", sql_text(db, "SELECT output_path FROM jobs WHERE kind='bed'"));
   EXPECT_NE(rebuilt, bed);
-  EXPECT_EQ(sweep::sha256_file(rebuilt), sql_text(db, "SELECT output_sha256 FROM jobs WHERE kind='bed'"));
+  EXPECT_EQ(queue::sha256_file(rebuilt), sql_text(db, "SELECT output_sha256 FROM jobs WHERE kind='bed'"));
   r = run_cli({"status", "--db", "c.db"}, d.path);
   EXPECT_NE(r.out.find("beds rebuilt after a checksum mismatch"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("bed checksum mismatch"), std::string::npos) << r.out;

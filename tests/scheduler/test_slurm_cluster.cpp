@@ -16,7 +16,7 @@
 
 #include "campaign_store.h"
 #include "db/database.h"
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/queue/canonical.h"
 #include "scheduler_test_helpers.h"
 #include "tests/common/slurm_cluster.h"
 
@@ -75,7 +75,7 @@ struct ClusterFixture : ::testing::Test {
     while (st.step()) {
       const fs::path p = store.files / st.get_text(0);
       ASSERT_TRUE(fs::exists(p)) << p;
-      EXPECT_EQ(sweep::sha256_file(p), st.get_text(1)) << p;
+      EXPECT_EQ(queue::sha256_file(p), st.get_text(1)) << p;
     }
   }
 };
@@ -230,7 +230,7 @@ TEST_F(ClusterFixture, ADropLongerThanATaskTimeLimitCompletesAcrossTasksFromItsC
   write_text(dir.path / "spec.json", doc.dump());
   ASSERT_EQ(run_cli(with_store({"submit", "spec.json"}), dir.path).code, 0);
   db::Database db(store.location);
-  constexpr int kMaxTasks = 8;
+  constexpr int kMaxTasks = 12;  // 4-6 on an idle 2-core host; more when the host is oversubscribed
   constexpr double kInterval_s = 20;
   int tasks = 0;
   while (tasks < kMaxTasks && sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'") < 2) {

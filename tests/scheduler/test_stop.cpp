@@ -1,10 +1,10 @@
-// The one stop request of the process (scheduler/pipeline/stop.h): a real signal sets it, a scope
+// The one stop request of the process (scheduler/queue/stop.h): a real signal sets it, a scope
 // clears it on entry and gives the previous handlers back.
 #include <gtest/gtest.h>
 
 #include <csignal>
 
-#include "scheduler/pipeline/stop.h"
+#include "scheduler/queue/stop.h"
 
 using namespace gravsweep;
 
@@ -14,15 +14,15 @@ TEST(StopRequest, ARealSignalSetsTheOneFlagAndTheScopeRestoresThePreviousHandler
   ignore.sa_handler = SIG_IGN;
   sigemptyset(&ignore.sa_mask);
   sigaction(SIGTERM, &ignore, &before);
-  pipeline::stop_requested().store(true);
+  queue::stop_requested().store(true);
   {
-    const pipeline::ScopedStopSignals scope;
-    EXPECT_FALSE(pipeline::stop_requested().load()) << "cleared on entry";
+    const queue::ScopedStopSignals scope;
+    EXPECT_FALSE(queue::stop_requested().load()) << "cleared on entry";
     std::raise(SIGTERM);
-    EXPECT_TRUE(pipeline::stop_requested().load()) << "SIGTERM sets the flag, and the process lives";
+    EXPECT_TRUE(queue::stop_requested().load()) << "SIGTERM sets the flag, and the process lives";
   }
   sigaction(SIGTERM, nullptr, &after);
   EXPECT_EQ(after.sa_handler, SIG_IGN) << "the handler before the scope is back";
   sigaction(SIGTERM, &before, nullptr);
-  pipeline::stop_requested().store(false);
+  queue::stop_requested().store(false);
 }

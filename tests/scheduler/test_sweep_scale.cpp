@@ -10,7 +10,7 @@
 #include <fstream>
 
 #include "scheduler/pipeline/scenario_spec.h"
-#include "scheduler/queue/impact.h"
+#include "scheduler/pipeline/impact_runners.h"
 #include "scheduler/sweep/spec.h"
 #include "scheduler_test_helpers.h"
 
@@ -38,7 +38,7 @@ json tiny_sweep(long speeds, long repeats) {
 TEST(SweepScale, EngineChecksRunOncePerDistinctSetupNotPerPoint) {
   const SweepSpec spec = parse_spec(tiny_sweep(50, 40), "big.json", GRAVSWEEP_SOURCE_DIR "/examples");
   const std::size_t before = pipeline::engine_check_runs();
-  const auto jobs = expand(spec, queue::impact_bed_key());
+  const auto jobs = expand(spec, pipeline::impact_bed_key());
   EXPECT_EQ(jobs.size(), 2001u);  // one bed, 2,000 drops
   // Speeds and seeds are not read by the engine's checks: one run for the whole sweep (two with
   // the base checked alone first), not 2,000.
@@ -51,7 +51,7 @@ TEST(SweepScale, AnEngineProblemIsStillFoundAtEveryPointThatHasIt) {
   s["axes"].push_back({{"name", "dt_s"}, {"pointer", "/dt_s"}, {"values", {1e-5, 1e-2}}});
   const SweepSpec spec = parse_spec(s, "big.json", GRAVSWEEP_SOURCE_DIR "/examples");
   try {
-    expand(spec, queue::impact_bed_key());
+    expand(spec, pipeline::impact_bed_key());
     FAIL() << "a time step the contact law refuses was accepted";
   } catch (const SpecError& e) {
     const std::string what = e.what();

@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/queue/canonical.h"
 #include "scheduler/sweep/spec.h"
 #include "scheduler_test_helpers.h"
 
@@ -57,7 +57,7 @@ TEST(SweepSpec, ProductOfListsRangesZipsAndRepeats) {
   EXPECT_EQ(spec.points(), 2u * 3u * 2u * 3u);
   // The range is 0.1, 0.2, 0.3 exactly as literals, not 0.30000000000000004.
   ASSERT_EQ(spec.groups[1].axes[0].values.size(), 3u);
-  EXPECT_EQ(canonical_json(spec.groups[1].axes[0].values[2]), "0.3");
+  EXPECT_EQ(gravsweep::queue::canonical_json(spec.groups[1].axes[0].values[2]), "0.3");
   const auto jobs = expand(spec, test_bed_key);
   std::size_t beds = 0, drops = 0;
   std::set<std::string> ids;

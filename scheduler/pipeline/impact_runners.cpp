@@ -1,43 +1,46 @@
-#include "scheduler/queue/impact.h"
+#include "scheduler/pipeline/impact_runners.h"
 
 #include <fmt/format.h>
 
 #include "scheduler/pipeline/bed_cache.h"
 #include "scheduler/pipeline/impact_job.h"
-#include "scheduler/pipeline/stop.h"
+#include "scheduler/queue/stop.h"
 
-namespace gravsweep::queue {
+namespace gravsweep::pipeline {
+
+using queue::JobKind;
+using queue::RunContext;
+using queue::RunnerTable;
+using queue::RunOutput;
 
 sweep::BedKeyFn impact_bed_key() {
-  return [](const nlohmann::json& scenario) { return pipeline::bed_key(scenario); };
+  return [](const nlohmann::json& scenario) { return bed_key(scenario); };
 }
 
 void add_impact_runners(RunnerTable& table) {
   table[JobKind::bed] = [](const RunContext& ctx) {
     RunOutput out;
     if (!ctx.bed_cache.empty()) {
-      if (auto cached =
-              pipeline::take_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.claim.scenario, ctx.output_tmp)) {
+      if (auto cached = take_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.claim.scenario, ctx.output_tmp)) {
         out.report = *cached;
         return out;
       }
     }
-    auto r = pipeline::run_bed_job(ctx.claim.scenario, ctx.output_tmp, ctx.threads, ctx.progress, ctx.stop);
+    auto r = run_bed_job(ctx.claim.scenario, ctx.output_tmp, ctx.threads, ctx.progress, ctx.stop);
     if (r.bed_path != ctx.output_tmp && !r.bed_path.empty()) std::filesystem::rename(r.bed_path, ctx.output_tmp);
-    if (!ctx.bed_cache.empty()) pipeline::store_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.output_tmp);
+    if (!ctx.bed_cache.empty()) store_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.output_tmp);
     out.report = r.report;
     return out;
   };
   table[JobKind::drop] = [](const RunContext& ctx) {
     if (ctx.bed_path.empty())
       throw std::runtime_error(fmt::format("drop job {} has no prepared bed", ctx.claim.job_id));
-    pipeline::DropCheckpointing ckpt;
+    DropCheckpointing ckpt;
     ckpt.path = ctx.checkpoint;
     ckpt.interval_s = ctx.checkpoint_interval_s;
     ckpt.attempt = ctx.claim.attempt;
-    ckpt.save_on_stop = &pipeline::stop_requested();  // SIGTERM, not a lease taken over
-    auto r = pipeline::run_drop_job(ctx.claim.scenario, ctx.bed_path, ctx.output_tmp, ctx.threads, ctx.progress,
-                                    ctx.stop, ckpt);
+    ckpt.save_on_stop = &queue::stop_requested();  // SIGTERM, not a lease taken over
+    auto r = run_drop_job(ctx.claim.scenario, ctx.bed_path, ctx.output_tmp, ctx.threads, ctx.progress, ctx.stop, ckpt);
     if (r.trace_path != ctx.output_tmp && !r.trace_path.empty()) std::filesystem::rename(r.trace_path, ctx.output_tmp);
     if (!r.snapshot_path.empty()) {
       // Grain snapshots (/output/snapshot_interval_s > 0): <campaign>.files/snapshots/, a folder that
@@ -54,9 +57,9 @@ void add_impact_runners(RunnerTable& table) {
 
 RunnerTable all_runners() {
   RunnerTable t;
-  t[JobKind::noop] = noop_runner();
+  t[JobKind::noop] = queue::noop_runner();
   add_impact_runners(t);
   return t;
 }
 
-}  // namespace gravsweep::queue
+}  // namespace gravsweep::pipeline

@@ -1,6 +1,6 @@
-#include "scheduler/pipeline/stop.h"
+#include "scheduler/queue/stop.h"
 
-namespace gravsweep::pipeline {
+namespace gravsweep::queue {
 
 namespace {
 
@@ -39,4 +39,4 @@ ScopedStopSignals::~ScopedStopSignals() {
   sigaction(SIGTERM, &old_term_, nullptr);
 }
 
-}  // namespace gravsweep::pipeline
+}  // namespace gravsweep::queue

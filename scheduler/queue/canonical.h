@@ -16,7 +16,7 @@
 
 #include "spec/sha256.h"
 
-namespace gravsweep::sweep {
+namespace gravsweep::queue {
 
 struct CanonicalError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -44,4 +44,4 @@ std::string sha256_file(const std::filesystem::path& path);
 /// Job id: the first 20 hex digits of SHA-256("gravsweep-job/1\n" + kind + "\n" + canonical).
 std::string job_id(std::string_view kind, const nlohmann::json& params);
 
-}  // namespace gravsweep::sweep
+}  // namespace gravsweep::queue

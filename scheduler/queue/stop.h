@@ -7,7 +7,7 @@
 #include <atomic>
 #include <csignal>
 
-namespace gravsweep::pipeline {
+namespace gravsweep::queue {
 
 /// The flag. Async-signal-safe to set (lock-free atomic).
 std::atomic<bool>& stop_requested();
@@ -29,4 +29,4 @@ class ScopedStopSignals {
   }, old_term_{};
 };
 
-}  // namespace gravsweep::pipeline
+}  // namespace gravsweep::queue

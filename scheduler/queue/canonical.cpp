@@ -1,4 +1,4 @@
-#include "scheduler/sweep/canonical.h"
+#include "scheduler/queue/canonical.h"
 
 #include <fmt/format.h>
 
@@ -10,7 +10,7 @@
 
 #include "spec/json_pointer.h"
 
-namespace gravsweep::sweep {
+namespace gravsweep::queue {
 
 namespace {
 
@@ -177,4 +177,4 @@ std::string job_id(std::string_view kind, const nlohmann::json& params) {
   return sha256_hex(text).substr(0, 20);
 }
 
-}  // namespace gravsweep::sweep
+}  // namespace gravsweep::queue
