@@ -106,7 +106,8 @@ void grain_speeds(const System& sys, double& rms_m_s, double& max_m_s) {
   max_m_s = std::sqrt(mx2);
 }
 
-BedRestState bed_rest_state(const System& sys, double surface_height_m, double grain_diameter_m) {
+BedRestState bed_rest_state(const System& sys, double surface_height_m, double grain_diameter_m,
+                            const SurfaceWindow& window) {
   BedRestState r;
   grain_speeds(sys, r.rms_speed_m_s, r.max_speed_m_s);
   const auto& p = sys.particles;
@@ -114,6 +115,7 @@ BedRestState bed_rest_state(const System& sys, double surface_height_m, double g
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (p.size_class[i] != SizeClass::grain || p.inv_mass_1_kg[i] == 0 || p.position_m[i].z() < layer_bottom_m)
       continue;
+    if (std::hypot(p.position_m[i].x() - window.x_m, p.position_m[i].y() - window.y_m) > window.radius_m) continue;
     r.max_surface_speed_m_s = std::max(r.max_surface_speed_m_s, p.velocity_m_s[i].norm());
     ++r.surface_grains;
   }

@@ -3,6 +3,7 @@
 // criteria, delete the grains above the fill height, and let the surface relax.
 // Engine frame: z up, container axis along z through the origin, bottom disk at z = 0.
 #pragma once
+#include <limits>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -174,7 +175,14 @@ struct BedRestState {
   std::size_t surface_grains = 0;
 };
 inline constexpr double kSurfaceLayerDiameters = 2.0;
-BedRestState bed_rest_state(const System& sys, double surface_height_m, double grain_diameter_m);
+/// The part of the surface layer that counts: grains whose centre lies within radius_m of the
+/// vertical line through (x_m, y_m), the impact axis; by default the whole surface.
+struct SurfaceWindow {
+  double x_m = 0, y_m = 0;
+  double radius_m = std::numeric_limits<double>::infinity();
+};
+BedRestState bed_rest_state(const System& sys, double surface_height_m, double grain_diameter_m,
+                            const SurfaceWindow& window = {});
 
 /// Packing fraction of the grains in a coaxial cylinder (axis distance < core_radius_m, z_lo_m < z <
 /// z_hi_m): each sphere's volume inside the z slab, exactly (layered crystals bias a count of whole

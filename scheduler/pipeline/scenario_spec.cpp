@@ -530,6 +530,8 @@ ScenarioParams scenario_params(const json& s) {
   out.at_rest.surface_speed_fraction = s["/at_rest/surface_speed_fraction"_json_pointer];
   out.at_rest.rms_speed_fraction = s["/at_rest/rms_speed_fraction"_json_pointer];
   out.at_rest.impact_speed_m_s = reference_impact_speed_m_s(s);
+  if (s.at("at_rest").contains("surface_radius_D"))
+    out.at_rest.surface_radius_D = s["/at_rest/surface_radius_D"_json_pointer];
   out.sample_rate_hz = s["/output/sample_rate_hz"_json_pointer];
   out.snapshot_interval_s = s["/output/snapshot_interval_s"_json_pointer];
 

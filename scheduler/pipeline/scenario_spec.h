@@ -52,6 +52,8 @@ struct AtRestCriterion {
   double surface_speed_fraction = 0.01;
   double rms_speed_fraction = 0.001;
   double impact_speed_m_s = 0;  ///< reference_impact_speed_m_s
+  /// Surface grains counted: within this many projectile diameters of the impact axis; 0: all.
+  double surface_radius_D = 0;
 };
 
 /// Everything the engine needs, from a validated scenario.
