@@ -257,8 +257,9 @@ void setup_work(CLI::App& app) {
       ->check(CLI::Range(0.0, 86400.0))
       ->capture_default_str();
   sub->add_option("--max-releases", opt->max_releases,
-                  "a job whose attempts were interrupted (SIGINT/SIGTERM, a Slurm time limit) this many times "
-                  "is stopped (dead, with the reason) instead of looping; `resume --dead` runs it again")
+                  "a job whose attempts were interrupted (SIGINT/SIGTERM, a Slurm time limit) this many times in a "
+                  "row without saving progress (a drop's checkpoint further on) is stopped (dead, with the reason) "
+                  "instead of looping; `resume --dead` runs it again")
       ->check(CLI::Range(1, 1000000))
       ->capture_default_str();
   sub->add_option("--backoff", opt->backoff_s, "retry backoff base, s (base * 2^(attempt-1), capped at 300 s)")

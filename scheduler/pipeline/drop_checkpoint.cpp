@@ -35,7 +35,27 @@ json drop_identity(const json& validated_scenario, const fs::path& bed, int thre
 DropCheckpointer::DropCheckpointer(DropCheckpointing cfg, json identity, const std::atomic<bool>* stop)
     : cfg_(std::move(cfg)), identity_(std::move(identity)), stop_(stop) {
   started_ = last_write_ = std::chrono::steady_clock::now();
-  if (!cfg_.path.empty()) load();
+  if (cfg_.path.empty()) return;
+  remove_stale_temporaries();
+  load();
+}
+
+void DropCheckpointer::remove_stale_temporaries() const {
+  // The job's lease is held by this attempt alone: a temporary of its checkpoint is a write that
+  // an earlier, killed worker never finished (h5::write_atomically names it <file>.tmp<pid>).
+  std::error_code ec;
+  const std::string prefix = cfg_.path.filename().string() + ".tmp";
+  for (fs::directory_iterator it(cfg_.path.parent_path(), ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    std::error_code rm;
+    if (name.rfind(prefix, 0) == 0 && fs::remove(it->path(), rm))
+      warn(fmt::format("removed {}: a checkpoint write an earlier worker never finished", it->path().string()));
+  }
+}
+
+double DropCheckpointer::resumed_t_s() const {
+  if (!resume_) return -1.0;
+  return resume_->drop.loop.result.samples.empty() ? 0.0 : resume_->drop.loop.result.samples.back().t_s;
 }
 
 void DropCheckpointer::warn(const std::string& message) const {
@@ -117,6 +137,7 @@ void DropCheckpointer::save(const System& sys, const DropLoopState& loop) {
     results::write_checkpoint(cfg_.path, c);
     ++written_;
     last_t_s_ = t_s;
+    if (cfg_.progress_saved != nullptr && t_s > resumed_t_s()) cfg_.progress_saved->store(true);
     last_clock_ = utc_time_of_day();
   } catch (const std::exception& e) {  // a full disk ends no drop: the next checkpoint may succeed
     warn(fmt::format("checkpoint {} not written (the drop goes on): {}", cfg_.path.string(), e.what()));
@@ -131,6 +152,7 @@ void DropCheckpointer::finished() {
   if (cfg_.path.empty()) return;
   std::error_code ec;
   fs::remove(cfg_.path, ec);
+  remove_stale_temporaries();
 }
 
 std::string DropCheckpointer::detail(const std::string& drop_detail) const {

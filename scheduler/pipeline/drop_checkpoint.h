@@ -39,6 +39,8 @@ struct DropCheckpointing {
   const std::atomic<bool>* save_on_stop = nullptr;
   /// The job's attempt: from the second on, a missing checkpoint is reported (warn) too.
   int attempt = 1;
+  /// Set when a checkpoint beyond where this attempt started is written (null: not reported).
+  std::atomic<bool>* progress_saved = nullptr;
   /// Where warnings go (a checkpoint discarded or not written); empty: stderr.
   std::function<void(const std::string&)> warn;
 };
@@ -63,7 +65,7 @@ class DropCheckpointer {
   /// drop_projectile's hooks: due() when the interval has passed or a stop was requested; save()
   /// writes the checkpoint, then throws Interrupted if a stop was requested.
   [[nodiscard]] DropCheckpoints hooks();
-  /// The drop is recorded: its checkpoint is removed.
+  /// The drop is recorded: its checkpoint (and any temporary of it) is removed.
   void finished();
 
   /// The progress detail with the last checkpoint appended (what `status` shows).
@@ -83,6 +85,10 @@ class DropCheckpointer {
   double last_t_s_ = -1;    ///< simulated time (since release) of the last checkpoint written
   std::string last_clock_;  ///< UTC time of day it was written
   void warn(const std::string& message) const;
+  /// Simulated time of the checkpoint continued from; -1 when the drop starts from its release.
+  [[nodiscard]] double resumed_t_s() const;
+  /// Removes temporaries of this checkpoint a writer killed mid-write left (<file>.tmp<pid>).
+  void remove_stale_temporaries() const;
   void load();
   void save(const System& sys, const DropLoopState& loop);
 };

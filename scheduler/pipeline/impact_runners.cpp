@@ -40,6 +40,7 @@ void add_impact_runners(RunnerTable& table) {
     ckpt.interval_s = ctx.checkpoint_interval_s;
     ckpt.attempt = ctx.claim.attempt;
     ckpt.save_on_stop = &queue::stop_requested();  // SIGTERM, not a lease taken over
+    ckpt.progress_saved = ctx.progress_saved;
     auto r = run_drop_job(ctx.claim.scenario, ctx.bed_path, ctx.output_tmp, ctx.threads, ctx.progress, ctx.stop, ckpt);
     if (r.trace_path != ctx.output_tmp && !r.trace_path.empty()) std::filesystem::rename(r.trace_path, ctx.output_tmp);
     if (!r.snapshot_path.empty()) {

@@ -132,25 +132,29 @@ bool bed_mismatch(Database& db, const Claim& c, const std::string& reason) {
   return true;
 }
 
-std::string release(Database& db, const Claim& c, const std::string& why, int max_releases) {
+std::string release(Database& db, const Claim& c, const std::string& why, int max_releases, bool saved_progress) {
   const double now = clock_s(db);
   const std::string stopped = fmt::format(
-      "released {} times without finishing (every attempt interrupted: a Slurm time limit or a scancel shorter "
-      "than the job?); stopped so that it does not loop; `gravsweep resume --dead` runs it again",
+      "released {} times in a row without finishing or saving progress (every attempt interrupted before its "
+      "first checkpoint: a Slurm time limit or a scancel shorter than the job or its checkpoint interval?); "
+      "stopped so that it does not loop; `gravsweep resume --dead` runs it again",
       max_releases);
   Transaction tx(db);
   std::string state;
   {
-    // The attempt is not counted against the retry budget; the release is, against max_releases.
+    // The attempt is not counted against the retry budget; the release is (jobs.releases), and
+    // against max_releases when it saved no progress (jobs.stalled_releases, reset by one that did).
     Statement st(db,
                  "UPDATE jobs SET releases=releases+1, "
-                 "state=CASE WHEN releases+1>=?1 THEN 'dead' ELSE 'queued' END, "
-                 "last_error=CASE WHEN releases+1>=?1 THEN ?2 ELSE last_error END, "
-                 "finished_at=CASE WHEN releases+1>=?1 THEN ?3 ELSE finished_at END, "
+                 "stalled_releases=CASE WHEN ?6=1 THEN 0 ELSE stalled_releases+1 END, "
+                 "state=CASE WHEN ?6=0 AND stalled_releases+1>=?1 THEN 'dead' ELSE 'queued' END, "
+                 "last_error=CASE WHEN ?6=0 AND stalled_releases+1>=?1 THEN ?2 ELSE last_error END, "
+                 "finished_at=CASE WHEN ?6=0 AND stalled_releases+1>=?1 THEN ?3 ELSE finished_at END, "
                  "attempts=CASE WHEN attempts>0 THEN attempts-1 ELSE 0 END, lease_owner=NULL, lease_expires=NULL, "
                  "progress=NULL, phase=NULL, detail=NULL WHERE job_id=?4 AND lease_token=?5 AND state='running' "
                  "RETURNING state");
     st.bind(1, max_releases).bind(2, stopped).bind(3, now).bind(4, c.job_id).bind(5, c.token);
+    st.bind(6, saved_progress ? 1 : 0);
     if (!st.step()) return "";
     state = st.get_text(0);
     st.run();

@@ -141,15 +141,19 @@ std::string fail(db::Database& db, const Claim& c, const std::string& error, int
 /// queued to be rebuilt, its other unstarted drops waiting for it. false = fenced out.
 bool bed_mismatch(db::Database& db, const Claim& c, const std::string& reason);
 
-/// Releases a job may have before it is stopped (dead, with the reason): a job interrupted at
-/// every attempt (a time limit shorter than the job) would otherwise loop forever, uncounted.
+/// Releases in a row without progress a job may have before it is stopped (dead, with the
+/// reason): a job interrupted at every attempt before it saved anything (a time limit shorter than
+/// the job, and than its checkpoint interval) would otherwise loop forever, uncounted.
 inline constexpr int kDefaultMaxReleases = 5;
 
 /// Gives the job back (interrupted worker): the attempt is not counted against the retry budget
-/// but the release is counted (jobs.releases); the job is queued again, or dead with the reason
-/// once it was released `max_releases` times. Returns the new state ("queued" or "dead"), ""
-/// when fenced out.
-std::string release(db::Database& db, const Claim& c, const std::string& why, int max_releases = kDefaultMaxReleases);
+/// but the release is counted (jobs.releases). `saved_progress`: the attempt left state the next
+/// one continues from (a drop's checkpoint beyond where it started); such a release resets
+/// jobs.stalled_releases, any other adds one. The job is queued again, or dead with the reason
+/// once `max_releases` releases in a row saved nothing. Returns the new state ("queued" or
+/// "dead"), "" when fenced out.
+std::string release(db::Database& db, const Claim& c, const std::string& why, int max_releases = kDefaultMaxReleases,
+                    bool saved_progress = false);
 
 /// Gives the job back after an environmental failure (the files root's disk full): queued again,
 /// the attempt closed as released with `why`, counted neither against the retry budget nor as a

@@ -48,7 +48,7 @@ ResumeReport resume(Database& db, const CampaignPaths& paths, const ResumeOption
       Statement a(
           db,
           "UPDATE jobs SET max_attempts=CASE WHEN max_attempts>attempts+?1 THEN max_attempts ELSE attempts+?1 END, "
-          "last_error=NULL, blocked_by=NULL, finished_at=NULL, releases=0, "
+          "last_error=NULL, blocked_by=NULL, finished_at=NULL, releases=0, stalled_releases=0, "
           "deps_pending=(SELECT count(*) FROM job_deps d JOIN jobs j2 ON j2.job_id=d.dep_id "
           "WHERE d.job_id=jobs.job_id AND j2.state!='done') WHERE state='dead'");
       a.bind(1, o.extra_attempts);

@@ -37,6 +37,7 @@ CREATE TABLE IF NOT EXISTS jobs(
   attempts {integer} NOT NULL DEFAULT 0,
   max_attempts {integer} NOT NULL,
   releases {integer} NOT NULL DEFAULT 0,  -- attempts given back (interrupted), not counted in attempts
+  stalled_releases {integer} NOT NULL DEFAULT 0,  -- the last releases in a row that saved no progress
   lease_owner TEXT,
   lease_token {integer} NOT NULL DEFAULT 0,
   lease_expires {real},
@@ -160,6 +161,11 @@ void add_missing_columns(Database& db) {
   }
   if (!d.has_column(db, "jobs", "releases"))
     db.exec(fmt::format("ALTER TABLE jobs ADD COLUMN releases {} NOT NULL DEFAULT 0", d.schema_types().integer));
+  if (!d.has_column(db, "jobs", "stalled_releases")) {
+    db.exec(
+        fmt::format("ALTER TABLE jobs ADD COLUMN stalled_releases {} NOT NULL DEFAULT 0", d.schema_types().integer));
+    db.exec("UPDATE jobs SET stalled_releases=releases");  // earlier campaigns knew no progress
+  }
   tx.commit();
 }
 

@@ -188,8 +188,8 @@ Status status(Database& db, std::size_t max_running) {
   {
     Statement st(db,
                  "SELECT coalesce(sum(releases), 0), coalesce(sum(CASE WHEN releases>0 AND state!='done' THEN 1 "
-                 "ELSE 0 END), 0), coalesce(sum(CASE WHEN state='dead' AND last_error LIKE 'released % times "
-                 "without finishing%' THEN 1 ELSE 0 END), 0) FROM jobs");
+                 "ELSE 0 END), 0), coalesce(sum(CASE WHEN state='dead' AND last_error LIKE 'released % times%without "
+                 "finishing%' THEN 1 ELSE 0 END), 0) FROM jobs");
     st.step();
     s.released_attempts = st.get_int(0);
     s.released_jobs = st.get_int(1);

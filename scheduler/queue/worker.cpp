@@ -141,6 +141,7 @@ struct JobSignals {
   double fraction = 0;
   std::atomic<bool> stop{false};  // tells the runner to end early
   std::atomic<bool> lease_lost{false};
+  std::atomic<bool> progress_saved{false};  // the runner left state the next attempt continues from
 };
 
 /// `db` is the heartbeat connection of this worker: used only by this thread while the job runs.
@@ -374,7 +375,8 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
                      &sig.stop,
                      o.bed_cache,
                      paths.root / "checkpoints" / (c->job_id + ".ckpt.h5"),
-                     o.checkpoint_interval_s};
+                     o.checkpoint_interval_s,
+                     &sig.progress_saved};
       out = runner->second(ctx);
     } catch (const ConfigError& e) {
       error = e.what();
@@ -402,13 +404,15 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
         return release(db, *c,
                        error.empty() ? "interrupted by SIGINT/SIGTERM; lease released"
                                      : fmt::format("interrupted by SIGINT/SIGTERM ({}); lease released", error),
-                       o.max_releases);
+                       o.max_releases, sig.progress_saved.load());
       });
       ++rep.released;
       rep.interrupted = true;
       if (o.verbose)
         std::fprintf(stderr, "worker %d: job %s released (interrupted)%s\n", who.pid, c->job_id.c_str(),
-                     state == "dead" ? fmt::format("; stopped after {} releases", o.max_releases).c_str() : "");
+                     state == "dead"
+                         ? fmt::format("; stopped after {} releases in a row without progress", o.max_releases).c_str()
+                         : "");
       break;
     }
     if (error.empty() && !fs::exists(tmp)) {

@@ -30,6 +30,9 @@ struct RunContext {
   /// written every checkpoint_interval_s of wall time (<= 0: never) and on a stop request.
   std::filesystem::path checkpoint;
   double checkpoint_interval_s = 0;
+  /// Set by a runner that saved state a later attempt continues from (a drop's checkpoint beyond
+  /// where this attempt started): a release of such an attempt does not count as a stall.
+  std::atomic<bool>* progress_saved = nullptr;
 };
 
 struct RunOutput {

@@ -1,14 +1,16 @@
 // Checkpoints of a campaign's drop through real worker processes (`gravsweep work`,
 // scheduler/pipeline/drop_checkpoint.h): a worker stopped by SIGTERM mid-drop writes the drop's
 // checkpoint, gives its lease back and says so in the attempts table; a worker killed by SIGKILL
-// leaves the last periodic checkpoint, which `status` names while the drop runs; either way the
-// next worker continues the drop and records the trace of an uninterrupted campaign, value for
-// value, and removes the checkpoint.
+// leaves the last periodic checkpoint, which `status` names while the drop runs (and perhaps the
+// temporary of a write it never finished); either way the next worker continues the drop and
+// records the trace of an uninterrupted campaign, value for value, and removes the checkpoint
+// and any temporary of it.
 #include <gtest/gtest.h>
 
 #include <csignal>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "results/io/trace_file.h"
 #include "scheduler_test_helpers.h"
@@ -110,7 +112,11 @@ class CampaignCheckpoint : public ::testing::Test {
 }  // namespace
 
 TEST_F(CampaignCheckpoint, SigtermCheckpointsAndTheNextWorkerContinues) {
-  const pid_t w = start_cli(work_args(d_.path, "c", "300"), d_.path / "w1.log");
+  // --max-releases 1: a release that saved no progress would stop the drop; this one saved its
+  // checkpoint, so the drop stays queued.
+  std::vector<std::string> args = work_args(d_.path, "c", "300");
+  args.insert(args.end(), {"--max-releases", "1"});
+  const pid_t w = start_cli(args, d_.path / "w1.log");
   ASSERT_TRUE(wait_for_detail(d_.path / "c.db", "depth=", 60)) << "the drop never started";
   std::this_thread::sleep_for(std::chrono::milliseconds(700));  // well inside the drop
   kill(w, SIGTERM);
@@ -120,6 +126,8 @@ TEST_F(CampaignCheckpoint, SigtermCheckpointsAndTheNextWorkerContinues) {
     db::Database db((d_.path / "c.db").string());
     const std::string why = sql_text(db, "SELECT coalesce(error,'') FROM attempts WHERE outcome='released'");
     EXPECT_NE(why.find("checkpoint"), std::string::npos) << "the attempts table says where it stopped: " << why;
+    EXPECT_EQ(sql_text(db, "SELECT state FROM jobs WHERE kind='drop'"), "queued");
+    EXPECT_EQ(sql_int(db, "SELECT stalled_releases FROM jobs WHERE kind='drop'"), 0);
   }
   EXPECT_NO_FATAL_FAILURE(finish_and_compare());
 }
@@ -131,7 +139,13 @@ TEST_F(CampaignCheckpoint, SigkillLosesAtMostOneIntervalAndStatusNamesTheCheckpo
   EXPECT_NE(status.out.find("ckpt t="), std::string::npos) << status.out;
   kill(w, SIGKILL);
   wait_child(w, 10);
-  ASSERT_EQ(std::distance(fs::directory_iterator(checkpoints()), fs::directory_iterator()), 1);
+  // One checkpoint; the kill may also have caught a write of the next one half done (its
+  // temporary): the next worker removes it. One is planted so that this is always tested.
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(checkpoints()))
+    if (e.path().filename().string().find(".tmp") == std::string::npos) files.push_back(e.path());
+  ASSERT_EQ(files.size(), 1u);
+  write_text(fs::path(files[0].string() + ".tmp999999"), "half a checkpoint");
   std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // the lease (2 s) lapses
   EXPECT_NO_FATAL_FAILURE(finish_and_compare());
 }

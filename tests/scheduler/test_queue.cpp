@@ -271,7 +271,8 @@ TEST_P(QueueTest, ReleasesAreCountedAndAJobReleasedTooOftenStops) {
     EXPECT_EQ(sql_text(db, "SELECT state FROM jobs"), i < 5 ? "queued" : "dead");
   }
   EXPECT_FALSE(claim(db, me, paths, 60)) << "stopped after 5 releases";
-  EXPECT_NE(sql_text(db, "SELECT last_error FROM jobs").find("released 5 times without finishing"), std::string::npos)
+  EXPECT_NE(sql_text(db, "SELECT last_error FROM jobs").find("released 5 times in a row without finishing"),
+            std::string::npos)
       << sql_text(db, "SELECT last_error FROM jobs");
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='released'"), 5);
   const auto st = test::run_cli({"status", "--db", store.location}, dir.path);
@@ -285,6 +286,26 @@ TEST_P(QueueTest, ReleasesAreCountedAndAJobReleasedTooOftenStops) {
   auto again = claim(db, me, paths, 60);
   ASSERT_TRUE(again);
   EXPECT_TRUE(complete(db, *again, done_for(*again)));
+}
+
+// A long drop run across many batch tasks is released once per task, each time after saving a
+// checkpoint further on: those releases never stop it. Only releases in a row that saved nothing
+// count towards the limit, and one that saved progress starts the count again.
+TEST_P(QueueTest, ReleasesThatSavedProgressNeverStopTheJob) {
+  submit_spec(noop_spec("s", {1}, 3));
+  auto release_once = [&](bool saved_progress) {
+    auto c = claim(db, me, paths, 60);
+    EXPECT_TRUE(c) << sql_text(db, "SELECT state || ' ' || coalesce(last_error,'') FROM jobs");
+    return c ? release(db, *c, "time limit", kDefaultMaxReleases, saved_progress) : std::string("not claimed");
+  };
+  for (int i = 1; i <= 2 * kDefaultMaxReleases; ++i) EXPECT_EQ(release_once(true), "queued") << "release " << i;
+  EXPECT_EQ(sql_int(db, "SELECT releases FROM jobs"), 2 * kDefaultMaxReleases);
+  EXPECT_EQ(sql_int(db, "SELECT stalled_releases FROM jobs"), 0);
+  for (int i = 1; i < kDefaultMaxReleases; ++i) EXPECT_EQ(release_once(false), "queued") << "stall " << i;
+  EXPECT_EQ(release_once(true), "queued") << "progress starts the count again";
+  for (int i = 1; i < kDefaultMaxReleases; ++i) EXPECT_EQ(release_once(false), "queued") << "stall " << i;
+  EXPECT_EQ(release_once(false), "dead") << kDefaultMaxReleases << " releases in a row saved nothing";
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='released'"), 4 * kDefaultMaxReleases);
 }
 
 TEST_P(QueueTest, ResumeRequeuesExpiredAndFailedAndRemovesOrphans) {
