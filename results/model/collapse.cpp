@@ -39,12 +39,19 @@ double poly_at(const Eigen::VectorXd& c, double x) {
   return y;
 }
 
-/// Distinct Froude numbers (to 1e-6 in ln Fr) among the points.
+/// Froude numbers closer than this in ln Fr (5 %) are one speed of the design: repeats of one
+/// point differ by their measured impact speeds, and a curve must not bend between them.
+constexpr double kSameFroudeLn = 0.05;
+
+/// Distinct Froude numbers among the points (clusters closer than kSameFroudeLn in ln Fr).
 int distinct_x(const std::vector<Point>& pts) {
   std::vector<double> x;
-  for (const auto& p : pts) x.push_back(std::round(p.x * 1e6));
+  for (const auto& p : pts) x.push_back(p.x);
   std::sort(x.begin(), x.end());
-  return static_cast<int>(std::unique(x.begin(), x.end()) - x.begin());
+  int n = 0;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    if (i == 0 || x[i] - x[i - 1] > kSameFroudeLn) ++n;
+  return n;
 }
 
 double pct(double ln_scatter) { return 100 * (std::exp(ln_scatter) - 1); }

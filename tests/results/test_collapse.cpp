@@ -51,6 +51,24 @@ TEST(Collapse, AResistanceThatDoesNotScaleWithGravityBreaksIt) {
   }
 }
 
+// A level with only two speeds (repeats at slightly different measured impact speeds) gets a
+// straight line, not a parabola bent between two repeats: its distance to the other levels
+// stays that of a Froude-scaled truth.
+TEST(Collapse, ALevelWithTwoSpeedsIsFittedByALine) {
+  TempDir d;
+  Campaign c = four_levels("base", d);
+  std::erase_if(c.trials, [](const MeasuredTrial& t) {
+    return same_gravity_level(t.info.gravity_m_s2, 0.01) && t.info.impact_velocity_m_s > 0.3;
+  });
+  const auto rows = collapse(c);
+  for (const auto& r : rows) {
+    EXPECT_EQ(r.trials, 52) << r.metric;  // 16 per level, 4 at 0.01 m/s2
+    if (r.metric == "apeak_over_g") continue;
+    EXPECT_LT(r.between_levels_pct, 20) << r.metric;
+    EXPECT_LT(r.collapse_ratio, 1.3) << r.metric;
+  }
+}
+
 TEST(Collapse, ScaledMetricsUseTheProjectileDiameterAndGravity) {
   TempDir d;
   const Campaign c = four_levels("base", d);
