@@ -109,16 +109,22 @@ void grain_speeds(const System& sys, double& rms_m_s, double& max_m_s) {
 BedRestState bed_rest_state(const System& sys, double surface_height_m, double grain_diameter_m,
                             const SurfaceWindow& window) {
   BedRestState r;
-  grain_speeds(sys, r.rms_speed_m_s, r.max_speed_m_s);
   const auto& p = sys.particles;
   const double layer_bottom_m = surface_height_m - kSurfaceLayerDiameters * grain_diameter_m;
+  double sum2_m2_s2 = 0;
+  std::size_t n = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
-    if (p.size_class[i] != SizeClass::grain || p.inv_mass_1_kg[i] == 0 || p.position_m[i].z() < layer_bottom_m)
-      continue;
+    if (p.size_class[i] != SizeClass::grain || p.inv_mass_1_kg[i] == 0) continue;
     if (std::hypot(p.position_m[i].x() - window.x_m, p.position_m[i].y() - window.y_m) > window.radius_m) continue;
-    r.max_surface_speed_m_s = std::max(r.max_surface_speed_m_s, p.velocity_m_s[i].norm());
+    const double speed_m_s = p.velocity_m_s[i].norm();
+    sum2_m2_s2 += speed_m_s * speed_m_s;
+    r.max_speed_m_s = std::max(r.max_speed_m_s, speed_m_s);
+    ++n;
+    if (p.position_m[i].z() < layer_bottom_m) continue;
+    r.max_surface_speed_m_s = std::max(r.max_surface_speed_m_s, speed_m_s);
     ++r.surface_grains;
   }
+  r.rms_speed_m_s = n > 0 ? std::sqrt(sum2_m2_s2 / static_cast<double>(n)) : 0.0;
   return r;
 }
 

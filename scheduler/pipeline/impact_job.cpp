@@ -80,13 +80,14 @@ double slowest_impact_at_rest_m_s(const BedRestState& r, const AtRestCriterion& 
 void require_at_rest(const System& sys, const results::BedData& bed, const ScenarioParams& p,
                      const std::filesystem::path& bed_path) {
   const AtRestCriterion& c = p.at_rest;
-  SurfaceWindow window;  // the whole surface, or the part about the impact axis
-  std::string where;
+  SurfaceWindow window;  // the whole bed, or the part about the impact axis
+  std::string where, there;
   if (c.surface_radius_D > 0) {
     window = {p.projectile.lateral_offset_x_m, p.projectile.lateral_offset_y_m,
               c.surface_radius_D * p.projectile.diameter_m};
     where = fmt::format(" within {:.3g} m of the impact axis (/at_rest/surface_radius_D: {:g})", window.radius_m,
                         c.surface_radius_D);
+    there = " there";
   }
   const BedRestState r = bed_rest_state(sys, bed.surface_height_m, p.bed.grains.diameter_m, window);
   const double v = c.impact_speed_m_s;
@@ -94,10 +95,10 @@ void require_at_rest(const System& sys, const results::BedData& bed, const Scena
   throw ConfigError(fmt::format(
       "bed {} is not at rest for an impact at {:.4g} m/s: its fastest surface grain{} moves at {:.3g} m/s (at "
       "most {:g} of the impact speed allowed, /at_rest/surface_speed_fraction: {:.3g} m/s) and its RMS grain "
-      "speed is {:.3g} m/s (at most {:g}: {:.3g} m/s); it is at rest for impacts of at least {:.3g} m/s. "
+      "speed{} is {:.3g} m/s (at most {:g}: {:.3g} m/s); it is at rest for impacts of at least {:.3g} m/s. "
       "Settle the bed longer (/bed/settle) or drop faster",
       bed_path.string(), v, where, r.max_surface_speed_m_s, c.surface_speed_fraction, c.surface_speed_fraction * v,
-      r.rms_speed_m_s, c.rms_speed_fraction, c.rms_speed_fraction * v, slowest_impact_at_rest_m_s(r, c)));
+      there, r.rms_speed_m_s, c.rms_speed_fraction, c.rms_speed_fraction * v, slowest_impact_at_rest_m_s(r, c)));
 }
 
 /// Runs `drop` continuing ckpt's checkpoint; when the engine refuses that state, the checkpoint

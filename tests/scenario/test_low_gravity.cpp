@@ -105,6 +105,39 @@ TEST(AtRest, ASurfaceRadiusCountsOnlyTheGrainsAboutTheImpactAxis) {
   }
 }
 
+// The RMS criterion counts the same column: the grains beyond 2 cm of the axis, at every depth,
+// moving at 0.3 % of the impact speed (below the surface criterion's 1 %, above the RMS's 0.1 %
+// over the whole bed) refuse the drop when the whole bed counts, and not with the window; moving
+// the grains within it instead refuses it, the message saying the RMS is taken there.
+TEST(AtRest, TheRmsSpeedCountsTheSameColumnAboutTheImpactAxis) {
+  test::TempDir dir;
+  const auto b = run_bed_job(test::tiny_scenario(), dir.path / "bed.h5", 1, {}, nullptr);
+  results::BedData bed = results::read_bed(b.bed_path);
+  constexpr double kWindow_m = 0.02, kCreep_m_s = 0.003;
+  std::size_t outside = 0;
+  for (std::size_t i = 0; i < bed.size(); ++i)
+    if (std::hypot(bed.position_m[3 * i], bed.position_m[3 * i + 1]) > kWindow_m) {
+      bed.velocity_m_s[3 * i] = kCreep_m_s;
+      ++outside;
+    }
+  ASSERT_GT(static_cast<double>(outside) / static_cast<double>(bed.size()), 0.2) << "whole-bed RMS above 0.1 %";
+  write_bed(dir.path / "wall.h5", bed);
+  json s = test::tiny_scenario();
+  s["stop"]["max_time_s"] = 0.002;
+  EXPECT_THROW(run_drop_job(s, dir.path / "wall.h5", dir.path / "never.h5", 1, {}, nullptr), ConfigError);
+  s["at_rest"] = {{"surface_radius_D", 0.5}};
+  EXPECT_NO_THROW(run_drop_job(s, dir.path / "wall.h5", dir.path / "ok.h5", 1, {}, nullptr));
+  for (std::size_t i = 0; i < bed.size(); ++i)
+    bed.velocity_m_s[3 * i] = std::hypot(bed.position_m[3 * i], bed.position_m[3 * i + 1]) > kWindow_m ? 0 : kCreep_m_s;
+  write_bed(dir.path / "column.h5", bed);
+  try {
+    run_drop_job(s, dir.path / "column.h5", dir.path / "never.h5", 1, {}, nullptr);
+    FAIL() << "a column moving at 0.3 % of the impact speed about the impact axis was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("RMS grain speed there is 0.00"), std::string::npos) << e.what();
+  }
+}
+
 /// The tiny cup at 0.001 m/s2 with soft grains (E 100 times lower: a 5x longer contact time, so a
 /// 50 us step; the test is about the drop's criteria, not the contact law): poured and settled at
 /// 9.81 m/s2, gravity ramped down under a quench, relaxed free; a 4 cm projectile at Froude number 4
