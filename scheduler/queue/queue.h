@@ -215,7 +215,7 @@ struct Status {
   std::int64_t blocked = 0;              ///< dead because a dependency is dead (jobs.blocked_by)
   std::int64_t released_attempts = 0;    ///< attempts given back (interrupted), not counted in attempts
   std::int64_t released_jobs = 0;        ///< unfinished jobs with at least one released attempt
-  std::int64_t stopped_by_releases = 0;  ///< dead because they were released max_releases times
+  std::int64_t stopped_by_releases = 0;  ///< dead: released max_releases times in a row without progress
   std::int64_t active_workers = 0;
   double eta_s = -1;  ///< < 0: unknown (no finished job of some remaining kind)
   std::vector<std::pair<std::string, std::string>> recent_errors;  ///< (job_id, error) of dead jobs
