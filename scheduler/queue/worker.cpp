@@ -248,124 +248,176 @@ Runner noop_runner() {
   };
 }
 
-WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
-  WorkerReport rep;
-  db::Database db(o.db_path.string());
-  check_campaign(db);  // never creates a schema: `work` opened the campaign with open_campaign
-  const CampaignPaths paths(o.db_path, o.files);
-  const WorkerIdentity who = make_identity(o.code_version, o.threads);
-  // Renew at least 4 times per lease, and report progress at least every 2 s.
-  const double hb = o.heartbeat_s > 0 ? o.heartbeat_s : std::min(o.lease_s / 4, 2.0);
-  std::error_code ec;
-  for (const char* d : kOutputFolders) fs::create_directories(paths.root / d, ec);
-  std::unique_ptr<db::Database> beat_db;  // the heartbeat thread's own connection, kept across jobs
-  Reconnecting with_db(db, o.db_path.string(), o.db_outage_s);
-  std::int64_t largest = with_db([&] { return largest_output(db); });
-  // An attempt that failed for its environment goes back uncounted; the worker stops claiming.
-  const auto give_back_env = [&](const Claim& c, const std::string& error, std::string full) {
-    with_db([&] { return give_back(db, c, "environmental, not counted: " + error); });
-    ++rep.released;
-    rep.disk_full = full.empty() ? error : full;
-    std::fprintf(stderr, "worker %d: job %s given back, not counted: %s\n", who.pid, c.job_id.c_str(),
-                 rep.disk_full.c_str());
-  };
-  long ran = 0;
-  while (!queue::stop_requested().load() && (o.max_jobs < 0 || ran < o.max_jobs)) {
-    if (supervisor_gone()) {
-      std::fprintf(stderr, "worker %d: its supervisor is gone; stopping\n", who.pid);
-      queue::stop_requested().store(true);
-      break;
-    }
-    if (const std::string full = disk_full(paths, o.min_free_bytes, largest); !full.empty() || !rep.disk_full.empty()) {
-      if (!o.follow) {
-        if (rep.disk_full.empty()) rep.disk_full = full;
-        std::fprintf(stderr, "worker %d: %s\n", who.pid, rep.disk_full.c_str());
+namespace {
+
+/// What one attempt of a job came to, before it is recorded.
+struct Attempt {
+  RunOutput out;
+  std::string error;  ///< empty: the runner returned
+  int exit_code = kExitOk;
+  bool permanent = false;  ///< the error is the job's own (ConfigError, NumericalFailure): no retry
+  int threads = 1;
+  double wall_s = 0;
+  bool lease_lost = false, progress_saved = false;
+};
+
+/// One worker process's loop: claim a job, verify its bed, run it beside a heartbeat thread, and
+/// record the outcome (done, failed, released, given back, fenced out) in the campaign.
+class Worker {
+ public:
+  Worker(const WorkerOptions& o, const RunnerTable& runners)
+      : o_(o),
+        runners_(runners),
+        db_(o.db_path.string()),
+        paths_(o.db_path, o.files),
+        who_(make_identity(o.code_version, o.threads)),
+        // Renew at least 4 times per lease, and report progress at least every 2 s.
+        heartbeat_s_(o.heartbeat_s > 0 ? o.heartbeat_s : std::min(o.lease_s / 4, 2.0)),
+        with_db_(db_, o.db_path.string(), o.db_outage_s) {
+    check_campaign(db_);  // never creates a schema: `work` opened the campaign with open_campaign
+    std::error_code ec;
+    for (const char* d : kOutputFolders) fs::create_directories(paths_.root / d, ec);
+    largest_ = with_db_([&] { return largest_output(db_); });
+  }
+
+  WorkerReport run() {
+    long ran = 0;
+    while (!queue::stop_requested().load() && (o_.max_jobs < 0 || ran < o_.max_jobs)) {
+      if (supervisor_gone()) {
+        std::fprintf(stderr, "worker %d: its supervisor is gone; stopping\n", who_.pid);
+        queue::stop_requested().store(true);
         break;
       }
-      rep.disk_full.clear();  // --follow: wait for space
-      sleep_interruptible(std::max(o.poll_s, 1.0));
-      if (!full.empty()) continue;
+      const Room room = room_for_output();
+      if (room == Room::stop) break;
+      if (room == Room::wait) continue;
+      bool idle_stop = false;
+      const std::optional<Claim> c = next_claim(idle_stop);
+      if (idle_stop) break;
+      if (!c) continue;
+      ++ran;
+      if (o_.verbose)
+        std::fprintf(stderr, "worker %d: %s job %s attempt %d\n", who_.pid, kind_name(c->kind), c->job_id.c_str(),
+                     c->attempt);
+      if (!bed_verified(*c)) continue;
+      if (record(*c, run_attempt(*c)) == Next::stop) break;
     }
+    if (queue::stop_requested().load()) rep_.interrupted = true;
+    return rep_;
+  }
+
+ private:
+  enum class Room { ok, wait, stop };
+  enum class Next { go_on, stop };
+
+  const WorkerOptions& o_;
+  const RunnerTable& runners_;
+  db::Database db_;
+  const CampaignPaths paths_;
+  const WorkerIdentity who_;
+  const double heartbeat_s_;
+  Reconnecting with_db_;
+  std::unique_ptr<db::Database> beat_db_;  // the heartbeat thread's own connection, kept across jobs
+  std::int64_t largest_ = 0;               // the largest output so far: what the next one may need
+  WorkerReport rep_;
+
+  [[nodiscard]] std::string full_now() const { return disk_full(paths_, o_.min_free_bytes, largest_); }
+  [[nodiscard]] fs::path tmp_of(const Claim& c) const {
+    return paths_.tmp() / (prefix_of(c) + "out" + kind_info(c.kind).extension);
+  }
+  static std::string prefix_of(const Claim& c) { return fmt::format("{}.a{}.", c.job_id, c.attempt); }
+
+  /// The files root's disk: room for the next output, wait for space (--follow), or stop.
+  Room room_for_output() {
+    const std::string full = full_now();
+    if (full.empty() && rep_.disk_full.empty()) return Room::ok;
+    if (!o_.follow) {
+      if (rep_.disk_full.empty()) rep_.disk_full = full;
+      std::fprintf(stderr, "worker %d: %s\n", who_.pid, rep_.disk_full.c_str());
+      return Room::stop;
+    }
+    rep_.disk_full.clear();  // --follow: wait for space
+    sleep_interruptible(std::max(o_.poll_s, 1.0));
+    return full.empty() ? Room::ok : Room::wait;
+  }
+
+  /// The next job (expired leases are reclaimed on the way); none when nothing is runnable now,
+  /// with `stop` set when nothing is left to wait for either.
+  std::optional<Claim> next_claim(bool& stop) {
     Reclaimed lost;
     std::optional<Claim> c;
     try {
-      c = with_db([&] {
+      c = with_db_([&] {
         lost = Reclaimed{};
-        return claim(db, who, paths, o.lease_s, &lost);
+        return claim(db_, who_, paths_, o_.lease_s, &lost);
       });
     } catch (const db::DbError& e) {
       if (!e.busy()) throw;
       sleep_interruptible(0.05 + 0.1 * (getpid() % 7) / 7.0);  // busy beyond the timeout: retry with jitter
-      continue;
+      return std::nullopt;
     }
     if (lost.lost > 0) {
-      rep.reclaimed += lost.lost;
-      remove_lost_files(paths, lost);
-      if (o.verbose)
-        std::fprintf(stderr, "worker %d: requeued %d job(s) with expired leases (%d dead)\n", who.pid, lost.lost,
+      rep_.reclaimed += lost.lost;
+      remove_lost_files(paths_, lost);
+      if (o_.verbose)
+        std::fprintf(stderr, "worker %d: requeued %d job(s) with expired leases (%d dead)\n", who_.pid, lost.lost,
                      lost.dead);
     }
     if (!c) {
-      if (!o.follow && !with_db([&] { return work_remains(db); })) break;
-      sleep_interruptible(o.poll_s);
-      continue;
+      if (!o_.follow && !with_db_([&] { return work_remains(db_); })) stop = true;
+      if (!stop) sleep_interruptible(o_.poll_s);
     }
-    ++ran;
-    const auto runner = runners.find(c->kind);
-    const std::string ext = kind_info(c->kind).extension;
-    const std::string prefix = fmt::format("{}.a{}.", c->job_id, c->attempt);
-    const fs::path tmp = paths.tmp() / (prefix + "out" + ext);
-    JobSignals sig;
-    std::thread beat(heartbeat_loop, std::cref(o), std::cref(*c), std::ref(sig), hb, std::ref(beat_db));
-    auto stop_beat = [&] {
-      {
-        std::lock_guard g(sig.m);
-        sig.finished = true;
-      }
-      sig.cv.notify_all();
-      if (beat.joinable()) beat.join();
-    };
-    RunOutput out;
-    std::string error;
-    int exit_code = kExitOk;
-    bool permanent = false;
-    const auto t0 = std::chrono::steady_clock::now();
-    if (o.verbose)
-      std::fprintf(stderr, "worker %d: %s job %s attempt %d\n", who.pid, kind_name(c->kind), c->job_id.c_str(),
-                   c->attempt);
-    if (!c->dep_output_rel.empty() && !c->dep_sha256.empty()) {
-      // The bed is verified before the drop uses it: a changed bit changes every drop's results.
-      const fs::path bed = paths.abs(c->dep_output_rel);
-      const std::string found = fs::exists(bed, ec) ? queue::sha256_file(bed) : std::string("missing");
-      if (found != c->dep_sha256) {
-        stop_beat();
-        const std::string why = fmt::format(
-            "bed checksum mismatch: '{}' of bed job {} has sha256 {}, recorded {}; the "
-            "bed is rebuilt and the drop waits for it",
-            bed.string(), c->dep_job_id, found, c->dep_sha256);
-        std::fprintf(stderr, "worker %d: job %s: %s\n", who.pid, c->job_id.c_str(), why.c_str());
-        if (with_db([&] { return bed_mismatch(db, *c, why); }))
-          ++rep.failed;
-        else
-          ++rep.fenced_out;
-        continue;
-      }
-    }
-    int threads = o.threads;
+    return c;
+  }
+
+  /// The bed is verified before the drop uses it: a changed bit changes every drop's results. A
+  /// mismatch sends the bed back to be rebuilt and the drop to wait for it (false).
+  bool bed_verified(const Claim& c) {
+    if (c.dep_output_rel.empty() || c.dep_sha256.empty()) return true;
+    std::error_code ec;
+    const fs::path bed = paths_.abs(c.dep_output_rel);
+    const std::string found = fs::exists(bed, ec) ? queue::sha256_file(bed) : std::string("missing");
+    if (found == c.dep_sha256) return true;
+    const std::string why = fmt::format(
+        "bed checksum mismatch: '{}' of bed job {} has sha256 {}, recorded {}; the bed is rebuilt and the drop "
+        "waits for it",
+        bed.string(), c.dep_job_id, found, c.dep_sha256);
+    std::fprintf(stderr, "worker %d: job %s: %s\n", who_.pid, c.job_id.c_str(), why.c_str());
+    if (with_db_([&] { return bed_mismatch(db_, c, why); }))
+      ++rep_.failed;
+    else
+      ++rep_.fenced_out;
+    return false;
+  }
+
+  /// The threads this job gets: a bed job running alone gets the pool's.
+  int threads_for(const Claim& c) {
     try {
-      threads = with_db([&] { return threads_for_claim(db, *c, o.threads, o.pool_threads); });
-      if (threads != o.threads && o.verbose)
-        std::fprintf(stderr, "worker %d: bed job %s runs alone: %d threads\n", who.pid, c->job_id.c_str(), threads);
+      const int threads = with_db_([&] { return threads_for_claim(db_, c, o_.threads, o_.pool_threads); });
+      if (threads != o_.threads && o_.verbose)
+        std::fprintf(stderr, "worker %d: bed job %s runs alone: %d threads\n", who_.pid, c.job_id.c_str(), threads);
+      return threads;
     } catch (const db::DbError& e) {
       if (!e.busy()) throw;  // busy: run with the worker's own threads
+      return o_.threads;
     }
+  }
+
+  /// Runs the job's runner beside the heartbeat thread; errors are caught and classified.
+  Attempt run_attempt(const Claim& c) {
+    Attempt a;
+    a.threads = threads_for(c);
+    JobSignals sig;
+    std::thread beat(heartbeat_loop, std::cref(o_), std::cref(c), std::ref(sig), heartbeat_s_, std::ref(beat_db_));
+    const auto t0 = std::chrono::steady_clock::now();
     try {
-      if (runner == runners.end())
-        throw ConfigError(fmt::format("job {}: no runner for kind '{}' in this build", c->job_id, kind_name(c->kind)));
-      RunContext ctx{*c,
-                     tmp,
-                     c->dep_output_rel.empty() ? fs::path() : paths.abs(c->dep_output_rel),
-                     threads,
+      const auto runner = runners_.find(c.kind);
+      if (runner == runners_.end())
+        throw ConfigError(fmt::format("job {}: no runner for kind '{}' in this build", c.job_id, kind_name(c.kind)));
+      RunContext ctx{c,
+                     tmp_of(c),
+                     c.dep_output_rel.empty() ? fs::path() : paths_.abs(c.dep_output_rel),
+                     a.threads,
                      [&sig](const std::string& phase, double f, const std::string& detail) {
                        std::lock_guard g(sig.m);
                        sig.phase = phase;
@@ -373,120 +425,159 @@ WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) {
                        sig.detail = detail;
                      },
                      &sig.stop,
-                     o.bed_cache,
-                     paths.root / "checkpoints" / (c->job_id + ".ckpt.h5"),
-                     o.checkpoint_interval_s,
+                     o_.bed_cache,
+                     paths_.root / "checkpoints" / (c.job_id + ".ckpt.h5"),
+                     o_.checkpoint_interval_s,
                      &sig.progress_saved};
-      out = runner->second(ctx);
+      a.out = runner->second(ctx);
     } catch (const ConfigError& e) {
-      error = e.what();
-      exit_code = kExitUsage;
-      permanent = true;
+      a.error = e.what();
+      a.exit_code = kExitUsage;
+      a.permanent = true;
     } catch (const NumericalFailure& e) {
-      error = fmt::format("numerical failure at step {}, particle {}: {}", e.step(), e.particle(), e.what());
-      exit_code = kExitNumerical;
-      permanent = true;
+      a.error = fmt::format("numerical failure at step {}, particle {}: {}", e.step(), e.particle(), e.what());
+      a.exit_code = kExitNumerical;
+      a.permanent = true;
     } catch (const std::exception& e) {
-      error = e.what();
-      exit_code = kExitFailure;
+      a.error = e.what();
+      a.exit_code = kExitFailure;
     }
-    stop_beat();
-    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (sig.lease_lost.load()) {
+    {
+      std::lock_guard g(sig.m);
+      sig.finished = true;
+    }
+    sig.cv.notify_all();
+    beat.join();
+    a.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    a.lease_lost = sig.lease_lost.load();
+    a.progress_saved = sig.progress_saved.load();
+    return a;
+  }
+
+  /// Records the attempt's outcome; stop after a release (the worker was told to stop).
+  Next record(const Claim& c, Attempt a) {
+    const fs::path tmp = tmp_of(c);
+    if (a.lease_lost) {
       // Someone else holds the job now: discard everything of this attempt.
-      remove_tmp_of(paths.tmp(), prefix);
-      ++rep.fenced_out;
-      continue;
+      remove_tmp_of(paths_.tmp(), prefix_of(c));
+      ++rep_.fenced_out;
+      return Next::go_on;
     }
-    if (queue::stop_requested().load() && (!error.empty() || !fs::exists(tmp))) {
-      remove_tmp_of(paths.tmp(), prefix);
-      const std::string state = with_db([&] {
-        return release(db, *c,
-                       error.empty() ? "interrupted by SIGINT/SIGTERM; lease released"
-                                     : fmt::format("interrupted by SIGINT/SIGTERM ({}); lease released", error),
-                       o.max_releases, sig.progress_saved.load());
-      });
-      ++rep.released;
-      rep.interrupted = true;
-      if (o.verbose)
-        std::fprintf(stderr, "worker %d: job %s released (interrupted)%s\n", who.pid, c->job_id.c_str(),
-                     state == "dead"
-                         ? fmt::format("; stopped after {} releases in a row without progress", o.max_releases).c_str()
-                         : "");
-      break;
+    if (queue::stop_requested().load() && (!a.error.empty() || !fs::exists(tmp))) {
+      released(c, a);
+      return Next::stop;
     }
-    if (error.empty() && !fs::exists(tmp)) {
-      error = fmt::format("job {} finished but wrote no output at '{}'", c->job_id, tmp.string());
-      exit_code = kExitFailure;
+    if (a.error.empty() && !fs::exists(tmp)) {
+      a.error = fmt::format("job {} finished but wrote no output at '{}'", c.job_id, tmp.string());
+      a.exit_code = kExitFailure;
     }
-    if (!error.empty() && environmental(error, disk_full(paths, o.min_free_bytes, largest))) {
-      remove_tmp_of(paths.tmp(), prefix);
-      give_back_env(*c, error, disk_full(paths, o.min_free_bytes, largest));
-      continue;
-    }
-    if (!error.empty()) {
-      remove_tmp_of(paths.tmp(), prefix);
-      const std::string state = with_db([&] { return fail(db, *c, error, exit_code, permanent, o.backoff_base_s); });
-      if (state == "dead")
-        ++rep.dead;
-      else if (state == "failed")
-        ++rep.failed;
+    if (!a.error.empty()) {
+      remove_tmp_of(paths_.tmp(), prefix_of(c));
+      if (environmental(a.error, full_now()))
+        give_back_env(c, a.error);
       else
-        ++rep.fenced_out;
-      std::fprintf(stderr, "worker %d: job %s attempt %d failed (%s): %s\n", who.pid, c->job_id.c_str(), c->attempt,
-                   state.empty() ? "fenced out" : state.c_str(), error.c_str());
-      continue;
+        failed(c, a.error, a.exit_code, a.permanent);
+      return Next::go_on;
     }
-    // Output: fsync, rename to its final name, fsync the directory, checksum, record.
-    const fs::path final_path = paths.abs(c->output_rel);
     Completion done;
+    if (!store_output(c, done)) return Next::go_on;
+    done.metrics = a.out.metrics;
+    done.report = a.out.report;
+    done.report["wall_s"] = a.wall_s;
+    done.report["threads"] = a.threads;
+    completed(c, done, a.wall_s);
+    return Next::go_on;
+  }
+
+  /// The worker was told to stop: the job goes back, its release counted (a stall unless the
+  /// attempt saved progress).
+  void released(const Claim& c, const Attempt& a) {
+    remove_tmp_of(paths_.tmp(), prefix_of(c));
+    const std::string why = a.error.empty()
+                                ? "interrupted by SIGINT/SIGTERM; lease released"
+                                : fmt::format("interrupted by SIGINT/SIGTERM ({}); lease released", a.error);
+    const std::string state = with_db_([&] { return release(db_, c, why, o_.max_releases, a.progress_saved); });
+    ++rep_.released;
+    rep_.interrupted = true;
+    if (o_.verbose)
+      std::fprintf(stderr, "worker %d: job %s released (interrupted)%s\n", who_.pid, c.job_id.c_str(),
+                   state == "dead"
+                       ? fmt::format("; stopped after {} releases in a row without progress", o_.max_releases).c_str()
+                       : "");
+  }
+
+  /// An attempt that failed for its environment goes back uncounted; the worker stops claiming.
+  void give_back_env(const Claim& c, const std::string& error) {
+    const std::string full = full_now();
+    with_db_([&] { return give_back(db_, c, "environmental, not counted: " + error); });
+    ++rep_.released;
+    rep_.disk_full = full.empty() ? error : full;
+    std::fprintf(stderr, "worker %d: job %s given back, not counted: %s\n", who_.pid, c.job_id.c_str(),
+                 rep_.disk_full.c_str());
+  }
+
+  void failed(const Claim& c, const std::string& error, int exit_code, bool permanent) {
+    const std::string state = with_db_([&] { return fail(db_, c, error, exit_code, permanent, o_.backoff_base_s); });
+    ++(state == "dead" ? rep_.dead : state == "failed" ? rep_.failed : rep_.fenced_out);
+    std::fprintf(stderr, "worker %d: job %s attempt %d failed (%s): %s\n", who_.pid, c.job_id.c_str(), c.attempt,
+                 state.empty() ? "fenced out" : state.c_str(), error.c_str());
+  }
+
+  /// Output: fsync, rename to its final name, fsync the directory, checksum. false when it could
+  /// not be stored (the attempt is given back or failed here).
+  bool store_output(const Claim& c, Completion& done) {
+    const fs::path tmp = tmp_of(c), final_path = paths_.abs(c.output_rel);
     try {
       fs::create_directories(final_path.parent_path());
       fsync_path(tmp);
       fs::rename(tmp, final_path);
       fsync_path(final_path.parent_path());
-      remove_tmp_of(paths.tmp(), prefix);
-      done.output_rel = c->output_rel;
+      remove_tmp_of(paths_.tmp(), prefix_of(c));
+      done.output_rel = c.output_rel;
       done.sha256 = queue::sha256_file(final_path);
       done.bytes = static_cast<std::int64_t>(fs::file_size(final_path));
+      return true;
     } catch (const std::exception& e) {
       // The file vanished or the disk is full: this attempt fails, the worker goes on.
-      remove_tmp_of(paths.tmp(), prefix);
+      std::error_code ec;
+      remove_tmp_of(paths_.tmp(), prefix_of(c));
       fs::remove(final_path, ec);
       const std::string why =
-          fmt::format("job {}: cannot store its output at '{}': {}", c->job_id, final_path.string(), e.what());
-      if (environmental(why, disk_full(paths, o.min_free_bytes, largest))) {
-        give_back_env(*c, why, disk_full(paths, o.min_free_bytes, largest));
-        continue;
+          fmt::format("job {}: cannot store its output at '{}': {}", c.job_id, final_path.string(), e.what());
+      if (environmental(why, full_now())) {
+        give_back_env(c, why);
+        return false;
       }
-      const std::string state = with_db([&] { return fail(db, *c, why, 1, false, o.backoff_base_s); });
-      ++(state == "dead" ? rep.dead : state == "failed" ? rep.failed : rep.fenced_out);
-      std::fprintf(stderr, "worker %d: %s\n", who.pid, why.c_str());
-      continue;
-    }
-    done.metrics = out.metrics;
-    done.report = out.report;
-    done.report["wall_s"] = secs;
-    done.report["threads"] = threads;
-    bool retried = false;  // after a lost connection the completion may have gone through
-    const bool completed = with_db([&] {
-      if (retried && completed_already(db, *c)) return true;
-      retried = true;
-      return complete(db, *c, done);
-    });
-    if (completed) {
-      ++rep.done;
-      largest = std::max(largest, done.bytes);
-      if (o.verbose) std::fprintf(stderr, "worker %d: job %s done in %.2f s\n", who.pid, c->job_id.c_str(), secs);
-    } else {
-      fs::remove(final_path, ec);
-      ++rep.fenced_out;
-      std::fprintf(stderr, "worker %d: job %s finished after its lease was taken over; output discarded\n", who.pid,
-                   c->job_id.c_str());
+      const std::string state = with_db_([&] { return fail(db_, c, why, 1, false, o_.backoff_base_s); });
+      ++(state == "dead" ? rep_.dead : state == "failed" ? rep_.failed : rep_.fenced_out);
+      std::fprintf(stderr, "worker %d: %s\n", who_.pid, why.c_str());
+      return false;
     }
   }
-  if (queue::stop_requested().load()) rep.interrupted = true;
-  return rep;
-}
+
+  void completed(const Claim& c, const Completion& done, double wall_s) {
+    bool retried = false;  // after a lost connection the completion may have gone through
+    const bool ok = with_db_([&] {
+      if (retried && completed_already(db_, c)) return true;
+      retried = true;
+      return complete(db_, c, done);
+    });
+    if (ok) {
+      ++rep_.done;
+      largest_ = std::max(largest_, done.bytes);
+      if (o_.verbose) std::fprintf(stderr, "worker %d: job %s done in %.2f s\n", who_.pid, c.job_id.c_str(), wall_s);
+      return;
+    }
+    std::error_code ec;
+    fs::remove(paths_.abs(c.output_rel), ec);
+    ++rep_.fenced_out;
+    std::fprintf(stderr, "worker %d: job %s finished after its lease was taken over; output discarded\n", who_.pid,
+                 c.job_id.c_str());
+  }
+};
+
+}  // namespace
+
+WorkerReport run_worker(const WorkerOptions& o, const RunnerTable& runners) { return Worker(o, runners).run(); }
 
 }  // namespace gravsweep::queue
