@@ -265,53 +265,33 @@ void load_bed(System& sys, const results::BedData& bed) {
   add_container_walls(sys, cs, bed.wall_height_m, kWallMaterial);
 }
 
-DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& bed_in,
-                           const std::filesystem::path& trace_out, int threads, const Progress& progress,
-                           const std::atomic<bool>* stop, const DropCheckpointing& checkpointing) {
-  const json s = validate_scenario(scenario);
-  ScenarioParams p = scenario_params(s);
-  if (threads > 0) p.drop_config.threads = threads;
-  const results::BedData bed = results::read_bed(bed_in);
-  require_bed_key(bed, s, bed_in);
-  check_stop(stop, "drop");
-  const auto t0 = std::chrono::steady_clock::now();
+namespace {
 
-  // Rebuild the bed in a fresh system: bit-exact state, no contact history (as after any restart).
-  System sys(p.drop_config);
-  load_bed(sys, bed);
-  require_at_rest(sys, bed, p, bed_in);
-
-  // Grain snapshots: the grains keep the order of bed.h5, the projectile comes last.
-  std::unique_ptr<results::SnapshotWriter> snaps;
+/// The drop's grain snapshots (/output/snapshot_interval_s > 0; none otherwise): the grains keep
+/// the order of bed.h5, the projectile comes last. `snaps` receives the writer.
+DropSnapshots snapshot_hooks(const ScenarioParams& p, const results::BedData& bed,
+                             const std::filesystem::path& trace_out, std::unique_ptr<results::SnapshotWriter>& snaps) {
   DropSnapshots ds;
-  if (p.snapshot_interval_s > 0) {
-    snaps = std::make_unique<results::SnapshotWriter>(results::snapshot_path_for(trace_out), bed.radius_m,
-                                                      0.5 * p.projectile.diameter_m, p.snapshot_interval_s,
-                                                      build_version());
-    ds.interval_s = p.snapshot_interval_s;
-    ds.write = [&](const System& sy, ParticleIndex ip, double t_s) {
-      const std::vector<int> c = sy.contact_counts();
-      results::Snapshot sn;
-      sn.t_s = t_s;
-      gather_points(sy.particles, c, 0, ip, sn.grains);
-      gather_points(sy.particles, c, ip, ip + 1, sn.projectile);
-      snaps->append(sn);
-    };
-  }
-  DropCheckpointer ckpt(checkpointing, checkpointing.path.empty() ? json() : drop_identity(s, bed_in, sys.threads()),
-                        stop);
-  const auto drop = [&] {
-    return drop_projectile(
-        sys, bed.surface_height_m, p.projectile, p.stop, p.sample_rate_hz,
-        [&](double f, const std::string& d) {
-          check_stop(stop, "drop");
-          if (progress) progress("drop", f, ckpt.detail(d));
-        },
-        ds, ckpt.hooks(), p.time_step);
+  if (!(p.snapshot_interval_s > 0)) return ds;
+  snaps =
+      std::make_unique<results::SnapshotWriter>(results::snapshot_path_for(trace_out), bed.radius_m,
+                                                0.5 * p.projectile.diameter_m, p.snapshot_interval_s, build_version());
+  ds.interval_s = p.snapshot_interval_s;
+  ds.write = [w = snaps.get()](const System& sy, ParticleIndex ip, double t_s) {
+    const std::vector<int> c = sy.contact_counts();
+    results::Snapshot sn;
+    sn.t_s = t_s;
+    gather_points(sy.particles, c, 0, ip, sn.grains);
+    gather_points(sy.particles, c, ip, ip + 1, sn.projectile);
+    w->append(sn);
   };
-  const DropResult dr = resume_or_start(ckpt, drop);
-  const double wall_s = seconds_since(t0) + ckpt.prior_wall_time_s();
+  return ds;
+}
 
+/// The drop's samples as trace columns, with the facts a reader of the trace needs (scenario, bed
+/// key and file, code version).
+results::TraceData trace_of(const DropResult& dr, const ScenarioParams& p, const json& validated,
+                            const results::BedData& bed, const std::filesystem::path& bed_in) {
   results::TraceData td;
   for (const auto& smp : dr.samples) {
     td.t_s.push_back(smp.t_s);
@@ -336,32 +316,40 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   td.projectile_mass_kg = p.projectile.mass_kg;
   td.grain_diameter_m = p.bed.grains.diameter_m;
   td.stopped = dr.stopped;
-  td.scenario_json = s.dump();
-  td.bed_key_json = bed_key_of_validated(s).dump();
+  td.scenario_json = validated.dump();
+  td.bed_key_json = bed_key_of_validated(validated).dump();
   td.bed_file = std::filesystem::absolute(bed_in).string();
   td.code_version = pipeline::build_version();
+  return td;
+}
 
-  // Sect. 2.3 through the one processing entry (results::process_trial): the trial's facts from
-  // the trace (fill height = the measured surface height) and the scenario's /output settings,
-  // exactly as a campaign reading this trace back measures it.
-  json m;
+/// Sect. 2.3 through the one processing entry (results::process_trial): the trial's facts from
+/// the trace (fill height = the measured surface height) and the scenario's /output settings,
+/// exactly as a campaign reading this trace back measures it. Nulls and metrics_error when the
+/// trace cannot be measured.
+json paper_metrics(const results::TraceData& td, const std::filesystem::path& trace_out) {
   try {
     results::MeasuredTrial trial = results::dem_trial_of(td, {"", "", trace_out});
     results::process_trial(trial);
     const results::Metrics& r = trial.processed.metrics;
-    m = json{{"vc_m_s", r.vc_m_s},
-             {"apeak_m_s2", r.apeak_m_s2},
-             {"zstop_m", r.zstop_m},
-             {"tstop_s", r.tstop_s},
-             {"t_start_s", r.t_start_s},
-             {"t_end_s", r.t_end_s},
-             {"rebound", r.rebound},
-             {"note", r.note},
-             {"depth_at_end_m", r.depth_at_end_m}};
+    return json{{"vc_m_s", r.vc_m_s},
+                {"apeak_m_s2", r.apeak_m_s2},
+                {"zstop_m", r.zstop_m},
+                {"tstop_s", r.tstop_s},
+                {"t_start_s", r.t_start_s},
+                {"t_end_s", r.t_end_s},
+                {"rebound", r.rebound},
+                {"note", r.note},
+                {"depth_at_end_m", r.depth_at_end_m}};
   } catch (const std::exception& e) {
-    m = json{{"vc_m_s", nullptr},    {"apeak_m_s2", nullptr}, {"zstop_m", nullptr}, {"tstop_s", nullptr},
-             {"t_start_s", nullptr}, {"t_end_s", nullptr},    {"rebound", nullptr}, {"metrics_error", e.what()}};
+    return json{{"vc_m_s", nullptr},    {"apeak_m_s2", nullptr}, {"zstop_m", nullptr}, {"tstop_s", nullptr},
+                {"t_start_s", nullptr}, {"t_end_s", nullptr},    {"rebound", nullptr}, {"metrics_error", e.what()}};
   }
+}
+
+/// The DEM side's own figures beside the paper's metrics: depths, rest, steps, the run's setup.
+void add_dem_metrics(json& m, const results::TraceData& td, const DropResult& dr, const ScenarioParams& p,
+                     const results::BedData& bed) {
   double max_depth = -1e300;
   for (double z : td.depth_m) max_depth = std::max(max_depth, z);
   m["max_depth_m"] = max_depth;
@@ -385,6 +373,45 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   m["release_height_above_surface_m"] = dr.release_height_m - bed.surface_height_m;
   m["first_touch_height_above_surface_m"] = dr.first_touch_height_m - bed.surface_height_m;
   m["lateral_offset_m"] = std::hypot(p.projectile.lateral_offset_x_m, p.projectile.lateral_offset_y_m);
+}
+
+}  // namespace
+
+DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& bed_in,
+                           const std::filesystem::path& trace_out, int threads, const Progress& progress,
+                           const std::atomic<bool>* stop, const DropCheckpointing& checkpointing) {
+  const json s = validate_scenario(scenario);
+  ScenarioParams p = scenario_params(s);
+  if (threads > 0) p.drop_config.threads = threads;
+  const results::BedData bed = results::read_bed(bed_in);
+  require_bed_key(bed, s, bed_in);
+  check_stop(stop, "drop");
+  const auto t0 = std::chrono::steady_clock::now();
+
+  // Rebuild the bed in a fresh system: bit-exact state, no contact history (as after any restart).
+  System sys(p.drop_config);
+  load_bed(sys, bed);
+  require_at_rest(sys, bed, p, bed_in);
+
+  std::unique_ptr<results::SnapshotWriter> snaps;
+  const DropSnapshots ds = snapshot_hooks(p, bed, trace_out, snaps);
+  DropCheckpointer ckpt(checkpointing, checkpointing.path.empty() ? json() : drop_identity(s, bed_in, sys.threads()),
+                        stop);
+  const auto drop = [&] {
+    return drop_projectile(
+        sys, bed.surface_height_m, p.projectile, p.stop, p.sample_rate_hz,
+        [&](double f, const std::string& d) {
+          check_stop(stop, "drop");
+          if (progress) progress("drop", f, ckpt.detail(d));
+        },
+        ds, ckpt.hooks(), p.time_step);
+  };
+  const DropResult dr = resume_or_start(ckpt, drop);
+  const double wall_s = seconds_since(t0) + ckpt.prior_wall_time_s();
+
+  results::TraceData td = trace_of(dr, p, s, bed, bed_in);
+  json m = paper_metrics(td, trace_out);
+  add_dem_metrics(m, td, dr, p, bed);
   m["threads"] = sys.threads();
   m["wall_time_s"] = wall_s;
   ckpt.add_metrics(m);
