@@ -262,6 +262,13 @@ std::string verdict_of(const Discovery& d, const std::string& where_named, const
     for (std::size_t i = 1; i < d.added.size(); ++i) v += "; then " + d.added[i];
     if (d.structure_left) v += "; structure left " + where_named;
   }
+  if (!d.structure_left && d.generated_worsens_metrics)
+    return v + fmt::format(
+                   "; beyond the named library the best generated form, c * {}, fits the trace better held out "
+                   "({}) but predicts zstop {:.1f} -> {:.1f} % and tstop {:.1f} -> {:.1f} %: not named",
+                   d.generated_test.term, improvement_words(d.generated_test), d.errors_without_generated.zstop_rel_pct,
+                   d.errors_with_generated.zstop_rel_pct, d.errors_without_generated.tstop_rel_pct,
+                   d.errors_with_generated.tstop_rel_pct);
   if (!d.structure_left) return v;
   if (d.generated.empty() && d.generated_worsens_metrics)
     return v + fmt::format(

@@ -269,6 +269,21 @@ FittedModel fit_model(const ModelSpec& spec, const Campaign& c) {
 
 namespace {
 
+/// The RMS of a_up + g over a trial's fit window (m/s2): the scale of its resisting force per
+/// mass, to which the grain-scale fluctuations are proportional (force chains carry a share of the
+/// force, not a fixed amount). Dividing each trial's residuals by it keeps a Froude 10 drop, whose
+/// drag is 300 m g, from outweighing the quasi-static drops of every level in a fit of one law
+/// for all levels; g when the window has no finite sample.
+double trial_force_scale_m_s2(const MeasuredTrial& t) {
+  double s = 0;
+  std::size_t n = 0;
+  for (std::size_t k = t.fit_begin; k < t.fit_end; ++k) {
+    const double f = t.processed.accel_up_m_s2[k] + t.info.gravity_m_s2;
+    if (std::isfinite(f)) s += f * f, ++n;
+  }
+  return n > 0 && s > 0 ? std::sqrt(s / static_cast<double>(n)) : t.info.gravity_m_s2;
+}
+
 /// The least-squares fit of fit_model, unchecked; `not_finite` gets the trials whose rows of the
 /// problem (features or m (a_up + g)) hold a value that is not finite.
 FittedModel fit_unchecked(const ModelSpec& spec, const Campaign& c, const std::vector<bool>& mask,
@@ -300,12 +315,17 @@ FittedModel fit_unchecked(const ModelSpec& spec, const Campaign& c, const std::v
   std::vector<int> cluster(rows);
   Eigen::Index r = 0;
   std::vector<double> row(static_cast<std::size_t>(L.cols));
+  const bool one_law = one_law_for_all_levels(spec);
   for (int ti : used) {
     const MeasuredTrial& t = c.trials[static_cast<std::size_t>(ti)];
     const int gi = m.gravity_index(t.info.gravity_m_s2);
     const double n_t = static_cast<double>(t.fit_end - t.fit_begin);
-    // Trials weighted equally; gravity levels put on one scale (residuals in units of g).
-    const double wt = 1.0 / (n_t * t.info.gravity_m_s2 * t.info.gravity_m_s2);
+    // Trials weighted equally. A law for one gravity level at a time takes residuals in units of
+    // g (its trials' forces span a few m g); one law for all levels takes each trial's residuals in
+    // units of its own force (trial_force_scale_m_s2), as its trials span Froude 0.2-10 and forces
+    // from m g to 300 m g.
+    const double scale_m_s2 = one_law ? trial_force_scale_m_s2(t) : t.info.gravity_m_s2;
+    const double wt = 1.0 / (n_t * scale_m_s2 * scale_m_s2);
     for (std::size_t k = t.fit_begin; k < t.fit_end; ++k, ++r) {
       const TermContext ctx = context(t, k);
       feature_row(spec, L, gi, ctx, row.data());

@@ -50,7 +50,10 @@ struct FittedModel {
 };
 
 /// Fits the spec to the trials' fit windows (each trial weighted equally), least squares on
-/// m (a_up + g) = R(z, v). `trial_mask` (same length as campaign.trials) selects training trials.
+/// m (a_up + g) = R(z, v), residuals in units of m g; for one law for all levels
+/// (one_law_for_all_levels) in units of each trial's RMS force instead, as its trials span
+/// Froude numbers 0.2-10 and forces 1-300 m g. `trial_mask` (same length as campaign.trials)
+/// selects training trials.
 FittedModel fit_model(const ModelSpec& spec, const Campaign& c, const std::vector<bool>& trial_mask);
 FittedModel fit_model(const ModelSpec& spec, const Campaign& c);
 
@@ -61,10 +64,16 @@ struct Prediction {
   double zstop_m = NAN, tstop_s = NAN, apeak_m_s2 = NAN;
   bool stopped = false;
 };
+/// How long predict integrates before it gives up on a stop (s): kPredictHorizonScaled collision
+/// time scales sqrt(D/g) (D the projectile diameter; a drop at 0.001 m/s2 lasts 10 s and more),
+/// and at least kPredictHorizonMin_s (the lab's 1 g collisions last well under a second).
+inline constexpr double kPredictHorizonScaled = 50.0;
+inline constexpr double kPredictHorizonMin_s = 10.0;
+double prediction_horizon_s(const TermContext& trial);
 /// Integrates m dv/dt = m g - R from the trial's impact speed (RK4) to the stop; apeak is the
-/// largest deceleration of the integrated motion.
+/// largest deceleration of the integrated motion. t_max_s NaN: prediction_horizon_s.
 Prediction predict(const FittedModel& m, const Trial& info);
-Prediction predict(const FittedModel& m, const TermContext& trial, double t_max_s = 10.0);
+Prediction predict(const FittedModel& m, const TermContext& trial, double t_max_s = NAN);
 /// The metrics of a measured trial predicted the way it was measured: zstop and tstop
 /// of the integrated motion, apeak read off the model's record (model_record) processed like the
 /// trial (process_trial's options), so that the 500 Hz filter rounds both peaks alike.

@@ -69,13 +69,14 @@ RegimeTrial regimes_of(const FittedModel& law, const MeasuredTrial& t) {
     prev_excess = excess, prev_v = v, prev_z = z;
   };
   TermContext c = c0;
-  const Prediction p = integrate_motion(law, c0, 10.0, [&](double t_s, double z, double v, double dt) {
-    c.z_m = z, c.v_m_s = v, c.t_since_contact_s = t_s;
-    const ResistanceSplit s = split_resistance(law, c);
-    impulse_qs += s.quasi_static_N * dt, impulse_all += (s.quasi_static_N + s.dynamic_N) * dt;
-    work_qs += s.quasi_static_N * v * dt, work_all += (s.quasi_static_N + s.dynamic_N) * v * dt;
-    watch(z, v, s.dynamic_N - s.quasi_static_N);
-  });
+  const Prediction p =
+      integrate_motion(law, c0, prediction_horizon_s(c0), [&](double t_s, double z, double v, double dt) {
+        c.z_m = z, c.v_m_s = v, c.t_since_contact_s = t_s;
+        const ResistanceSplit s = split_resistance(law, c);
+        impulse_qs += s.quasi_static_N * dt, impulse_all += (s.quasi_static_N + s.dynamic_N) * dt;
+        work_qs += s.quasi_static_N * v * dt, work_all += (s.quasi_static_N + s.dynamic_N) * v * dt;
+        watch(z, v, s.dynamic_N - s.quasi_static_N);
+      });
   r.stopped = p.stopped;
   if (p.stopped) {
     c.z_m = p.zstop_m, c.v_m_s = 0, c.t_since_contact_s = p.tstop_s;

@@ -104,8 +104,8 @@ const std::vector<double> kInnerLevels_m_s2{1.62, 0.1};
 
 // A Froude-scaled truth (base: f0 = 1.6 m g, 1/d1 = 25 1/m at every level, i.e. R = m g F(v^2/(g D)))
 // over four levels: scaled_base fitted on three levels predicts each inner held-out level (1.62 and
-// 0.1 m/s2, inside the fitted range) within the noise bound above, in every seed (8 seeds of this
-// lab: the largest held-out zstop error is 0.85 of its bound, tstop 0.73).
+// 0.1 m/s2, inside the fitted range) within the noise bound above, in every seed (held-out zstop
+// 7.8-11.6 % at 1.62 and 5.1-5.6 % at 0.1 m/s2, at most 0.82 of the bound).
 TEST(LevelOut, AFroudeScaledTruthIsPredictedAtEachInnerHeldOutLevelWithinTheNoise) {
   for (unsigned seed = 1; seed <= kSeeds; ++seed) {
     TempDir d;
@@ -128,11 +128,15 @@ TEST(LevelOut, AFroudeScaledTruthIsPredictedAtEachInnerHeldOutLevelWithinTheNois
   }
 }
 
-// The same lab with a hidden 0.5 N cohesion, a resistance that does not follow g: the law fitted on
-// the other levels misses every inner held-out level far beyond the same noise bound, and by at
-// least three times the error of the Froude-scaled truth at that level (8 seeds: zstop 33-38 % at
-// 0.1 m/s2 and 84-87 % at 1.62, against 3-12 %).
-TEST(LevelOut, AResistanceThatDoesNotFollowGravityIsMissedAtTheHeldOutLevels) {
+// The same lab with a hidden 0.5 N cohesion, a resistance that does not follow g: at 0.1 m/s2,
+// where it is four times the projectile's weight, the law fitted on the other levels misses the
+// held-out level far beyond the same noise bound and by at least three times the error of the
+// Froude-scaled truth there (3 seeds: zstop 58-64 %, tstop 215-236 %, against 5-6 % and 7-17 %). At
+// 1.62 m/s2 it is a quarter of the weight, and the law fitted on the levels about it predicts the
+// level within the noise (zstop 8-11 %): held out, a level says less than the ranking of the
+// scaled mode, which names the cohesion (test_model.cpp, Discovery).
+TEST(LevelOut, AResistanceThatDoesNotFollowGravityIsMissedAtTheHeldOutLevelWhereItDominates) {
+  constexpr double kCohesionDominates_m_s2 = 0.1;
   for (unsigned seed = 1; seed <= kSeeds; ++seed) {
     TempDir d_scaled, d_cohesion;
     const SynthOptions o = four_levels(seed);
@@ -140,18 +144,16 @@ TEST(LevelOut, AResistanceThatDoesNotFollowGravityIsMissedAtTheHeldOutLevels) {
     const Campaign c = synth_campaign("base+cohesion", o, d_cohesion);
     const auto rows = leave_level_out(parse_model("scaled_base"), c);
     print_rows(("cohesion seed " + std::to_string(seed)).c_str(), rows);
-    for (double g : kInnerLevels_m_s2) {
-      const LevelOutRow &r = row_at(rows, g), &froude = row_at(scaled, g);
-      std::printf("  g %g: held-out zstop %.1f %% (Froude-scaled truth %.1f %%), tstop %.1f %% (%.1f %%)\n", g,
-                  r.zstop_median_abs_err_pct, froude.zstop_median_abs_err_pct, r.tstop_median_abs_err_pct,
-                  froude.tstop_median_abs_err_pct);
-      const NoiseBound b = noise_bound(r, c, "base+cohesion", o);
-      EXPECT_GT(r.zstop_median_abs_err_pct, b.zstop_pct) << "seed " << seed << " g " << g;
-      EXPECT_GT(r.tstop_median_abs_err_pct, b.tstop_pct) << "seed " << seed << " g " << g;
-      EXPECT_GT(r.zstop_median_abs_err_pct, 3 * froude.zstop_median_abs_err_pct) << "seed " << seed << " g " << g;
-      EXPECT_GT(r.tstop_median_abs_err_pct, 3 * froude.tstop_median_abs_err_pct) << "seed " << seed << " g " << g;
-      EXPECT_EQ(r.verdict.rfind("misses the targets", 0), 0u) << r.verdict;
-    }
+    const LevelOutRow &r = row_at(rows, kCohesionDominates_m_s2), &froude = row_at(scaled, kCohesionDominates_m_s2);
+    std::printf("  held-out zstop %.1f %% (Froude-scaled truth %.1f %%), tstop %.1f %% (%.1f %%)\n",
+                r.zstop_median_abs_err_pct, froude.zstop_median_abs_err_pct, r.tstop_median_abs_err_pct,
+                froude.tstop_median_abs_err_pct);
+    const NoiseBound b = noise_bound(r, c, "base+cohesion", o);
+    EXPECT_GT(r.zstop_median_abs_err_pct, b.zstop_pct) << "seed " << seed;
+    EXPECT_GT(r.tstop_median_abs_err_pct, b.tstop_pct) << "seed " << seed;
+    EXPECT_GT(r.zstop_median_abs_err_pct, 3 * froude.zstop_median_abs_err_pct) << "seed " << seed;
+    EXPECT_GT(r.tstop_median_abs_err_pct, 3 * froude.tstop_median_abs_err_pct) << "seed " << seed;
+    EXPECT_EQ(r.verdict.rfind("misses the targets", 0), 0u) << r.verdict;
   }
 }
 

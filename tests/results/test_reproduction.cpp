@@ -457,51 +457,72 @@ std::vector<std::map<std::string, std::string>> csv_rows(const std::string& args
   return rows;
 }
 
+/// The eight committed folders of the gravity sweep: five levels, 50 drops (GRAVITY.md).
 std::string sweep_levels() {
   std::string s;
-  for (const char* level : {"g9.81", "g1.62"})
+  for (const char* level : {"g9.81", "g1.62", "g0.1", "g0.1_axis", "g0.01", "g0.01_axis", "g0.001", "g0.001_axis"})
     s += " '" + (std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "data" / "gravity_sweep" / level).string() + "'";
   return s;
 }
 
 }  // namespace
 
-// Leave one level out on the two committed levels (GRAVITY.md, "One gravity-scaled law"): each is
-// predicted by scaled_base fitted on the other alone, so both are extrapolations; the numbers are
-// the ones GRAVITY.md states (within 1 point), and the law misses both levels even fitted on both
-// (its form: the slow drops stop deeper and later than phi m g + m v^2/d1 says).
-TEST(GravitySweep, LeaveOneLevelOutOnTheCommittedLevelsIsAnExtrapolationBothWays) {
+// Leave one level out on the five committed levels (GRAVITY.md, "One gravity-scaled law"): phi m g
+// + kappa g z + m v^2/d1 fitted on four levels predicts the fifth within the targets (zstop
+// 10 %, tstop 15 %) at 1.62 and 0.1 m/s2 and misses zstop at 0.01 m/s2 by 13 %, the verdict naming
+// both regimes; the numbers are the ones GRAVITY.md states (within 1 point). Without the depth
+// term (phi m g + m v^2/d1) every level is missed by more than 30 % in zstop.
+TEST(GravitySweep, OneDepthFrictionLawPredictsEachHeldOutLevelFromTheOtherFour) {
   std::string out;
-  const auto rows = csv_rows("model lolo" + sweep_levels(), out);
+  const auto rows = csv_rows("model lolo" + sweep_levels() + " --law scaled_base+gravity_depth_friction", out);
   std::printf("%s", out.c_str());
-  ASSERT_EQ(rows.size(), 2u) << out;
-  const std::map<std::string, std::pair<double, double>> stated{{"9.81", {26.8, 32.9}}, {"1.62", {30.8, 49.5}}};
+  ASSERT_EQ(rows.size(), 5u) << out;
+  const std::map<std::string, std::pair<double, double>> stated{
+      {"9.81", {6.5, 3.2}}, {"1.62", {4.6, 6.0}}, {"0.1", {6.5, 5.6}}, {"0.01", {13.0, 5.8}}, {"0.001", {12.4, 25.9}}};
   for (const auto& r : rows) {
-    SCOPED_TRACE(r.at("held_out_g_m_s2"));
-    EXPECT_EQ(r.at("range"), "outside");
-    EXPECT_EQ(r.at("verdict").rfind("extrapolation (outside the fitted ", 0), 0u) << r.at("verdict");
-    ASSERT_EQ(stated.count(r.at("held_out_g_m_s2")), 1u);
-    const auto [zstop, tstop] = stated.at(r.at("held_out_g_m_s2"));
-    EXPECT_NEAR(std::stod(r.at("zstop_median_err_pct")), zstop, 1.0);
-    EXPECT_NEAR(std::stod(r.at("tstop_median_err_pct")), tstop, 1.0);
-    EXPECT_NE(r.at("verdict").find("the form of the law misses this level"), std::string::npos) << r.at("verdict");
+    const std::string g = r.at("held_out_g_m_s2");
+    SCOPED_TRACE(g);
+    ASSERT_EQ(stated.count(g), 1u);
+    EXPECT_NEAR(std::stod(r.at("zstop_median_err_pct")), stated.at(g).first, 1.0);
+    EXPECT_NEAR(std::stod(r.at("tstop_median_err_pct")), stated.at(g).second, 1.0);
+    const bool outer = g == "9.81" || g == "0.001";
+    EXPECT_EQ(r.at("range"), outer ? "outside" : "inside");
+    if (g == "1.62" || g == "0.1") EXPECT_EQ(r.at("verdict").rfind("within the targets", 0), 0u) << r.at("verdict");
+    if (g == "0.01") {
+      EXPECT_EQ(r.at("verdict").rfind("misses the targets: zstop", 0), 0u) << r.at("verdict");
+      EXPECT_NE(r.at("verdict").find("both regimes miss"), std::string::npos) << r.at("verdict");
+    }
+  }
+  const auto plain = csv_rows("model lolo" + sweep_levels(), out);
+  ASSERT_EQ(plain.size(), 5u) << out;
+  for (const auto& r : plain) EXPECT_GT(std::stod(r.at("zstop_median_err_pct")), 30.0) << r.at("held_out_g_m_s2");
+}
+
+// The regime map of the depth-friction law fitted on all five levels: one crossover at the surface
+// for every level, Fr 0.51 (GRAVITY.md), a third of paper II's 1.5; a drop that starts above it
+// crosses it on its way down, one that starts below is quasi-static from the impact on.
+TEST(GravitySweep, TheRegimeMapOfTheFiveLevelsCrossesAtFroude051) {
+  std::string out;
+  const auto rows = csv_rows("model regimes" + sweep_levels() + " --law scaled_base+gravity_depth_friction", out);
+  std::printf("%s", out.c_str());
+  ASSERT_EQ(rows.size(), 50u) << out;
+  for (const auto& r : rows) {
+    SCOPED_TRACE(r.at("trial_id"));
+    const double crossover = std::stod(r.at("law_crossover_fr"));
+    EXPECT_NEAR(crossover, 0.511, 0.005);
+    EXPECT_EQ(r.at("paper_ii_fr"), "1.5");
+    EXPECT_EQ(r.at("crossover_fr") != "-", std::stod(r.at("impact_fr")) > crossover) << r.at("impact_fr");
   }
 }
 
-// The regime map of scaled_base fitted on both committed levels: one crossover for every level,
-// sqrt(phi d1 / D) = 0.71 (GRAVITY.md), below paper II's 1.5; the Fr 1 and 2 drops cross it, the
-// Fr 0.2 and 0.5 drops are quasi-static from the impact on.
-TEST(GravitySweep, TheRegimeMapOfTheCommittedLevelsCrossesAtFroude071) {
-  std::string out;
-  const auto rows = csv_rows("model regimes" + sweep_levels(), out);
-  std::printf("%s", out.c_str());
-  ASSERT_EQ(rows.size(), 14u) << out;
-  for (const auto& r : rows) {
-    SCOPED_TRACE(r.at("trial_id"));
-    EXPECT_NEAR(std::stod(r.at("law_crossover_fr")), 0.714, 0.005);
-    EXPECT_EQ(r.at("paper_ii_fr"), "1.5");
-    const bool inertial_start = std::stod(r.at("impact_fr")) > 0.714;
-    EXPECT_EQ(r.at("crossover_fr") != "-", inertial_start) << r.at("impact_fr");
-    if (inertial_start) EXPECT_NEAR(std::stod(r.at("crossover_fr")), 0.714, 0.005);
-  }
+// `model rank --scaled` on the five levels names the depth friction that follows g, and reports
+// the best generated form (a drag concentrated within two grain diameters of the surface) as
+// tried but not named: it fits the traces better held out but lengthens the predicted durations.
+TEST(GravitySweep, TheScaledRankOnTheFiveLevelsNamesTheDepthFrictionThatFollowsGravity) {
+  const auto r = gravsweep::testing::run_gravsweep("model rank" + sweep_levels() + " --scaled", false);
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::printf("%s", r.out.c_str());
+  EXPECT_NE(r.out.find("Verdict: missing effect: gravity_depth_friction ("), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("the best generated form, c * v^2*exp(-z/0.02):shared"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(": not named"), std::string::npos) << r.out;
 }
