@@ -421,3 +421,25 @@ TEST(Discovery, TheScaledModeNamesAResistanceThatDoesNotFollowGravityThePerLevel
   };
   EXPECT_GT(gain(scaled), 3 * gain(scaled_truth)) << scaled.verdict << " / " << scaled_truth.verdict;
 }
+
+// Eq. 1 with R = phi m g + m v^2/d1 integrates to the closed forms tstop = T atan(vc / (g' T)) and
+// zstop = d1/2 ln(1 + vc^2 / (g' d1)), g' = (phi - 1) g, T = sqrt(d1 / g'). At 0.001 m/s2 the stop
+// comes 11.5 s after contact: the prediction must integrate past the 10 s that suffice at 1 g.
+TEST(Predict, ADropAtOneThousandthOfAMetrePerSecondSquaredComesToRestAtTheClosedForm) {
+  constexpr double kPhi = 1.6, kInvD1_1_m = 25.0, kG_m_s2 = 0.001, kVc_m_s = 0.03;
+  FittedModel m;
+  m.spec = parse_model("scaled_base");
+  m.gravity_levels = {kG_m_s2};
+  m.coef = Eigen::Vector2d(kPhi, kInvD1_1_m);
+  TermContext c;
+  c.g_m_s2 = kG_m_s2;
+  c.vc_m_s = c.v_m_s = kVc_m_s;
+  const Prediction p = predict(m, c);
+  const double g_net = (kPhi - 1) * kG_m_s2, d1 = 1 / kInvD1_1_m, T = std::sqrt(d1 / g_net);
+  const double tstop_s = T * std::atan(kVc_m_s / (g_net * T));
+  const double zstop_m = 0.5 * d1 * std::log(1 + kVc_m_s * kVc_m_s / (g_net * d1));
+  ASSERT_TRUE(p.stopped);
+  EXPECT_GT(tstop_s, 10.0);
+  EXPECT_NEAR(p.tstop_s, tstop_s, 1e-4 * tstop_s);
+  EXPECT_NEAR(p.zstop_m, zstop_m, 1e-4 * zstop_m);
+}
