@@ -211,9 +211,11 @@ std::vector<Candidate> rank_candidates(const ModelSpec& current, const Campaign&
                                                                       : ":shared");
     double sum = 0;
     std::vector<double> rel_all;
+    cd.trial_rel_gain.assign(c.trials.size(), NAN);
     for (std::size_t i = 0; i < c.trials.size(); ++i) {
       if (!std::isfinite(h0.trace_mse[i]) || !std::isfinite(h1.trace_mse[i]) || h0.trace_mse[i] <= 0) continue;
       const double rel = (h0.trace_mse[i] - h1.trace_mse[i]) / h0.trace_mse[i];
+      cd.trial_rel_gain[i] = rel;
       rel_all.push_back(rel);
       sum += rel;
       ++cd.trials;
@@ -230,6 +232,30 @@ std::vector<Candidate> rank_candidates(const ModelSpec& current, const Campaign&
     return a.mean_rel_improvement > b.mean_rel_improvement;
   });
   return cands;
+}
+
+/// The other significant candidates of a ranked round that the held-out trials cannot tell apart
+/// from its winner (the first): per trial, how much less each gains than the winner.
+std::vector<std::string> equivalent_to_winner(const std::vector<Candidate>& ranked) {
+  std::vector<std::string> out;
+  for (std::size_t j = 1; j < ranked.size() && ranked[j].significant; ++j) {
+    std::vector<double> worse;
+    for (std::size_t i = 0; i < ranked[0].trial_rel_gain.size() && i < ranked[j].trial_rel_gain.size(); ++i)
+      if (std::isfinite(ranked[0].trial_rel_gain[i]) && std::isfinite(ranked[j].trial_rel_gain[i]))
+        worse.push_back(ranked[0].trial_rel_gain[i] - ranked[j].trial_rel_gain[i]);
+    if (cannot_tell_apart(worse)) out.push_back(ranked[j].term);
+  }
+  return out;
+}
+
+/// ", or equally well a and b (...)" when the trials cannot tell other terms from a winner.
+std::string equivalent_words(const std::vector<std::string>& names) {
+  if (names.empty()) return "";
+  std::string list;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    list += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + names[i];
+  return fmt::format(", or equally well {} (the held-out trials cannot tell {} apart: signed-rank p >= {})", list,
+                     names.size() == 1 ? "the two" : "them", kEquivalentLevel);
 }
 
 std::string improvement_words(const Candidate& cd) {
@@ -256,10 +282,10 @@ std::string verdict_of(const Discovery& d, const std::string& where_named, const
   } else {
     const auto& first = d.rounds.front().front();
     const TermInfo& w = find_term(first.term.substr(0, first.term.find(':')));
-    v = fmt::format("{} {} ({}); {}; references: {}",
+    v = fmt::format("{} {} ({}){}; {}; references: {}",
                     d.structure_left ? "partly explained by" : "missing effect:", w.name, w.meaning,
-                    improvement_words(first), w.references);
-    for (std::size_t i = 1; i < d.added.size(); ++i) v += "; then " + d.added[i];
+                    equivalent_words(d.equivalent.front()), improvement_words(first), w.references);
+    for (std::size_t i = 1; i < d.added.size(); ++i) v += "; then " + d.added[i] + equivalent_words(d.equivalent[i]);
     if (d.structure_left) v += "; structure left " + where_named;
   }
   if (!d.structure_left && d.generated_worsens_metrics)
@@ -325,6 +351,7 @@ Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds, doub
     const TermInfo& win = find_term(cands.front().term);
     current.terms.push_back({&win, win.per_gravity, 1.0});
     d.added.push_back(win.name);
+    d.equivalent.push_back(equivalent_to_winner(cands));
   }
   const FittedModel named_fit = fit_model(current, c);
   d.residual_after = residual_axes(named_fit, c);

@@ -199,6 +199,10 @@ double binom_tail_half(int k, int n) {
 /// One-sided Wilcoxon signed-rank test that the per-trial improvements d_i are centred above 0:
 /// one value per trial, so n is the number of trials (never samples). Normal approximation with
 /// continuity correction (n >= 10 here); ties get average ranks.
+bool cannot_tell_apart(const std::vector<double>& other_worse) {
+  return signed_rank_p(other_worse) >= kEquivalentLevel;
+}
+
 double signed_rank_p(const std::vector<double>& d) {
   std::vector<std::pair<double, bool>> a;
   for (double x : d)

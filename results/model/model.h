@@ -165,6 +165,7 @@ struct Candidate {
   int trials_better = 0, trials = 0;
   double p_value = 1;  ///< one-sided Wilcoxon signed-rank test over trials (not samples)
   bool significant = false;
+  std::vector<double> trial_rel_gain;  ///< (mse0 - mse1) / mse0 per trial of the campaign, NaN where not finite
 };
 struct Discovery {
   std::string baseline;
@@ -173,8 +174,11 @@ struct Discovery {
   bool gravity_scaled = false;
   std::vector<std::vector<Candidate>> rounds;  ///< ranking of the named terms per forward step
   std::vector<std::string> added;              ///< named winners, in order
-  std::string verdict;                         ///< the sentence for users
-  bool structure_left = false;                 ///< residuals structured after the named additions
+  /// Per named winner, the other significant terms of its round that the held-out trials cannot
+  /// tell apart from it (detail::cannot_tell_apart): the verdict names them beside it.
+  std::vector<std::vector<std::string>> equivalent;
+  std::string verdict;          ///< the sentence for users
+  bool structure_left = false;  ///< residuals structured after the named additions
   /// A trend too weak for the binned tests (eta^2) but the same in almost every trial (sign test
   /// over trials p < kConsistentTrendP), described ("along depth_m: 41 of 42 trials ..."); empty
   /// when there is none. It also starts the search beyond the named library.

@@ -22,6 +22,11 @@ Prediction integrate_motion(const FittedModel& m, const TermContext& c0, double 
 double binom_tail_half(int k, int n);
 /// One-sided Wilcoxon signed-rank p-value that the per-trial values are centred above 0.
 double signed_rank_p(const std::vector<double>& d);
+/// Two explanations the trials cannot tell apart: given per trial how much worse the second fits
+/// than the best (a difference of relative held-out errors), the one-sided signed-rank test that
+/// it is worse stays at or above kEquivalentLevel.
+inline constexpr double kEquivalentLevel = 0.05;
+bool cannot_tell_apart(const std::vector<double>& other_worse);
 /// Fold of each trial, stratified by gravity level (same_gravity_level).
 std::vector<int> fold_of(const Campaign& c, int folds, unsigned seed);
 

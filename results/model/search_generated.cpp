@@ -62,11 +62,9 @@ Screening screen(const ModelSpec& current, const Campaign& c, const std::vector<
   return out;
 }
 
-/// The forms the trials cannot tell apart from the best one: a one-sided signed-rank test over
-/// trials that a form fits worse than the best (per-trial MSE difference relative to `current`'s)
-/// does not reach kEquivalentLevel. Each has one parameter per level, so in-sample fits compare
-/// them fairly.
-constexpr double kEquivalentLevel = 0.05;
+/// The forms the trials cannot tell apart from the best one (cannot_tell_apart, on the per-trial MSE
+/// difference relative to `current`'s). Each has one parameter per level, so in-sample fits
+/// compare them fairly.
 std::vector<std::string> equivalent_forms(const std::vector<Screened>& ranked, const std::vector<double>& before) {
   std::vector<std::string> out;
   for (std::size_t j = 1; j < ranked.size(); ++j) {
@@ -75,7 +73,7 @@ std::vector<std::string> equivalent_forms(const std::vector<Screened>& ranked, c
       if (std::isfinite(before[i]) && before[i] > 0 && std::isfinite(ranked[j].mse[i]) &&
           std::isfinite(ranked[0].mse[i]))
         worse.push_back((ranked[j].mse[i] - ranked[0].mse[i]) / before[i]);
-    if (signed_rank_p(worse) >= kEquivalentLevel) out.push_back(ranked[j].term->name);
+    if (cannot_tell_apart(worse)) out.push_back(ranked[j].term->name);
   }
   return out;
 }

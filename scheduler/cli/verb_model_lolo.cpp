@@ -141,7 +141,8 @@ void setup_model_lolo(CLI::App& model) {
       "than twice the fitted law's own uncertainty (*_law_sd_*: the standard deviation of a prediction\n"
       "propagated from the covariance of the law's constants, median over the drops; the fit's noise),\n"
       "or by more (its gravity scaling misses); outside the range it is an extrapolation. A law with a\n"
-      "parameter per level (base) is refused: a held-out level has none.\n\n"
+      "parameter per level (base) is refused: a held-out level has none. The fit takes each trial's\n"
+      "residuals in units of its own RMS force, so that the Froude 10 drops do not outweigh the rest.\n\n"
       "Examples:\n"
       "  gravsweep model lolo data/gravity_sweep/g9.81 data/gravity_sweep/g1.62\n"
       "  gravsweep model lolo runs/gravity_sweep/sweep.db --law scaled_base+cohesion --format csv");

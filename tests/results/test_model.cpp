@@ -184,6 +184,16 @@ TEST(Discovery, DevCampaignBaselineFailsWithDepthAndDepthFrictionWins) {
   EXPECT_TRUE(is_depth_friction(d.added.front()));
   EXPECT_NE(d.verdict.find("missing effect"), std::string::npos) << d.verdict;
   EXPECT_EQ(d.verdict.find("structure left"), std::string::npos) << d.verdict;
+  // At one gravity level a depth friction k z and its gravity-scaled form kappa g z are one law: the
+  // held-out trials cannot tell them apart, and the verdict names both. bottom_stiffening is
+  // significant too, but fits worse in most trials: it is not named.
+  ASSERT_EQ(d.equivalent.size(), d.added.size());
+  const std::string other = d.added.front() == "depth_friction" ? "gravity_depth_friction" : "depth_friction";
+  EXPECT_NE(std::find(d.equivalent.front().begin(), d.equivalent.front().end(), other), d.equivalent.front().end());
+  EXPECT_NE(d.verdict.find(", or equally well " + other + " (the held-out trials cannot tell the two apart"),
+            std::string::npos)
+      << d.verdict;
+  EXPECT_EQ(d.verdict.find("bottom_stiffening"), std::string::npos) << d.verdict;
 }
 
 TEST(Discovery, AddingDepthFrictionCutsHeldOutZstopAndTstopErrors) {
