@@ -248,6 +248,25 @@ std::vector<std::string> equivalent_to_winner(const std::vector<Candidate>& rank
   return out;
 }
 
+/// The best generated form added to `current` (where the round's named winner was added), as
+/// "c * <form>", when it is significant held out and the trials cannot tell it from the winner
+/// (neither fits significantly better: a form that fits better is left to the search beyond the
+/// named library, which reports it as structure left);
+/// empty otherwise. Its form is chosen in sample, which favours it: an equal verdict is an upper
+/// bound on what the trials can tell apart, never a reason to drop the named term.
+std::string generated_equivalent_to(const Candidate& winner, const ModelSpec& current, const Campaign& c,
+                                    bool gravity_scaled, int folds, double alpha, double min_improvement) {
+  const TermInfo* form = detail::best_generated_form(current, c, !gravity_scaled);
+  if (!form) return "";
+  const auto ranked = rank_candidates(current, c, {{form, !gravity_scaled, 1.0}}, folds, alpha, min_improvement);
+  if (ranked.empty() || !ranked.front().significant) return "";
+  std::vector<double> worse;
+  for (std::size_t i = 0; i < winner.trial_rel_gain.size() && i < ranked.front().trial_rel_gain.size(); ++i)
+    if (std::isfinite(winner.trial_rel_gain[i]) && std::isfinite(ranked.front().trial_rel_gain[i]))
+      worse.push_back(winner.trial_rel_gain[i] - ranked.front().trial_rel_gain[i]);
+  return cannot_tell_apart(worse) ? "c * " + form->name : "";
+}
+
 /// ", or equally well a and b (...)" when the trials cannot tell other terms from a winner.
 std::string equivalent_words(const std::vector<std::string>& names) {
   if (names.empty()) return "";
@@ -348,10 +367,15 @@ Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds, doub
     const auto cands = rank_candidates(current, c, named, folds, alpha, min_improvement);
     d.rounds.push_back(cands);
     if (cands.empty() || !cands.front().significant) break;
+    d.equivalent.push_back(equivalent_to_winner(cands));
+    if (search_generated) {
+      const std::string form =
+          generated_equivalent_to(cands.front(), current, c, d.gravity_scaled, folds, alpha, min_improvement);
+      if (!form.empty()) d.equivalent.back().push_back(form);
+    }
     const TermInfo& win = find_term(cands.front().term);
     current.terms.push_back({&win, win.per_gravity, 1.0});
     d.added.push_back(win.name);
-    d.equivalent.push_back(equivalent_to_winner(cands));
   }
   const FittedModel named_fit = fit_model(current, c);
   d.residual_after = residual_axes(named_fit, c);

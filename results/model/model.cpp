@@ -200,7 +200,9 @@ double binom_tail_half(int k, int n) {
 /// one value per trial, so n is the number of trials (never samples). Normal approximation with
 /// continuity correction (n >= 10 here); ties get average ranks.
 bool cannot_tell_apart(const std::vector<double>& other_worse) {
-  return signed_rank_p(other_worse) >= kEquivalentLevel;
+  std::vector<double> other_better(other_worse.size());
+  std::transform(other_worse.begin(), other_worse.end(), other_better.begin(), [](double x) { return -x; });
+  return signed_rank_p(other_worse) >= kEquivalentLevel && signed_rank_p(other_better) >= kEquivalentLevel;
 }
 
 double signed_rank_p(const std::vector<double>& d) {

@@ -175,7 +175,9 @@ struct Discovery {
   std::vector<std::vector<Candidate>> rounds;  ///< ranking of the named terms per forward step
   std::vector<std::string> added;              ///< named winners, in order
   /// Per named winner, the other significant terms of its round that the held-out trials cannot
-  /// tell apart from it (detail::cannot_tell_apart): the verdict names them beside it.
+  /// tell apart from it (detail::cannot_tell_apart): the verdict names them beside it. The best
+  /// form of the generated family added to the same model is judged the same way and, when the
+  /// trials cannot tell it from the winner, listed as "c * <form>".
   std::vector<std::vector<std::string>> equivalent;
   std::string verdict;          ///< the sentence for users
   bool structure_left = false;  ///< residuals structured after the named additions

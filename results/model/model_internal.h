@@ -23,8 +23,8 @@ double binom_tail_half(int k, int n);
 /// One-sided Wilcoxon signed-rank p-value that the per-trial values are centred above 0.
 double signed_rank_p(const std::vector<double>& d);
 /// Two explanations the trials cannot tell apart: given per trial how much worse the second fits
-/// than the best (a difference of relative held-out errors), the one-sided signed-rank test that
-/// it is worse stays at or above kEquivalentLevel.
+/// than the first (a difference of relative held-out errors), neither one-sided signed-rank test
+/// (that it is worse, that it is better) falls below kEquivalentLevel.
 inline constexpr double kEquivalentLevel = 0.05;
 bool cannot_tell_apart(const std::vector<double>& other_worse);
 /// Fold of each trial, stratified by gravity level (same_gravity_level).
@@ -41,6 +41,10 @@ struct GeneratedSearch {
   std::vector<Candidate> screened;
   std::vector<std::string> equivalent;  ///< forms the trials cannot tell apart from the chosen one
 };
+/// The form of the generated family that, added to `current` (one parameter per gravity level, or
+/// one for all levels when per_gravity is false), fits all trials best in sample; nullptr when
+/// none improves on `current`. Chosen in sample, so a held-out test of it alone is optimistic.
+const TermInfo* best_generated_form(const ModelSpec& current, const Campaign& c, bool per_gravity);
 GeneratedSearch search_generated(const ModelSpec& current, const Campaign& c, int folds, double alpha,
                                  double min_improvement);
 

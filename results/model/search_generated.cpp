@@ -46,14 +46,14 @@ struct Screening {
   std::vector<double> current_mse;  ///< per-trial in-sample trace MSE of `current`
   std::vector<Screened> ranked;
 };
-Screening screen(const ModelSpec& current, const Campaign& c, const std::vector<bool>& mask) {
+Screening screen(const ModelSpec& current, const Campaign& c, const std::vector<bool>& mask, bool per_gravity = true) {
   Screening out{fit_model(current, c, mask), {}, {}};
   out.current_mse = trial_mses(out.current, c, mask);
   for (const auto& name : generated_family()) {
     if (current.has(name)) continue;
     ModelSpec s = current;
     const TermInfo* t = generated_term(name);
-    s.terms.push_back({t, true, 1.0});
+    s.terms.push_back({t, per_gravity, 1.0});
     auto mse = trial_mses(fit_model(s, c, mask), c, mask);
     out.ranked.push_back({t, mean_relative_gain(out.current_mse, mse), std::move(mse)});
   }
@@ -79,6 +79,11 @@ std::vector<std::string> equivalent_forms(const std::vector<Screened>& ranked, c
 }
 
 }  // namespace
+
+const TermInfo* best_generated_form(const ModelSpec& current, const Campaign& c, bool per_gravity) {
+  const Screening s = screen(current, c, std::vector<bool>(c.trials.size(), true), per_gravity);
+  return s.ranked.empty() || !(s.ranked.front().gain > 0) ? nullptr : s.ranked.front().term;
+}
 
 GeneratedSearch search_generated(const ModelSpec& current, const Campaign& c, int folds, double alpha,
                                  double min_improvement) {
