@@ -4,11 +4,13 @@
 // `gravsweep model rank DIR` then works on the folder without rerunning anything, and it is
 // small enough to keep in git (the reproduction dataset, REPRODUCTION.md).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <optional>
 #include <nlohmann/json.hpp>
@@ -24,6 +26,7 @@
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
+#include "scheduler/pipeline/build_version.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/filter.h"
 #include "scheduler/queue/queue.h"
@@ -42,7 +45,33 @@ struct ExportOptions {
   std::vector<std::string> where;
   std::string sweep;
   double rate_hz = 2000;
+  bool allow_dirty = false;
 };
+
+/// A build from a source tree with uncommitted changes (`git describe --dirty`, build_version.h).
+bool is_dirty_build(const std::string& code_version) {
+  static const std::string kDirty = "-dirty";
+  return code_version.size() >= kDirty.size() &&
+         code_version.compare(code_version.size() - kDirty.size(), kDirty.size(), kDirty) == 0;
+}
+
+/// Drops per code version, refusing (UsageError) a dataset with drops from a dirty build unless
+/// --allow-dirty: a dataset must name the commits that made it.
+std::map<std::string, int> check_provenance(const std::vector<std::string>& versions, const ExportOptions& o) {
+  std::map<std::string, int> count;
+  for (const auto& v : versions) ++count[v];
+  std::vector<std::string> dirty;
+  int n_dirty = 0;
+  for (const auto& [v, n] : count)
+    if (is_dirty_build(v)) dirty.push_back(fmt::format("{} ({} drops)", v, n)), n_dirty += n;
+  if (!dirty.empty() && !o.allow_dirty)
+    throw UsageError(fmt::format(
+        "{}: {} of {} drops come from builds with uncommitted changes: {}. A dataset must name the commit that "
+        "made it: run them again with a build of a clean commit, or give --allow-dirty (recorded in "
+        "{}/provenance.json)",
+        o.db, n_dirty, versions.size(), fmt::join(dirty, ", "), o.out));
+  return count;
+}
 
 /// Columns of trials.csv after the trial record's own (results::trial_fields()): the DEM
 /// provenance that the record does not carry.
@@ -140,13 +169,20 @@ void run_export(const ExportOptions& o) {
     return static_cast<std::size_t>(it - t.columns.begin());
   };
   const std::size_t c_job = col("job_id"), c_sweep = col("sweep"), c_kind = col("kind"), c_trace = col("trace_path"),
-                    c_bed = col("bed_job_id");
+                    c_bed = col("bed_job_id"), c_version = col("code_version");
+  const auto exported = [&](const std::vector<json>& r) {
+    return r[c_kind].is_string() && r[c_kind].get<std::string>() == "drop" && r[c_trace].is_string();
+  };
+  std::vector<std::string> versions;
+  for (const auto& r : t.rows)
+    if (exported(r)) versions.push_back(r[c_version].is_string() ? r[c_version].get<std::string>() : "unknown");
+  const auto by_version = check_provenance(versions, o);
   const fs::path out(o.out);
   fs::create_directories(out / "traces");
   fs::create_directories(out / "scenarios");
   results::Table trials(trials_header()), results_csv(t.columns);
   for (const auto& r : t.rows) {
-    if (!r[c_kind].is_string() || r[c_kind].get<std::string>() != "drop" || !r[c_trace].is_string()) continue;
+    if (!exported(r)) continue;
     const std::string job = r[c_job].get<std::string>();
     const fs::path trace_path = paths.abs(r[c_trace].get<std::string>());
     const results::TraceData td = results::read_trace(trace_path);
@@ -158,6 +194,13 @@ void run_export(const ExportOptions& o) {
     for (const auto& v : r) cells.push_back(v.is_null() ? "" : v.is_string() ? v.get<std::string>() : v.dump());
     results_csv.add(std::move(cells));
   }
+  write_text_file(out / "provenance.json", json{{"exported_by", pipeline::build_version()},
+                                                {"drops_by_code_version", by_version},
+                                                {"allow_dirty", o.allow_dirty},
+                                                {"sweep", o.sweep},
+                                                {"where", o.where}}
+                                                   .dump(2) +
+                                               "\n");
   // CSV files are written last, each under a temporary name: an interrupted export leaves no
   // trials.csv that points at missing traces.
   for (const auto& [name, table] : {std::pair{"results.csv", &results_csv}, std::pair{"trials.csv", &trials}}) {
@@ -180,7 +223,9 @@ void setup_export(CLI::App& app) {
       "(t_s, accel_m_s2, position_m, velocity_m_s at --rate-hz after a 4th-order anti-alias low-pass\n"
       "at 0.4 x the new rate), OUT/scenarios/<job>.json (the scenario of each drop) and OUT/results.csv\n"
       "(the campaign's results table, metrics from the full-rate traces). The folder is what `gravsweep\n"
-      "measurements import` and `gravsweep model ...` read.\n\n"
+      "measurements import` and `gravsweep model ...` read. OUT/provenance.json gives the code version of\n"
+      "every drop; drops from a build with uncommitted changes (a code version ending in -dirty) are\n"
+      "refused (exit 2) unless --allow-dirty, which provenance.json records.\n\n"
       "Example:\n"
       "  gravsweep export --db paper.db --out data/reproduction --sweep part1_chrono_1g");
   add_campaign_options(sub, o->db, &o->files);
@@ -188,6 +233,8 @@ void setup_export(CLI::App& app) {
   sub->add_option("--where", o->where, "filter, e.g. 'gravity_m_s2<1' (repeatable)");
   sub->add_option("--sweep", o->sweep, "only this sweep");
   sub->add_option("--rate-hz", o->rate_hz, "sample rate of the exported traces")->capture_default_str();
+  sub->add_flag("--allow-dirty", o->allow_dirty,
+                "export drops from builds with uncommitted changes too (recorded in provenance.json)");
   sub->callback([o]() { run_export(*o); });
 }
 

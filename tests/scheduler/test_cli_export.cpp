@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "db/database.h"
 #include "scheduler/pipeline/impact_runners.h"
 #include "scheduler_test_helpers.h"
 
@@ -26,6 +27,13 @@ std::vector<std::string> lines_of(const std::filesystem::path& p) {
   return out;
 }
 
+std::string read_text(const std::filesystem::path& p) {
+  std::ifstream f(p);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
 }  // namespace
 
 TEST(CliExport, FinishedDropsBecomeAMeasurementCampaign) {
@@ -38,8 +46,14 @@ TEST(CliExport, FinishedDropsBecomeAMeasurementCampaign) {
   ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
   auto r = run_cli({"work", "--db", "c.db", "--workers", "2", "--threads", "1", "--quiet"}, d.path);
   ASSERT_EQ(r.code, 0) << r.err;
+  {  // the drops as a clean commit's build made them (this test's own build may be dirty)
+    db::Database db((d.path / "c.db").string());
+    db.exec("UPDATE results SET code_version='0.1.0+0123456789ab'");
+  }
   r = run_cli({"export", "--db", "c.db", "--out", "ds", "--rate-hz", "2000"}, d.path);
   ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(json::parse(read_text(d.path / "ds" / "provenance.json"))["drops_by_code_version"],
+            (json{{"0.1.0+0123456789ab", 2}}));
   EXPECT_NE(r.out.find("2 drops exported"), std::string::npos) << r.out;
   const auto trials = lines_of(d.path / "ds" / "trials.csv");
   ASSERT_EQ(trials.size(), 3u);
@@ -60,6 +74,23 @@ TEST(CliExport, FinishedDropsBecomeAMeasurementCampaign) {
   // The folder is a measurement campaign that the import reads.
   r = run_cli({"measurements", "import", "ds", "--db", "ds.db"}, d.path);
   EXPECT_EQ(r.code, 0) << r.err << r.out;
+  // A drop from a build with uncommitted changes: refused, naming it, and nothing is written;
+  // exported with --allow-dirty, which provenance.json records.
+  {
+    db::Database db((d.path / "c.db").string());
+    db.exec(
+        "UPDATE results SET code_version='0.1.0+0123456789ab-dirty' WHERE rowid=(SELECT MIN(rowid) FROM results "
+        "WHERE kind='drop')");
+  }
+  r = run_cli({"export", "--db", "c.db", "--out", "dirty"}, d.path);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("1 of 2 drops come from builds with uncommitted changes: 0.1.0+0123456789ab-dirty (1 drops)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(d.path / "dirty"));
+  r = run_cli({"export", "--db", "c.db", "--out", "dirty", "--allow-dirty"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(json::parse(read_text(d.path / "dirty" / "provenance.json"))["allow_dirty"], true);
   // Bad input: exit 2, naming what is wrong.
   r = run_cli({"export", "--db", "nope.db", "--out", "x"}, d.path);
   EXPECT_EQ(r.code, 2);
