@@ -35,8 +35,9 @@ std::size_t remove_spilled_grains(System& sys, ParticleIndex& projectile) {
       const double along_m = rel.dot(axis);
       const Vec3 radial = rel - along_m * axis;
       const double r = p.radius_m[i];
-      // Wholly above the rim, beyond the wall's radius less its own, moving outward.
-      if (along_m - r <= top_m || radial.norm() <= w.radius_m - r || p.velocity_m_s[i].dot(radial) <= 0) continue;
+      // Centred above the rim (the wall acts only on centres within its height, geometry/walls.h),
+      // beyond the wall's radius less its own, moving outward: nothing keeps it in the container.
+      if (along_m <= top_m || radial.norm() <= w.radius_m - r || p.velocity_m_s[i].dot(radial) <= 0) continue;
       if (spilled.empty()) spilled.assign(p.size(), false);
       if (spilled[i]) continue;
       spilled[i] = true;

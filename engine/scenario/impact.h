@@ -70,8 +70,9 @@ struct DropResult {
   std::size_t grains_spilled = 0;
 };
 
-/// Removes the grains that went over the rim of a container wall (a cylinder of finite height):
-/// wholly above its top, centred beyond its radius less their own, moving outward. Nothing brings
+/// Removes the grains that go over the rim of a container wall (a cylinder of finite height):
+/// centred above its top (where the wall no longer acts on them) and beyond its radius less their
+/// own, moving outward. Nothing brings
 /// them back (the paper's Chrono runs have no domain: such grains fly on), so they are taken out
 /// rather than ending a low-gravity drop with "left the container" when they cross the domain's
 /// side. Contact histories of the other particles are kept; `projectile` follows the renumbering.
