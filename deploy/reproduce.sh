@@ -5,7 +5,8 @@
 #                                (hours on 2 cores; kill it any time, run it again to resume)
 #   deploy/reproduce.sh status   progress with ETA
 #   deploy/reproduce.sh export   the finished drops -> data/reproduction/ (measurement format)
-#   deploy/reproduce.sh figures  Figs. 3, 6, 9, 10 and Table 3 from the campaign and the dataset
+#   deploy/reproduce.sh figures  Figs. 3, 6, 9, 10 and Table 3 from the committed data
+#                                (docs/reproduction/figures.txt)
 #
 # Environment: GRAVSWEEP_CAMPAIGN (default runs/reproduction/paper.db), GRAVSWEEP_BIN (default
 # build/scheduler/gravsweep), WORKERS (2), THREADS (1).
@@ -62,22 +63,21 @@ case "${1:-}" in
     du -sh "$data"
     ;;
   figures)
-    mkdir -p "$figs"
-    plot() { "$gs" plot results --db "$db" "$@" || true; }
-    plot --sweep part3_fill_height --x fill_height_m --y zstop_m \
-      --title "Fig. 3: 1 m/s at 1 g, Chrono set" --out "$figs/fig3_zstop_vs_fill.png"
-    plot --sweep part4_rolling_friction --x mu_rolling --y zstop_m \
-      --title "Fig. 6: 1 m/s at 1 g, mu_t = 0" --out "$figs/fig6_zstop_vs_mur.png"
-    for y in apeak_m_s2 zstop_m tstop_s; do
-      plot --where 'sweep~_chrono_' --x vc_m_s --y "$y" --group gravity_m_s2 \
-        --title "Chrono set, 10 cm (1 g) and 21 cm (0.1 m/s2) fills" --out "$figs/fig9_${y}_vs_vc.png"
+    # Every line of docs/reproduction/figures.txt, from the committed data (paths from the root),
+    # then the report's Figs. 9 and 10 (Eq. 2-4 lines and alpha fits) of both Chrono levels.
+    cd "$root"
+    grep -v '^#' docs/reproduction/figures.txt | while IFS= read -r line; do
+      [ -n "$line" ] || continue
+      file="${line%%: *}"; args="${line#*: }"
+      case "$file" in
+        *.png) eval "\"$gs\" $args --out 'docs/reproduction/$file' --data 'docs/reproduction/${file%.png}.csv'" ;;
+        *) eval "\"$gs\" $args" > "docs/reproduction/$file" 2>&1 ;;
+      esac
     done
-    for d in "$data"/*/; do "$gs" model table3 "$d"; done | tee "$figs/table3.txt"
-    "$gs" model rank "$db" --where 'sweep~_chrono_' | tee "$figs/model_rank_chrono.txt"
-    # Figs. 9 and 10 with both gravity levels (Table 3's Eq. 2-4 lines and alpha fits, the models' curves).
-    reports=("$data/chrono_1g"); [ -f "$data/chrono_0.1g/trials.csv" ] && reports+=("$data/chrono_0.1g")
-    "$gs" report "${reports[@]}" --out "$figs/report"
+    rm -rf "$figs/report"
+    "$gs" report data/reproduction/chrono_1g_sites data/reproduction/chrono_0.1g --out "$figs/report" >/dev/null
     cp "$figs/report/fig9_metrics_vs_vc.png" "$figs/report/fig10_zstop_vs_H.png" "$figs/"
+    rm -rf "$figs/report"
     ;;
   *)
     sed -n '2,12p' "${BASH_SOURCE[0]}"
