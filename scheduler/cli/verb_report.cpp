@@ -153,7 +153,8 @@ void setup_report(CLI::App& app) {
       "Examples:\n"
       "  gravsweep report ../shared/data/measurements/depth-friction-dev --out report-dev\n"
       "  gravsweep report campaign.db --out report-sweep    # the drops of `submit` + `work`\n"
-      "  gravsweep report data/reproduction/chrono_1g_sites data/reproduction/chrono_0.1g --out r  # both gravity levels");
+      "  gravsweep report data/reproduction/chrono_1g_sites data/reproduction/chrono_0.1g --out r  # both gravity "
+      "levels");
   sub->add_option("dir", o->dirs,
                   "campaign database from `submit`/`work` (an SQLite file, or postgresql://user@host:port/dbname "
                   "with --files; every finished drop is a trial), SQLite file from "
