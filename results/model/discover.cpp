@@ -113,17 +113,22 @@ std::vector<Candidate> rank_candidates(const ModelSpec& current, const Campaign&
   return cands;
 }
 
+/// The held-out trials cannot tell `a` from `b` (cannot_tell_apart on the per-trial differences
+/// of their relative gains, over the trials where both are finite).
+bool held_out_equal(const Candidate& a, const Candidate& b) {
+  std::vector<double> worse;
+  for (std::size_t i = 0; i < a.trial_rel_gain.size() && i < b.trial_rel_gain.size(); ++i)
+    if (std::isfinite(a.trial_rel_gain[i]) && std::isfinite(b.trial_rel_gain[i]))
+      worse.push_back(a.trial_rel_gain[i] - b.trial_rel_gain[i]);
+  return cannot_tell_apart(worse);
+}
+
 /// The other significant candidates of a ranked round that the held-out trials cannot tell apart
 /// from its winner (the first): per trial, how much less each gains than the winner.
 std::vector<std::string> equivalent_to_winner(const std::vector<Candidate>& ranked) {
   std::vector<std::string> out;
-  for (std::size_t j = 1; j < ranked.size() && ranked[j].significant; ++j) {
-    std::vector<double> worse;
-    for (std::size_t i = 0; i < ranked[0].trial_rel_gain.size() && i < ranked[j].trial_rel_gain.size(); ++i)
-      if (std::isfinite(ranked[0].trial_rel_gain[i]) && std::isfinite(ranked[j].trial_rel_gain[i]))
-        worse.push_back(ranked[0].trial_rel_gain[i] - ranked[j].trial_rel_gain[i]);
-    if (cannot_tell_apart(worse)) out.push_back(ranked[j].term);
-  }
+  for (std::size_t j = 1; j < ranked.size() && ranked[j].significant; ++j)
+    if (held_out_equal(ranked[0], ranked[j])) out.push_back(ranked[j].term);
   return out;
 }
 
@@ -139,11 +144,7 @@ std::string generated_equivalent_to(const Candidate& winner, const ModelSpec& cu
   if (!form) return "";
   const auto ranked = rank_candidates(current, c, {{form, !gravity_scaled, 1.0}}, folds, alpha, min_improvement);
   if (ranked.empty() || !ranked.front().significant) return "";
-  std::vector<double> worse;
-  for (std::size_t i = 0; i < winner.trial_rel_gain.size() && i < ranked.front().trial_rel_gain.size(); ++i)
-    if (std::isfinite(winner.trial_rel_gain[i]) && std::isfinite(ranked.front().trial_rel_gain[i]))
-      worse.push_back(winner.trial_rel_gain[i] - ranked.front().trial_rel_gain[i]);
-  return cannot_tell_apart(worse) ? "c * " + form->name : "";
+  return held_out_equal(winner, ranked.front()) ? "c * " + form->name : "";
 }
 
 /// ", or equally well a and b (...)" when the trials cannot tell other terms from a winner.
