@@ -15,6 +15,7 @@
 
 #include "db/database.h"
 #include "results/measurements/campaign.h"
+#include "results/processing/metric_fields.h"
 #include "spec/sha256.h"
 
 namespace gravsweep::results {
@@ -24,6 +25,39 @@ namespace {
 /// Samples of one trial as stored: raw (t, a) and processed (a filtered, v, z).
 struct StoredSamples {
   std::vector<double> t_s, raw, filtered, velocity, depth;
+};
+
+/// The processing figures stored beside the metrics in trial_metrics: what a fit needs to use a
+/// stored trial without processing it again (the removed bias, the collision's sample window,
+/// the fit window, the processed rate). `required`: a row without it was written by an older
+/// gravsweep and must be imported again.
+struct ProcessingColumn {
+  const char* key;
+  const char* sql_type;
+  bool required;
+  void (*bind)(db::Statement&, int, const MeasuredTrial&);
+  void (*read)(db::Statement&, int, MeasuredTrial&);
+};
+std::size_t as_index(std::int64_t v) { return static_cast<std::size_t>(v); }
+const ProcessingColumn kProcessingColumns[] = {
+    {"bias_m_s2", "REAL", false,
+     [](db::Statement& s, int k, const MeasuredTrial& t) { s.bind(k, t.processed.bias_m_s2); },
+     [](db::Statement& q, int c, MeasuredTrial& t) { t.processed.bias_m_s2 = q.get_double(c); }},
+    {"i_start", "INTEGER", true,
+     [](db::Statement& s, int k, const MeasuredTrial& t) { s.bind(k, static_cast<std::int64_t>(t.processed.i_start)); },
+     [](db::Statement& q, int c, MeasuredTrial& t) { t.processed.i_start = as_index(q.get_int(c)); }},
+    {"i_end", "INTEGER", true,
+     [](db::Statement& s, int k, const MeasuredTrial& t) { s.bind(k, static_cast<std::int64_t>(t.processed.i_end)); },
+     [](db::Statement& q, int c, MeasuredTrial& t) { t.processed.i_end = as_index(q.get_int(c)); }},
+    {"fit_begin", "INTEGER", true,
+     [](db::Statement& s, int k, const MeasuredTrial& t) { s.bind(k, static_cast<std::int64_t>(t.fit_begin)); },
+     [](db::Statement& q, int c, MeasuredTrial& t) { t.fit_begin = as_index(q.get_int(c)); }},
+    {"fit_end", "INTEGER", true,
+     [](db::Statement& s, int k, const MeasuredTrial& t) { s.bind(k, static_cast<std::int64_t>(t.fit_end)); },
+     [](db::Statement& q, int c, MeasuredTrial& t) { t.fit_end = as_index(q.get_int(c)); }},
+    {"processed_rate_hz", "REAL", false,
+     [](db::Statement& s, int k, const MeasuredTrial& t) { s.bind(k, t.processed.sample_rate_hz); },
+     [](db::Statement& q, int c, MeasuredTrial& t) { t.processed.sample_rate_hz = q.get_double(c); }},
 };
 
 StoredSamples samples_of(const MeasuredTrial& t) {
@@ -166,20 +200,23 @@ CREATE TABLE IF NOT EXISTS processed_samples (
   processed_id INTEGER NOT NULL, sample INTEGER NOT NULL, accel_filtered_m_s2 REAL, velocity_m_s REAL, depth_m REAL,
   PRIMARY KEY (processed_id, sample)) WITHOUT ROWID;
 CREATE TABLE IF NOT EXISTS trial_metrics (
-  trial_id TEXT PRIMARY KEY REFERENCES trials(trial_id) ON DELETE CASCADE,
-  vc_m_s REAL, apeak_m_s2 REAL, zstop_m REAL, tstop_s REAL, t_start_s REAL, t_end_s REAL,
-  rebound INTEGER, bias_m_s2 REAL, note TEXT, i_start INTEGER, i_end INTEGER, fit_begin INTEGER,
-  fit_end INTEGER, processed_rate_hz REAL);
+  trial_id TEXT PRIMARY KEY REFERENCES trials(trial_id) ON DELETE CASCADE);
 )");
-  const auto cols = columns_of(db, "trials");
-  std::set<std::string> have(cols.begin(), cols.end());
-  auto add = [&](const std::string& name, const char* type) {
-    if (have.insert(name).second) db.exec(fmt::format("ALTER TABLE trials ADD COLUMN \"{}\" {}", name, type));
+  auto adder = [&db](const char* table) {
+    const auto cols = columns_of(db, table);
+    return [&db, table, have = std::set<std::string>(cols.begin(), cols.end())](const std::string& name,
+                                                                                const char* type) mutable {
+      if (have.insert(name).second) db.exec(fmt::format("ALTER TABLE {} ADD COLUMN \"{}\" {}", table, name, type));
+    };
   };
+  auto add = adder("trials");
   add("source", "TEXT");
   add("trace_id", "INTEGER");
   add("processed_id", "INTEGER");
   for (const auto& f : trial_fields()) add(f.key, f.number ? "REAL" : "TEXT");
+  auto add_metric = adder("trial_metrics");
+  for (const auto& f : metric_fields()) add_metric(f.key, f.sql_type());
+  for (const auto& c : kProcessingColumns) add_metric(c.key, c.sql_type);
   if (table_exists(db, "trial_samples")) migrate_trial_samples(db);
   db.exec(R"(
 CREATE VIEW IF NOT EXISTS trial_samples AS
@@ -202,25 +239,37 @@ DELETE FROM processed_traces WHERE processed_id NOT IN (SELECT processed_id FROM
 )");
 }
 
+/// "vc_m_s, ..., processed_rate_hz": the metric and processing columns of trial_metrics, in the
+/// order insert_metrics binds and read_metrics reads them (`prefix` before each name).
+/// `present`: the columns the table has (a database of an older gravsweep may lack some; they read
+/// as NULL), or nullptr for all of them.
+std::string metric_columns(const char* prefix, const std::set<std::string>* present = nullptr) {
+  std::string out;
+  auto add = [&](const char* key) {
+    const bool has = !present || present->count(key);
+    out += fmt::format("{}{}", out.empty() ? "" : ", ", has ? fmt::format("{}\"{}\"", prefix, key) : "NULL");
+  };
+  for (const auto& f : metric_fields()) add(f.key);
+  for (const auto& c : kProcessingColumns) add(c.key);
+  return out;
+}
+
+std::size_t metric_column_count() { return metric_fields().size() + std::size(kProcessingColumns); }
+
 void insert_metrics(db::Statement& met, const MeasuredTrial& t) {
-  const auto& p = t.processed;
-  const auto& m = p.metrics;
+  const auto& m = t.processed.metrics;
   met.reset();
-  met.bind(1, t.info.trial_id)
-      .bind(2, m.vc_m_s)
-      .bind(3, m.apeak_m_s2)
-      .bind(4, m.zstop_m)
-      .bind(5, m.tstop_s)
-      .bind(6, m.t_start_s)
-      .bind(7, m.t_end_s)
-      .bind(8, m.rebound ? 1 : 0)
-      .bind(9, p.bias_m_s2)
-      .bind(10, m.note)
-      .bind(11, static_cast<std::int64_t>(p.i_start))
-      .bind(12, static_cast<std::int64_t>(p.i_end))
-      .bind(13, static_cast<std::int64_t>(t.fit_begin))
-      .bind(14, static_cast<std::int64_t>(t.fit_end))
-      .bind(15, p.sample_rate_hz);
+  met.bind(1, t.info.trial_id);
+  int k = 2;
+  for (const auto& f : metric_fields()) {
+    if (f.number)
+      met.bind(k++, m.*f.number);
+    else if (f.flag)
+      met.bind(k++, m.*f.flag ? 1 : 0);
+    else
+      met.bind(k++, m.*f.text);
+  }
+  for (const auto& c : kProcessingColumns) c.bind(met, k++, t);
   met.run();
 }
 
@@ -236,10 +285,10 @@ int store_campaign(db::Database& db, const Campaign& c) {
     marks += ", ?";
   }
   db::Statement ins(db, fmt::format("INSERT INTO trials ({}) VALUES ({})", names, marks));
+  std::string met_marks = "?";
+  for (std::size_t k = 0; k < metric_column_count(); ++k) met_marks += ", ?";
   db::Statement met(db,
-                    "INSERT INTO trial_metrics (trial_id, vc_m_s, apeak_m_s2, zstop_m, tstop_s, "
-                    "t_start_s, t_end_s, rebound, bias_m_s2, note, i_start, i_end, fit_begin, fit_end, "
-                    "processed_rate_hz) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?,?)");
+                    fmt::format("INSERT INTO trial_metrics (trial_id, {}) VALUES ({})", metric_columns(""), met_marks));
   ContentStore raw = raw_store(db), processed = processed_store(db);
   int stored = 0;
   for (const auto& t : c.trials) {
@@ -291,29 +340,30 @@ Trial trial_of_row(db::Statement& q, const std::vector<std::string>& cols) {
   return j.get<Trial>();
 }
 
-/// The metrics columns of a row, from column b on (the SELECT of load_campaign_db).
+/// The metrics columns of a row, from column b on, in metric_columns() order (null: the default).
 void read_metrics(db::Database& db, db::Statement& q, int b, MeasuredTrial& t) {
-  auto& p = t.processed;
-  auto& m = p.metrics;
-  m.vc_m_s = q.get_double(b);
-  m.apeak_m_s2 = q.get_double(b + 1);
-  m.zstop_m = q.get_double(b + 2);
-  m.tstop_s = q.get_double(b + 3);
-  m.t_start_s = q.get_double(b + 4);
-  m.t_end_s = q.get_double(b + 5);
-  m.rebound = q.get_int(b + 6) != 0;
-  p.bias_m_s2 = q.get_double(b + 7);
-  m.note = q.is_null(b + 8) ? "" : q.get_text(b + 8);
-  if (q.is_null(b + 9) || q.is_null(b + 11))
-    throw std::runtime_error(
-        fmt::format("{}: trial '{}' was imported by an older gravsweep without fit "
-                    "windows; import the campaign again",
-                    db.path(), t.info.trial_id));
-  p.i_start = static_cast<std::size_t>(q.get_int(b + 9));
-  p.i_end = static_cast<std::size_t>(q.get_int(b + 10));
-  t.fit_begin = static_cast<std::size_t>(q.get_int(b + 11));
-  t.fit_end = static_cast<std::size_t>(q.get_int(b + 12));
-  p.sample_rate_hz = q.get_double(b + 13);
+  auto& m = t.processed.metrics;
+  int c = b;
+  for (const auto& f : metric_fields()) {
+    if (!q.is_null(c)) {
+      if (f.number)
+        m.*f.number = q.get_double(c);
+      else if (f.flag)
+        m.*f.flag = q.get_int(c) != 0;
+      else
+        m.*f.text = q.get_text(c);
+    }
+    ++c;
+  }
+  for (const auto& col : kProcessingColumns) {
+    if (q.is_null(c) && col.required)
+      throw std::runtime_error(
+          fmt::format("{}: trial '{}' was imported by an older gravsweep without {}; import "
+                      "the campaign again",
+                      db.path(), t.info.trial_id, col.key));
+    if (!q.is_null(c)) col.read(q, c, t);
+    ++c;
+  }
 }
 
 }  // namespace
@@ -324,11 +374,10 @@ Campaign load_campaign_db(db::Database& db) {
   const std::vector<std::string> cols = columns_of(db, "trials");
   std::string sel;
   for (const auto& n : cols) sel += fmt::format("{}t.\"{}\"", sel.empty() ? "" : ", ", n);
-  db::Statement q(db, fmt::format("SELECT {}, m.vc_m_s, m.apeak_m_s2, m.zstop_m, m.tstop_s, m.t_start_s, m.t_end_s, "
-                                  "m.rebound, m.bias_m_s2, m.note, m.i_start, m.i_end, m.fit_begin, m.fit_end, "
-                                  "m.processed_rate_hz FROM trials t JOIN trial_metrics m USING (trial_id) "
-                                  "ORDER BY t.rowid",
-                                  sel));
+  const auto metric_cols = columns_of(db, "trial_metrics");
+  const std::set<std::string> stored(metric_cols.begin(), metric_cols.end());
+  db::Statement q(db, fmt::format("SELECT {}, {} FROM trials t JOIN trial_metrics m USING (trial_id) ORDER BY t.rowid",
+                                  sel, metric_columns("m.", &stored)));
   // The view over the shared tables, or the table of a database written before them: one query.
   db::Statement smp(db,
                     "SELECT t_s, accel_raw_m_s2, accel_filtered_m_s2, velocity_m_s, depth_m FROM trial_samples "

@@ -16,6 +16,7 @@
 #include "results/io/trace_file.h"
 #include "results/measurements/campaign.h"
 #include "results/model/collapse.h"
+#include "results/processing/metric_fields.h"
 #include "results/report/report.h"
 
 namespace gravsweep::results {
@@ -117,11 +118,6 @@ Fig2Record load_record(const std::string& path) {
   return r;
 }
 
-json metrics_json(const Metrics& m) {
-  return json{{"vc_m_s", m.vc_m_s},   {"apeak_m_s2", m.apeak_m_s2}, {"zstop_m", m.zstop_m},
-              {"tstop_s", m.tstop_s}, {"t_start_s", m.t_start_s},   {"t_end_s", m.t_end_s}};
-}
-
 /// fig2_<i>.csv: time since the collision start and the columns plots.py draws (empty = absent).
 json write_fig2_record(const fs::path& dir, std::size_t i, const Fig2Record& r) {
   const auto& raw = r.trial.raw;
@@ -141,7 +137,7 @@ json write_fig2_record(const fs::path& dir, std::size_t i, const Fig2Record& r) 
               {"gravity_m_s2", r.trial.info.gravity_m_s2},
               {"bias_m_s2", p.bias_m_s2},
               {"note", r.note},
-              {"metrics", metrics_json(p.metrics)}};
+              {"metrics", json(p.metrics)}};
 }
 
 void check_png(const std::string& out) {

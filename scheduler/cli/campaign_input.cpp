@@ -8,6 +8,7 @@
 #include <set>
 
 #include "db/database.h"
+#include "results/processing/metric_fields.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/filter.h"
@@ -62,12 +63,9 @@ nlohmann::json row_of(const results::MeasuredTrial& t) {
   nlohmann::json j = t.info;
   j.erase("attributes");
   for (const auto& [k, v] : t.info.attributes) j[k] = v;
-  const auto& m = t.processed.metrics;
-  j["vc_m_s"] = m.vc_m_s;
-  j["apeak_m_s2"] = m.apeak_m_s2;
-  j["zstop_m"] = m.zstop_m;
-  j["tstop_s"] = m.tstop_s;
-  j["rebound"] = m.rebound;
+  const nlohmann::json m = t.processed.metrics;
+  for (const auto& f : results::metric_fields())
+    if (!f.text) j[f.key] = m[f.key];  // the processing note stays out: a trial may have a "note" column
   return j;
 }
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "results/measurements/trial.h"
+#include "results/processing/metric_fields.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/campaign_options.h"
 #include "results/io/table.h"
@@ -149,8 +150,9 @@ std::string group_text(const ResultsOptions& o, db::Database& db, std::size_t& n
     metrics = metric_columns(db);
     if (o.format == "table" && !o.all) {
       std::vector<std::string> paper;
-      for (const char* m : {"vc_m_s", "apeak_m_s2", "zstop_m", "tstop_s"})
-        if (std::find(metrics.begin(), metrics.end(), m) != metrics.end()) paper.emplace_back(m);
+      for (const auto& f : results::metric_fields())
+        if (f.headline && f.number && std::find(metrics.begin(), metrics.end(), f.key) != metrics.end())
+          paper.emplace_back(f.key);
       metrics = paper;
     }
   }
@@ -203,7 +205,8 @@ void run_results(const ResultsOptions& o) {
   // A table shows the swept parameters and the paper's metrics unless asked for more; CSV and JSON
   // exports carry every column.
   const bool summary = o.format == "table" && o.columns.empty() && !o.all;
-  const std::vector<std::string> columns = summary ? queue::summary_result_columns(db) : o.columns;
+  const std::vector<std::string> columns =
+      summary ? queue::summary_result_columns(db, results::headline_metric_keys()) : o.columns;
   queue::ResultsQuery q{o.where, columns, o.sweep, o.sort, o.limit};
   queue::ResultsTable t;
   try {

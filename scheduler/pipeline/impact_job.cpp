@@ -15,6 +15,7 @@
 #include "results/io/snapshot_file.h"
 #include "results/io/trace_file.h"
 #include "results/measurements/campaign.h"
+#include "results/processing/metric_fields.h"
 #include "results/processing/trace.h"
 #include "scheduler/pipeline/build_version.h"
 #include "scheduler/pipeline/scenario_spec.h"
@@ -331,19 +332,11 @@ json paper_metrics(const results::TraceData& td, const std::filesystem::path& tr
   try {
     results::MeasuredTrial trial = results::dem_trial_of(td, {"", "", trace_out});
     results::process_trial(trial);
-    const results::Metrics& r = trial.processed.metrics;
-    return json{{"vc_m_s", r.vc_m_s},
-                {"apeak_m_s2", r.apeak_m_s2},
-                {"zstop_m", r.zstop_m},
-                {"tstop_s", r.tstop_s},
-                {"t_start_s", r.t_start_s},
-                {"t_end_s", r.t_end_s},
-                {"rebound", r.rebound},
-                {"note", r.note},
-                {"depth_at_end_m", r.depth_at_end_m}};
+    return json(trial.processed.metrics);
   } catch (const std::exception& e) {
-    return json{{"vc_m_s", nullptr},    {"apeak_m_s2", nullptr}, {"zstop_m", nullptr}, {"tstop_s", nullptr},
-                {"t_start_s", nullptr}, {"t_end_s", nullptr},    {"rebound", nullptr}, {"metrics_error", e.what()}};
+    json m = results::null_metrics_json();
+    m["metrics_error"] = e.what();
+    return m;
   }
 }
 

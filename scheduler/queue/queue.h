@@ -229,8 +229,8 @@ std::vector<std::string> result_columns(db::Database& db);
 /// The names of the results columns that hold numbers (fixed INTEGER/REAL ones, and the swept
 /// parameters and metrics stored as INTEGER or REAL).
 std::set<std::string> numeric_result_columns(db::Database& db);
-/// The columns a results table shows by default: job_id, every swept parameter, and the paper's
-/// metrics (vc_m_s, apeak_m_s2, zstop_m, tstop_s, rebound) where the campaign has them.
-std::vector<std::string> summary_result_columns(db::Database& db);
+/// The columns a results table shows by default: job_id, every swept parameter, and those of
+/// `headline_metrics` the campaign has (the job kinds' own choice; the queue knows no metric).
+std::vector<std::string> summary_result_columns(db::Database& db, const std::vector<std::string>& headline_metrics);
 
 }  // namespace gravsweep::queue

@@ -176,8 +176,7 @@ std::set<std::string> numeric_result_columns(Database& db) {
   return out;
 }
 
-std::vector<std::string> summary_result_columns(Database& db) {
-  static const std::vector<std::string> kPaperMetrics{"vc_m_s", "apeak_m_s2", "zstop_m", "tstop_s", "rebound"};
+std::vector<std::string> summary_result_columns(Database& db, const std::vector<std::string>& headline_metrics) {
   std::vector<std::string> cols{"job_id"}, metrics;
   Statement st(db, "SELECT name, role FROM results_columns ORDER BY position");
   while (st.step()) {
@@ -186,7 +185,7 @@ std::vector<std::string> summary_result_columns(Database& db) {
     else
       metrics.push_back(st.get_text(0));
   }
-  for (const auto& m : kPaperMetrics)
+  for (const auto& m : headline_metrics)
     if (std::find(metrics.begin(), metrics.end(), m) != metrics.end()) cols.push_back(m);
   return cols;
 }

@@ -9,6 +9,7 @@
 #include "results/measurements/campaign.h"
 #include "results/model/model.h"
 #include "results/model/synth.h"
+#include "results/processing/metric_fields.h"
 #include "results_helpers.h"
 #include "db/database.h"
 
@@ -158,11 +159,37 @@ TEST(Campaign, ReadBackFromSqliteFitsExactlyAsFromTheFolder) {
     EXPECT_EQ(back.trials[i].info.trial_id, c.trials[i].info.trial_id);
     EXPECT_EQ(back.trials[i].fit_begin, c.trials[i].fit_begin);
     EXPECT_EQ(back.trials[i].fit_end, c.trials[i].fit_end);
-    EXPECT_DOUBLE_EQ(back.trials[i].processed.metrics.zstop_m, c.trials[i].processed.metrics.zstop_m);
+    // Every metric of the one table, the depths at the end and the note included.
+    EXPECT_EQ(nlohmann::json(back.trials[i].processed.metrics), nlohmann::json(c.trials[i].processed.metrics));
   }
   const auto spec = parse_model("base+depth_friction");
   const auto a = fit_model(spec, c), b = fit_model(spec, back);
   for (Eigen::Index j = 0; j < a.coef.size(); ++j) EXPECT_NEAR(b.coef(j), a.coef(j), 1e-9 * std::abs(a.coef(j)));
+}
+
+// A database imported before a metric had its column: it is read with that metric at its default,
+// and storing into it adds the column (no rows lost).
+TEST(Campaign, AnOlderMetricsTableGainsTheNewColumnsWhenStoredInto) {
+  TempDir d;
+  write_synthetic_campaign((d.path / "c").string(), parse_model("base"), small());
+  const Campaign c = load_campaign((d.path / "c").string());
+  const std::string dbfile = (d.path / "lab.db").string();
+  {
+    db::Database db(dbfile);
+    store_campaign(db, c);
+    db.exec("ALTER TABLE trial_metrics DROP COLUMN depth_at_end_m");
+  }
+  const Campaign old = load_campaign_any(dbfile);
+  ASSERT_EQ(old.trials.size(), c.trials.size());
+  EXPECT_EQ(old.trials[0].processed.metrics.depth_at_end_m, 0.0);
+  EXPECT_EQ(old.trials[0].processed.metrics.zstop_m, c.trials[0].processed.metrics.zstop_m);
+  {
+    db::Database db(dbfile);
+    EXPECT_EQ(store_campaign(db, c), 8);
+  }
+  const Campaign back = load_campaign_any(dbfile);
+  ASSERT_GT(c.trials[0].processed.metrics.depth_at_end_m, 0.0);
+  EXPECT_EQ(back.trials[0].processed.metrics.depth_at_end_m, c.trials[0].processed.metrics.depth_at_end_m);
 }
 
 TEST(Campaign, AttributeCellWithQuotesBackslashesAndLineBreaksIsStoredAsValidJson) {

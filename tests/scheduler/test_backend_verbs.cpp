@@ -107,7 +107,7 @@ TEST_P(BackendVerbs, EveryVerbReadingACampaignTakesItsLocation) {
   ASSERT_EQ(cli({"submit", "spec.json"}).code, 0);
   auto r = cli({"work", "--workers", "2", "--threads", "1", "--quiet"});
   ASSERT_EQ(r.code, 0) << r.err;
-  r = cli({"export", "--out", "ds", "--rate-hz", "2000"});
+  r = cli({"export", "--out", "ds", "--rate-hz", "2000", "--allow-dirty"});  // this test's build may be dirty
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("6 drops exported"), std::string::npos) << r.out;
   EXPECT_TRUE(fs::exists(dir.path / "ds" / "trials.csv"));

@@ -1,0 +1,62 @@
+// The one table of the paper's metrics (see metric_fields.h).
+#include "results/processing/metric_fields.h"
+
+namespace gravsweep::results {
+
+const std::vector<MetricField>& metric_fields() {
+  // key, unit, headline, member (number / flag / text).
+  static const std::vector<MetricField> fields = {
+      {"vc_m_s", "m/s", true, &Metrics::vc_m_s, nullptr, nullptr},
+      {"apeak_m_s2", "m/s2", true, &Metrics::apeak_m_s2, nullptr, nullptr},
+      {"zstop_m", "m", true, &Metrics::zstop_m, nullptr, nullptr},
+      {"tstop_s", "s", true, &Metrics::tstop_s, nullptr, nullptr},
+      {"rebound", "1", true, nullptr, &Metrics::rebound, nullptr},
+      {"t_start_s", "s", false, &Metrics::t_start_s, nullptr, nullptr},
+      {"t_end_s", "s", false, &Metrics::t_end_s, nullptr, nullptr},
+      {"depth_at_end_m", "m", false, &Metrics::depth_at_end_m, nullptr, nullptr},
+      {"final_depth_m", "m", false, &Metrics::final_depth_m, nullptr, nullptr},
+      {"note", "", false, nullptr, nullptr, &Metrics::note},
+  };
+  return fields;
+}
+
+void to_json(nlohmann::json& j, const Metrics& m) {
+  j = nlohmann::json::object();
+  for (const auto& f : metric_fields()) {
+    if (f.number)
+      j[f.key] = m.*f.number;
+    else if (f.flag)
+      j[f.key] = m.*f.flag;
+    else
+      j[f.key] = m.*f.text;
+  }
+}
+
+void from_json(const nlohmann::json& j, Metrics& m) {
+  for (const auto& f : metric_fields()) {
+    const auto it = j.find(f.key);
+    if (it == j.end() || it->is_null()) continue;
+    if (f.number)
+      m.*f.number = it->get<double>();
+    else if (f.flag)
+      m.*f.flag = it->is_boolean() ? it->get<bool>() : it->get<double>() != 0;
+    else
+      m.*f.text = it->get<std::string>();
+  }
+}
+
+nlohmann::json null_metrics_json() {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& f : metric_fields())
+    if (!f.text) j[f.key] = nullptr;
+  return j;
+}
+
+std::vector<std::string> headline_metric_keys() {
+  std::vector<std::string> keys;
+  for (const auto& f : metric_fields())
+    if (f.headline) keys.emplace_back(f.key);
+  return keys;
+}
+
+}  // namespace gravsweep::results

@@ -1,0 +1,40 @@
+// The one table of the paper's metrics (Metrics, trace.h): every representation of a processed
+// collision (a drop job's metrics JSON and its results columns, the `trial_metrics` table of an
+// imported campaign, a --where row, the report's figure records) is made from metric_fields();
+// nothing else lists them.
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
+
+#include "results/processing/trace.h"
+
+namespace gravsweep::results {
+
+/// One field of Metrics and its names everywhere. Exactly one of `number`, `flag`, `text` is set.
+struct MetricField {
+  const char* key;   ///< JSON key, SQL column, CSV header (one name: units in it)
+  const char* unit;  ///< SI unit ("1" for a flag, "" for text)
+  /// One of Sect. 2.3's headline figures (vc, apeak, zstop, tstop and the rebound flag): the
+  /// columns a summary table shows by default.
+  bool headline;
+  double Metrics::*number;
+  bool Metrics::*flag;
+  std::string Metrics::*text;
+  [[nodiscard]] const char* sql_type() const { return number ? "REAL" : flag ? "INTEGER" : "TEXT"; }
+};
+
+/// The table, headline figures first.
+const std::vector<MetricField>& metric_fields();
+
+/// Every field (the flag as a JSON boolean, the note as a string).
+void to_json(nlohmann::json& j, const Metrics& m);
+/// Fields present in `j` (null or absent: the default).
+void from_json(const nlohmann::json& j, Metrics& m);
+/// Every numeric and flag field as null: a trace whose metrics could not be found.
+nlohmann::json null_metrics_json();
+/// The keys of the headline figures, in the table's order.
+std::vector<std::string> headline_metric_keys();
+
+}  // namespace gravsweep::results
