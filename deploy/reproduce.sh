@@ -37,7 +37,7 @@ case "${1:-}" in
     # machine may hold fewer drops of a part than the committed dataset: that dataset is kept.
     count() { [ -f "$1/trials.csv" ] && echo $(( $(wc -l < "$1/trials.csv") - 1 )) || echo 0; }
     for part in part1_chrono_1g:chrono_1g part2_chrono_lowg:chrono_0.1g part5_pkdgrav_1g:pkdgrav_1g \
-      part1_dt_check:dt_check part4_rolling_friction:rolling_friction \
+      part1_dt_check:dt_check part4_rolling_friction:rolling_friction part3_fill_height:fill_height \
       part5b_pkdgrav_stiff_1g:pkdgrav_stiff_1g; do
       sweep="${part%%:*}"; dir="$data/${part##*:}"
       rm -rf "$dir.tmp"

@@ -149,14 +149,16 @@ std::vector<std::string> required_columns() {
   return r;
 }
 
-/// One row of trials.csv into a trial (numbers checked, the trace read, not processed).
-MeasuredTrial read_row(const fs::path& dir, const std::map<std::string, int>& col, const std::vector<std::string>& f,
-                       int ln, double cutoff_hz) {
-  auto text = [&](const std::string& name) -> std::string {
+/// The cells of one trials.csv row by column name, numbers checked against their physical range.
+struct RowCells {
+  const std::map<std::string, int>& col;
+  const std::vector<std::string>& f;
+  int ln;
+  [[nodiscard]] std::string text(const std::string& name) const {
     const auto it = col.find(name);
     return it != col.end() && it->second < static_cast<int>(f.size()) ? f[it->second] : std::string();
-  };
-  auto num = [&](const std::string& name, bool positive) {
+  }
+  [[nodiscard]] double num(const std::string& name, bool positive) const {
     const int i = col.at(name);
     const std::string s = text(name);
     double v;
@@ -168,44 +170,59 @@ MeasuredTrial read_row(const fs::path& dir, const std::map<std::string, int>& co
     if (const std::string expected = out_of_physical_range(name, v); !expected.empty())
       throw ParseError{{"trials.csv", ln, i + 1, fmt::format("column '{}': found {}, expected {}", name, s, expected)}};
     return v;
-  };
-  MeasuredTrial t;
-  Trial& ti = t.info;
+  }
+};
+
+/// The trial's facts from its row: the fields of trial_fields(), the impact speed (or sqrt(2 g h)
+/// from drop_height_m), the other columns as attributes, an explicit source.
+Trial trial_of_row(const RowCells& row, double cutoff_hz) {
+  const auto& col = row.col;
+  Trial ti;
   ti.source = TraceSource::lab;
   ti.filter_cutoff_hz = cutoff_hz;
   for (const auto& fd : trial_fields()) {
-    const bool present = col.count(fd.key) && !text(fd.key).empty();
+    const bool present = col.count(fd.key) && !row.text(fd.key).empty();
     if (fd.text) {
-      if (col.count(fd.key)) ti.*fd.text = text(fd.key);
+      if (col.count(fd.key)) ti.*fd.text = row.text(fd.key);
     } else if (std::string(fd.key) == "impact_velocity_m_s") {
       continue;  // below: it may come from drop_height_m
     } else if (fd.csv_required || present) {
       // bulk density is kept, not used by the models: it may be 0; optional fields are checked
       // where they are used
-      ti.*fd.number = num(fd.key, fd.csv_required && std::string(fd.key) != "bulk_density_kg_m3");
+      ti.*fd.number = row.num(fd.key, fd.csv_required && std::string(fd.key) != "bulk_density_kg_m3");
     }
   }
-  if (ti.trial_id.empty()) throw ParseError{{"trials.csv", ln, col.at("trial_id") + 1, "column 'trial_id': empty"}};
-  if (col.count("drop_height_m") && text("impact_velocity_m_s").empty()) {
-    ti.drop_height_m = num("drop_height_m", true);
+  if (ti.trial_id.empty()) throw ParseError{{"trials.csv", row.ln, col.at("trial_id") + 1, "column 'trial_id': empty"}};
+  if (col.count("drop_height_m") && row.text("impact_velocity_m_s").empty()) {
+    ti.drop_height_m = row.num("drop_height_m", true);
     ti.impact_velocity_m_s = std::sqrt(2.0 * ti.gravity_m_s2 * ti.drop_height_m);
   } else {
-    ti.impact_velocity_m_s = num("impact_velocity_m_s", true);
+    ti.impact_velocity_m_s = row.num("impact_velocity_m_s", true);
   }
   for (const auto& [name, i] : col) {
     const bool known =
         std::any_of(trial_fields().begin(), trial_fields().end(), [&](const TrialField& fd) { return name == fd.key; });
-    if (!known && i < static_cast<int>(f.size())) ti.attributes[name] = f[i];
+    if (!known && i < static_cast<int>(row.f.size())) ti.attributes[name] = row.f[i];
   }
   // An explicit source column (`gravsweep export` writes "dem" for DEM drops as CSV traces).
-  if (!text("source").empty()) {
+  if (!row.text("source").empty()) {
     try {
-      ti.source = trace_source_of(text("source"));
+      ti.source = trace_source_of(row.text("source"));
     } catch (const std::invalid_argument& e) {
-      throw ParseError{{"trials.csv", ln, col.at("source") + 1, fmt::format("column 'source': {}", e.what())}};
+      throw ParseError{{"trials.csv", row.ln, col.at("source") + 1, fmt::format("column 'source': {}", e.what())}};
     }
     ti.attributes.erase("source");
   }
+  return ti;
+}
+
+/// One row of trials.csv into a trial (numbers checked, the trace read, not processed).
+MeasuredTrial read_row(const fs::path& dir, const std::map<std::string, int>& col, const std::vector<std::string>& f,
+                       int ln, double cutoff_hz) {
+  const RowCells row{col, f, ln};
+  MeasuredTrial t;
+  t.info = trial_of_row(row, cutoff_hz);
+  Trial& ti = t.info;
   const std::string& rel = ti.trace_file;
   const fs::path full = resolve_inside(dir, rel, ln, col.at("trace_file") + 1);
   if (fs::path(rel).extension() == ".h5") {
@@ -223,12 +240,12 @@ MeasuredTrial read_row(const fs::path& dir, const std::map<std::string, int>& co
   } else {
     t.raw = read_trace_csv(full, rel, ti.sample_rate_hz, ln, col.at("sample_rate_hz") + 1, t);
     t.raw.source = ti.source;
-    if (ti.source == TraceSource::dem && !text("contact_start_s").empty()) {
+    if (ti.source == TraceSource::dem && !row.text("contact_start_s").empty()) {
       double s0;
-      if (!parse_double(text("contact_start_s"), s0))
+      if (!parse_double(row.text("contact_start_s"), s0))
         throw ParseError{
             {"trials.csv", ln, col.at("contact_start_s") + 1,
-             fmt::format("column 'contact_start_s': expected a finite number, got '{}'", text("contact_start_s"))}};
+             fmt::format("column 'contact_start_s': expected a finite number, got '{}'", row.text("contact_start_s"))}};
       t.raw.contact_start_s = s0;
     }
   }

@@ -175,28 +175,67 @@ Metrics draw_fig2(const Fig2Request& rq) {
   return m;
 }
 
+/// The bed of Fig. 1, read or refused with the file named.
+BedData fig1_bed(const std::string& path) {
+  if (!fs::exists(path)) throw ConfigError(fmt::format("no bed file at '{}'", path));
+  try {
+    return read_bed(path);
+  } catch (const std::exception& e) {
+    throw ConfigError(fmt::format("{}: not a readable gravsweep bed.h5 ({})", path, e.what()));
+  }
+}
+
+/// The projectile's record of Fig. 1 (empty path: none), read or refused with the file named.
+TraceData fig1_trace(const std::string& path) {
+  TraceData td;
+  if (path.empty()) return td;
+  if (!fs::exists(path)) throw ConfigError(fmt::format("--trace: no trace file at '{}'", path));
+  try {
+    td = read_trace(path);
+  } catch (const std::exception& e) {
+    throw ConfigError(fmt::format("{}: not a readable gravsweep trace.h5 ({})", path, e.what()));
+  }
+  if (td.size() == 0) throw ConfigError(fmt::format("{}: the trace holds no sample", path));
+  return td;
+}
+
+/// Fig. 1 (b): the projectile where the record ends, over the grains of the drop's last snapshot
+/// (written by `write_grains` as rest.csv) or, without snapshots, the grains as prepared.
+template <class WriteGrains, class Projectile>
+json fig1_rest_panel(const Fig1Request& rq, const BedData& bed, const TraceData& td, WriteGrains write_grains,
+                     Projectile projectile, std::string& what) {
+  const std::size_t k = td.size() - 1;
+  json panel{{"title", fmt::format("(b) {} at t = {:.0f} ms, {:.2f} cm deep",
+                                   td.stopped ? "at rest" : "at the time cap", 1000 * td.t_s[k], 100 * td.depth_m[k])},
+             {"grains", "bed.csv"},
+             {"projectile", projectile(k)}};
+  const std::string snaps = rq.snapshots.empty() ? snapshot_path_for(rq.trace).string() : rq.snapshots;
+  if (fs::exists(snaps)) {
+    try {
+      const Snapshot s = read_snapshot(snaps, -1);
+      if (s.grains.size() != bed.size())
+        throw ConfigError(fmt::format("{}: {} grains, the bed has {}", snaps, s.grains.size(), bed.size()));
+      write_grains("rest.csv", s.grains.position_m);
+      panel["grains"] = "rest.csv";
+      what += fmt::format(", grains at rest from {}", snaps);
+    } catch (const h5::H5Error& e) {
+      throw ConfigError(fmt::format("{}: not a readable snapshots file ({})", snaps, e.what()));
+    }
+  } else {
+    panel["note"] = "grains as prepared (no snapshots.h5 of this drop)";
+    what += ", no snapshots: grains as prepared in (b)";
+  }
+  return panel;
+}
+
 std::string draw_fig1(const Fig1Request& rq) {
   check_png(rq.out);
   if (rq.at != "" && rq.at != "release" && rq.at != "rest")
     throw ConfigError(fmt::format("--at '{}': expected release or rest", rq.at));
   if (!rq.at.empty() && rq.trace.empty()) throw ConfigError("--at needs --trace (the projectile's record)");
   if (!fs::exists(rq.bed)) throw ConfigError(fmt::format("no bed file at '{}'", rq.bed));
-  BedData bed;
-  try {
-    bed = read_bed(rq.bed);
-  } catch (const std::exception& e) {
-    throw ConfigError(fmt::format("{}: not a readable gravsweep bed.h5 ({})", rq.bed, e.what()));
-  }
-  TraceData td;
-  if (!rq.trace.empty()) {
-    if (!fs::exists(rq.trace)) throw ConfigError(fmt::format("--trace: no trace file at '{}'", rq.trace));
-    try {
-      td = read_trace(rq.trace);
-    } catch (const std::exception& e) {
-      throw ConfigError(fmt::format("{}: not a readable gravsweep trace.h5 ({})", rq.trace, e.what()));
-    }
-    if (td.size() == 0) throw ConfigError(fmt::format("{}: the trace holds no sample", rq.trace));
-  }
+  const BedData bed = fig1_bed(rq.bed);
+  const TraceData td = fig1_trace(rq.trace);
   ScratchDir tmp("fig1");
   auto write_grains = [&](const std::string& name, const std::vector<double>& pos) {
     std::ofstream f(tmp.path / name);
@@ -223,31 +262,8 @@ std::string draw_fig1(const Fig1Request& rq) {
                                                 100 * (td.release_height_m - td.surface_height_m))},
                           {"grains", "bed.csv"},
                           {"projectile", projectile(0)}});
-  if (!rq.trace.empty() && rq.at != "release") {
-    const std::size_t k = td.size() - 1;
-    json panel{
-        {"title", fmt::format("(b) {} at t = {:.0f} ms, {:.2f} cm deep", td.stopped ? "at rest" : "at the time cap",
-                              1000 * td.t_s[k], 100 * td.depth_m[k])},
-        {"grains", "bed.csv"},
-        {"projectile", projectile(k)}};
-    const std::string snaps = rq.snapshots.empty() ? snapshot_path_for(rq.trace).string() : rq.snapshots;
-    if (fs::exists(snaps)) {
-      try {
-        const Snapshot s = read_snapshot(snaps, -1);
-        if (s.grains.size() != bed.size())
-          throw ConfigError(fmt::format("{}: {} grains, the bed has {}", snaps, s.grains.size(), bed.size()));
-        write_grains("rest.csv", s.grains.position_m);
-        panel["grains"] = "rest.csv";
-        what += fmt::format(", grains at rest from {}", snaps);
-      } catch (const h5::H5Error& e) {
-        throw ConfigError(fmt::format("{}: not a readable snapshots file ({})", snaps, e.what()));
-      }
-    } else {
-      panel["note"] = "grains as prepared (no snapshots.h5 of this drop)";
-      what += ", no snapshots: grains as prepared in (b)";
-    }
-    panels.push_back(panel);
-  }
+  if (!rq.trace.empty() && rq.at != "release")
+    panels.push_back(fig1_rest_panel(rq, bed, td, write_grains, projectile, what));
   const json spec{{"out", fs::absolute(rq.out).string()},
                   {"panels", panels},
                   {"container_diameter_m", bed.container_diameter_m},

@@ -93,52 +93,38 @@ std::int64_t count_done(const std::string& db_path) {
   return st.get_int(0);
 }
 
-void run_bench_queue(const BenchQueueOptions& o) {
-  fs::path dir = o.dir;
-  if (dir.empty()) {
-    std::string tmpl = (fs::temp_directory_path() / "gravsweep-bench-queue-XXXXXX").string();
-    if (!mkdtemp(tmpl.data())) throw std::runtime_error("cannot create a temporary directory");
-    dir = tmpl;
+/// 1. In-process latency of each operation (one connection, no contention).
+void bench_operations(const BenchQueueOptions& o, BenchStore& store) {
+  const std::string db_path = store.fresh("ops");
+  const long n = std::min<long>(o.jobs, 1000);
+  make_campaign(db_path, n);
+  db::Database db(db_path);
+  const queue::CampaignPaths paths(db_path, store.files(db_path));
+  const auto who = queue::make_identity("bench", 1);
+  double t_claim = 0, t_beat = 0, t_done = 0;
+  long k = 0;
+  for (;; ++k) {
+    auto t0 = Clock::now();
+    auto c = queue::claim(db, who, paths, 60);
+    t_claim += since(t0);
+    if (!c) break;
+    t0 = Clock::now();
+    queue::heartbeat(db, *c, 60, 0.5, "noop", "");
+    t_beat += since(t0);
+    queue::Completion done;
+    done.output_rel = c->output_rel;
+    done.sha256 = std::string(64, '0');
+    done.metrics = {{"noop_value", k}};
+    t0 = Clock::now();
+    queue::complete(db, *c, done);
+    t_done += since(t0);
   }
-  fs::create_directories(dir);
-  BenchStore store{o.server, dir, {}};
-  const std::string exe = queue::self_exe();
-  fmt::print(
-      "scheduler overhead with no-op jobs on {} (each: claim in one transaction, one heartbeat, output file "
-      "written + fsynced + renamed + checksummed, fenced completion with results row)\n\n",
-      o.server.empty() ? std::string("SQLite") : "PostgreSQL at " + o.server);
+  fmt::print("per operation, one process, {} jobs:  claim {:.3f} ms   heartbeat {:.3f} ms   complete {:.3f} ms\n\n", k,
+             1e3 * t_claim / std::max(1L, k), 1e3 * t_beat / std::max(1L, k), 1e3 * t_done / std::max(1L, k));
+}
 
-  // 1. In-process latency of each operation (one connection, no contention).
-  {
-    const std::string db_path = store.fresh("ops");
-    const long n = std::min<long>(o.jobs, 1000);
-    make_campaign(db_path, n);
-    db::Database db(db_path);
-    const queue::CampaignPaths paths(db_path, store.files(db_path));
-    const auto who = queue::make_identity("bench", 1);
-    double t_claim = 0, t_beat = 0, t_done = 0;
-    long k = 0;
-    for (;; ++k) {
-      auto t0 = Clock::now();
-      auto c = queue::claim(db, who, paths, 60);
-      t_claim += since(t0);
-      if (!c) break;
-      t0 = Clock::now();
-      queue::heartbeat(db, *c, 60, 0.5, "noop", "");
-      t_beat += since(t0);
-      queue::Completion done;
-      done.output_rel = c->output_rel;
-      done.sha256 = std::string(64, '0');
-      done.metrics = {{"noop_value", k}};
-      t0 = Clock::now();
-      queue::complete(db, *c, done);
-      t_done += since(t0);
-    }
-    fmt::print("per operation, one process, {} jobs:  claim {:.3f} ms   heartbeat {:.3f} ms   complete {:.3f} ms\n\n",
-               k, 1e3 * t_claim / std::max(1L, k), 1e3 * t_beat / std::max(1L, k), 1e3 * t_done / std::max(1L, k));
-  }
-
-  // 2. Worker processes end to end.
+/// 2. Worker processes end to end.
+void bench_workers(const BenchQueueOptions& o, BenchStore& store, const std::string& exe) {
   fmt::print("{:>8} {:>8} {:>10} {:>10} {:>10}\n", "workers", "jobs", "wall_s", "jobs_per_s", "all_done");
   for (int w : o.workers) {
     const std::string db_path = store.fresh(fmt::format("work_{}", w));
@@ -154,28 +140,48 @@ void run_bench_queue(const BenchQueueOptions& o) {
     fmt::print("{:>8} {:>8} {:>10.2f} {:>10.0f} {:>10}\n", w, o.jobs, wall, static_cast<double>(done) / wall,
                done == o.jobs && code == 0 ? "yes" : fmt::format("NO ({} done, exit {})", done, code));
   }
+}
 
-  // 3. status on a large queue.
-  {
-    const std::string db_path = store.fresh("status");
-    const double submit_s = make_campaign(db_path, o.status_jobs);
-    db::Database db(db_path);
-    double best = 1e9;
-    for (int i = 0; i < 5; ++i) {
-      const auto t0 = Clock::now();
-      const auto s = queue::status(db);
-      best = std::min(best, since(t0));
-      if (s.per_sweep.empty()) throw std::runtime_error("bench-queue: status saw no jobs");
-    }
+/// 3. status on a large queue.
+void bench_status(const BenchQueueOptions& o, BenchStore& store, const std::string& exe) {
+  const std::string db_path = store.fresh("status");
+  const double submit_s = make_campaign(db_path, o.status_jobs);
+  db::Database db(db_path);
+  double best = 1e9;
+  for (int i = 0; i < 5; ++i) {
     const auto t0 = Clock::now();
-    const pid_t pid = queue::spawn_process(exe, {"status", "--db", db_path}, true);
-    const int code = queue::wait_process(pid);
-    const double cli_s = since(t0);
-    fmt::print(
-        "\n{} queued jobs: submit {:.2f} s ({:.0f} jobs/s); status query {:.1f} ms (best of 5); "
-        "`gravsweep status` process {:.1f} ms (exit {})\n",
-        o.status_jobs, submit_s, static_cast<double>(o.status_jobs) / submit_s, 1e3 * best, 1e3 * cli_s, code);
+    const auto s = queue::status(db);
+    best = std::min(best, since(t0));
+    if (s.per_sweep.empty()) throw std::runtime_error("bench-queue: status saw no jobs");
   }
+  const auto t0 = Clock::now();
+  const pid_t pid = queue::spawn_process(exe, {"status", "--db", db_path}, true);
+  const int code = queue::wait_process(pid);
+  const double cli_s = since(t0);
+  fmt::print(
+      "\n{} queued jobs: submit {:.2f} s ({:.0f} jobs/s); status query {:.1f} ms (best of 5); "
+      "`gravsweep status` process {:.1f} ms (exit {})\n",
+      o.status_jobs, submit_s, static_cast<double>(o.status_jobs) / submit_s, 1e3 * best, 1e3 * cli_s, code);
+}
+
+void run_bench_queue(const BenchQueueOptions& o) {
+  fs::path dir = o.dir;
+  if (dir.empty()) {
+    std::string tmpl = (fs::temp_directory_path() / "gravsweep-bench-queue-XXXXXX").string();
+    if (!mkdtemp(tmpl.data())) throw std::runtime_error("cannot create a temporary directory");
+    dir = tmpl;
+  }
+  fs::create_directories(dir);
+  BenchStore store{o.server, dir, {}};
+  const std::string exe = queue::self_exe();
+  fmt::print(
+      "scheduler overhead with no-op jobs on {} (each: claim in one transaction, one heartbeat, output file "
+      "written + fsynced + renamed + checksummed, fenced completion with results row)\n\n",
+      o.server.empty() ? std::string("SQLite") : "PostgreSQL at " + o.server);
+
+  bench_operations(o, store);
+  bench_workers(o, store, exe);
+  bench_status(o, store, exe);
   if (!o.keep) store.drop_all();
   if (!o.keep && o.dir.empty())
     fs::remove_all(dir);

@@ -31,11 +31,49 @@ struct ImportOptions {
   bool keep_going = false;
 };
 
-}  // namespace
+/// `measurements import`: read, check, store, print the table of metrics.
+void run_import(const ImportOptions& o) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(o.db) && fs::equivalent(o.db, o.dir, ec))
+    throw UsageError(fmt::format("--db '{}': the campaign read; another file expected", o.db));
+  auto in = load_campaign_input(o.dir, o.where, o.cutoff_hz, o.files);
+  describe_input(o.dir, in);
+  const results::Campaign& c = in.campaign;
+  std::size_t bad = 0;
+  for (const auto& is : c.issues) bad += is.kind == results::ImportIssue::Kind::bad_input;
+  if (bad > 0 && !o.keep_going)
+    throw UsageError(
+        fmt::format("{}: {} trial{} with bad input (listed above); nothing written to {} "
+                    "(--keep-going stores the others)",
+                    o.dir, bad, bad == 1 ? "" : "s", o.db));
+  if (c.trials.empty()) throw UsageError(fmt::format("{}: no usable trials; nothing written to {}", o.dir, o.db));
+  int stored = 0;
+  {
+    db::Database db(o.db);
+    stored = results::store_campaign(db, c);
+  }
+  // A clipped accelerometer's apeak is a lower bound: its column holds the clip level.
+  results::Table t({"trial_id", "source", "gravity_m_s2", "vc_m_s", "apeak_m_s2", "zstop_mm", "tstop_ms", "bias_m_s2",
+                    "rebound", "clipped_at_m_s2"});
+  for (const auto& tr : c.trials) {
+    const auto& m = tr.processed.metrics;
+    const bool clipped = tr.info.clipped_at_m_s2 > 0;
+    t.add({tr.info.trial_id, results::to_string(tr.info.source), results::num(tr.info.gravity_m_s2),
+           results::num(m.vc_m_s), results::num(m.apeak_m_s2), results::num(1e3 * m.zstop_m),
+           results::num(1e3 * m.tstop_s), results::num(tr.processed.bias_m_s2, 3), m.rebound ? "yes" : "no",
+           clipped ? results::num(tr.info.clipped_at_m_s2) : ""});
+  }
+  t.print(o.format);
+  std::fprintf(stderr, "%d trials stored in %s (read from %s: %s), %zu not usable\n", stored, o.db.c_str(),
+               o.dir.c_str(), in.kind.c_str(), c.issues.size());
+  for (const auto& tr : c.trials)
+    if (const std::string clip = results::clip_summary(tr); !clip.empty())
+      std::fprintf(stderr, "warning: trial %s: %s\n", tr.info.trial_id.c_str(), clip.c_str());
+  if (!c.issues.empty()) throw ExitWith{kExitIncomplete};  // finished, but some trials failed
+}
 
-void setup_measurements(CLI::App& app) {
-  auto* sub = app.add_subcommand("measurements", "Laboratory measurement campaigns (import).");
-  sub->require_subcommand(1);
+void setup_import(CLI::App* sub) {
   auto o = std::make_shared<ImportOptions>();
   auto* imp = sub->add_subcommand(
       "import",
@@ -68,6 +106,10 @@ void setup_measurements(CLI::App& app) {
   imp->add_option("--cutoff", o->cutoff_hz, "low-pass cut-off, Hz")->capture_default_str();
   add_input_files_option(imp, o->files);
   add_format_option(imp, o->format);
+  imp->callback([o]() { run_import(*o); });
+}
+
+void setup_from_runs(CLI::App* sub) {
   auto runs = std::make_shared<std::vector<std::string>>();
   auto runs_out = std::make_shared<std::string>();
   auto* fr = sub->add_subcommand(
@@ -91,47 +133,15 @@ void setup_measurements(CLI::App& app) {
       throw UsageError("no readable trace.h5 (run folders) or <campaign>.files/traces/*.h5 under the given folders");
     if (!issues.empty()) throw ExitWith{kExitIncomplete};
   });
+}
 
-  imp->callback([o]() {
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    if (fs::exists(o->db) && fs::equivalent(o->db, o->dir, ec))
-      throw UsageError(fmt::format("--db '{}': the campaign read; another file expected", o->db));
-    auto in = load_campaign_input(o->dir, o->where, o->cutoff_hz, o->files);
-    describe_input(o->dir, in);
-    const results::Campaign& c = in.campaign;
-    std::size_t bad = 0;
-    for (const auto& is : c.issues) bad += is.kind == results::ImportIssue::Kind::bad_input;
-    if (bad > 0 && !o->keep_going)
-      throw UsageError(
-          fmt::format("{}: {} trial{} with bad input (listed above); nothing written to {} "
-                      "(--keep-going stores the others)",
-                      o->dir, bad, bad == 1 ? "" : "s", o->db));
-    if (c.trials.empty()) throw UsageError(fmt::format("{}: no usable trials; nothing written to {}", o->dir, o->db));
-    int stored = 0;
-    {
-      db::Database db(o->db);
-      stored = results::store_campaign(db, c);
-    }
-    // A clipped accelerometer's apeak is a lower bound: its column holds the clip level.
-    results::Table t({"trial_id", "source", "gravity_m_s2", "vc_m_s", "apeak_m_s2", "zstop_mm", "tstop_ms", "bias_m_s2",
-                      "rebound", "clipped_at_m_s2"});
-    for (const auto& tr : c.trials) {
-      const auto& m = tr.processed.metrics;
-      const bool clipped = tr.info.clipped_at_m_s2 > 0;
-      t.add({tr.info.trial_id, results::to_string(tr.info.source), results::num(tr.info.gravity_m_s2),
-             results::num(m.vc_m_s), results::num(m.apeak_m_s2), results::num(1e3 * m.zstop_m),
-             results::num(1e3 * m.tstop_s), results::num(tr.processed.bias_m_s2, 3), m.rebound ? "yes" : "no",
-             clipped ? results::num(tr.info.clipped_at_m_s2) : ""});
-    }
-    t.print(o->format);
-    std::fprintf(stderr, "%d trials stored in %s (read from %s: %s), %zu not usable\n", stored, o->db.c_str(),
-                 o->dir.c_str(), in.kind.c_str(), c.issues.size());
-    for (const auto& tr : c.trials)
-      if (const std::string clip = results::clip_summary(tr); !clip.empty())
-        std::fprintf(stderr, "warning: trial %s: %s\n", tr.info.trial_id.c_str(), clip.c_str());
-    if (!c.issues.empty()) throw ExitWith{kExitIncomplete};  // finished, but some trials failed
-  });
+}  // namespace
+
+void setup_measurements(CLI::App& app) {
+  auto* sub = app.add_subcommand("measurements", "Laboratory measurement campaigns (import).");
+  sub->require_subcommand(1);
+  setup_import(sub);
+  setup_from_runs(sub);
 }
 
 }  // namespace gravsweep::cli

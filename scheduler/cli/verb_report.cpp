@@ -138,6 +138,76 @@ results::HtmlReport report_page(const std::string& dir, const CampaignInput& in,
   return page;
 }
 
+/// The 'before' model and the 'after' one: --model, or the baseline plus the terms `d` added.
+std::pair<results::ModelSpec, results::ModelSpec> report_models(const ReportOptions& o, const results::Campaign& c,
+                                                                results::Discovery& d) {
+  results::ModelSpec base, after;
+  try {
+    base = results::parse_model(o.baseline);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  d = results::discover(c, base, o.folds);
+  if (!o.model.empty()) {
+    try {
+      after = results::parse_model(o.model);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
+  } else {
+    after = base;
+    for (const auto& n : d.added) {
+      const auto& t = results::find_term(n);
+      after.terms.push_back({&t, t.per_gravity, 1.0});
+    }
+  }
+  return {base, after};
+}
+
+/// summary.md: the page's tables as text, and the figures that were drawn.
+void write_summary_md(const std::string& out, const results::HtmlReport& page, bool with_issues) {
+  namespace fs = std::filesystem;
+  std::ofstream md(fs::path(out) / "summary.md");
+  md << fmt::format("# {}\n\n{}", page.title, page.summary);
+  md << fmt::format("{}\n\n", with_issues ? ":" : "");
+  for (const auto& is : page.issues) md << fmt::format("- {}\n", is);
+  md << fmt::format("{}## Verdict\n\n{}\n\n", with_issues ? "\n" : "", page.verdict);
+  for (const auto& sec : page.sections) {
+    md << fmt::format("## {}\n\n{}```\n", sec.heading, sec.text.empty() ? "" : sec.text + "\n\n");
+    for (std::size_t i = 0; i < sec.tables.size(); ++i)
+      md << (i ? "\n" : "") << (sec.tables[i].first.empty() ? "" : sec.tables[i].first + ":\n")
+         << sec.tables[i].second.render("table");
+    md << "```\n\n";
+  }
+  md << "## Figures\n\n";
+  for (const auto& f : page.figures)
+    if (fs::exists(fs::path(out) / f.file)) md << fmt::format("![{}]({})\n\n{}\n\n", f.file, f.file, f.caption);
+}
+
+void run_report(const ReportOptions& o) {
+  const std::string inputs = fmt::format("{}", fmt::join(o.dirs, " + "));
+  auto in = load_campaign_inputs(o.dirs, o.where, 500.0, o.files);
+  const results::Campaign& c = in.campaign;
+  if (c.trials.size() < 6) throw UsageError(fmt::format("{}: only {} usable trials", inputs, c.trials.size()));
+  results::Discovery d;
+  const auto [base, after] = report_models(o, c, d);
+  std::vector<results::ModelSpec> specs{base};
+  if (after.name() != base.name()) specs.push_back(after);
+  const auto cm = results::compare_models(c, specs, o.folds);
+  results::write_report_data(o.out, c, cm, specs, &d);
+  std::string log;
+  const int rc = results::run_plots(o.out, "all", log);
+  if (rc != 0) throw std::runtime_error("plotting failed (python3 with matplotlib needed): " + log);
+  // The same tables in summary.md and index.html.
+  namespace fs = std::filesystem;
+  results::HtmlReport page = report_page(inputs, in, d, cm);
+  write_summary_md(o.out, page, !c.issues.empty());
+  const fs::path html = results::write_html_report(o.out, page);
+  fmt::print("{}", log);
+  fmt::print("{}\n{} (one self-contained page: open it in a browser)\nverdict: {}\n",
+             (fs::path(o.out) / "summary.md").string(), html.string(), d.verdict);
+}
+
 }  // namespace
 
 void setup_report(CLI::App& app) {
@@ -167,61 +237,7 @@ void setup_report(CLI::App& app) {
   sub->add_option("--baseline", o->baseline, "the 'before' model")->capture_default_str();
   sub->add_option("--model", o->model, "the 'after' model (default: baseline + discovered terms)");
   sub->add_option("--folds", o->folds, "cross-validation folds")->check(CLI::Range(2, 100))->capture_default_str();
-  sub->callback([o]() {
-    const std::string inputs = fmt::format("{}", fmt::join(o->dirs, " + "));
-    auto in = load_campaign_inputs(o->dirs, o->where, 500.0, o->files);
-    const results::Campaign& c = in.campaign;
-    if (c.trials.size() < 6) throw UsageError(fmt::format("{}: only {} usable trials", inputs, c.trials.size()));
-    results::ModelSpec base, after;
-    try {
-      base = results::parse_model(o->baseline);
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(e.what());
-    }
-    const auto d = results::discover(c, base, o->folds);
-    if (!o->model.empty()) {
-      try {
-        after = results::parse_model(o->model);
-      } catch (const std::invalid_argument& e) {
-        throw UsageError(e.what());
-      }
-    } else {
-      after = base;
-      for (const auto& n : d.added) {
-        const auto& t = results::find_term(n);
-        after.terms.push_back({&t, t.per_gravity, 1.0});
-      }
-    }
-    std::vector<results::ModelSpec> specs{base};
-    if (after.name() != base.name()) specs.push_back(after);
-    const auto cm = results::compare_models(c, specs, o->folds);
-    results::write_report_data(o->out, c, cm, specs, &d);
-    std::string log;
-    const int rc = results::run_plots(o->out, "all", log);
-    if (rc != 0) throw std::runtime_error("plotting failed (python3 with matplotlib needed): " + log);
-    // The same tables in summary.md and index.html.
-    namespace fs = std::filesystem;
-    results::HtmlReport page = report_page(inputs, in, d, cm);
-    std::ofstream md(fs::path(o->out) / "summary.md");
-    md << fmt::format("# {}\n\n{}", page.title, page.summary);
-    md << fmt::format("{}\n\n", c.issues.empty() ? "" : ":");
-    for (const auto& is : page.issues) md << fmt::format("- {}\n", is);
-    md << fmt::format("{}## Verdict\n\n{}\n\n", c.issues.empty() ? "" : "\n", page.verdict);
-    for (const auto& sec : page.sections) {
-      md << fmt::format("## {}\n\n{}```\n", sec.heading, sec.text.empty() ? "" : sec.text + "\n\n");
-      for (std::size_t i = 0; i < sec.tables.size(); ++i)
-        md << (i ? "\n" : "") << (sec.tables[i].first.empty() ? "" : sec.tables[i].first + ":\n")
-           << sec.tables[i].second.render("table");
-      md << "```\n\n";
-    }
-    md << "## Figures\n\n";
-    for (const auto& f : page.figures)
-      if (fs::exists(fs::path(o->out) / f.file)) md << fmt::format("![{}]({})\n\n{}\n\n", f.file, f.file, f.caption);
-    const fs::path html = results::write_html_report(o->out, page);
-    fmt::print("{}", log);
-    fmt::print("{}\n{} (one self-contained page: open it in a browser)\nverdict: {}\n",
-               (fs::path(o->out) / "summary.md").string(), html.string(), d.verdict);
-  });
+  sub->callback([o]() { run_report(*o); });
 }
 
 }  // namespace gravsweep::cli

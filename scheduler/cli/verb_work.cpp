@@ -57,8 +57,9 @@ int final_code(const std::string& db_path) {
   return st.get_int(0) > 0 ? kExitIncomplete : kExitOk;
 }
 
-int supervise(const WorkOptions& o, int threads) {
-  // Children are this binary again with --workers 1: each opens its own connection after exec.
+/// The command line of one worker process: this binary again with --workers 1 and the
+/// supervisor's options (each child opens its own database connection after exec).
+std::vector<std::string> worker_args(const WorkOptions& o, int threads) {
   std::vector<std::string> args = {"work",
                                    "--db",
                                    o.db,
@@ -87,48 +88,53 @@ int supervise(const WorkOptions& o, int threads) {
   args.insert(args.end(), {"--checkpoint-interval", fmt::format("{}", o.checkpoint_interval_s)});
   if (o.quiet) args.push_back("--quiet");
   if (o.max_jobs >= 0) args.insert(args.end(), {"--max-jobs", std::to_string(o.max_jobs)});
-  // Block SIGINT/SIGTERM here while forking; the supervisor forwards them to the children.
-  sigset_t set, old;
-  sigemptyset(&set);
-  sigaddset(&set, SIGINT);
-  sigaddset(&set, SIGTERM);
-  sigprocmask(SIG_BLOCK, &set, &old);
+  return args;
+}
+
+/// Forks `n` children that exec `args` with the signal mask `old` restored. Workers die with
+/// their supervisor: SIGTERM when it dies (any way, SIGKILL included; kept across exec), and the
+/// worker checks its parent too (queue::run_worker) in case it died before the prctl.
+std::vector<pid_t> fork_workers(int n, const std::vector<std::string>& args, const sigset_t& old) {
   const std::string exe = queue::self_exe();
   const pid_t supervisor = getpid();
   const std::string supervisor_env = std::to_string(supervisor);
   std::vector<pid_t> kids;
-  for (int i = 0; i < o.workers; ++i) {
+  for (int i = 0; i < n; ++i) {
     pid_t pid = fork();
     if (pid < 0) throw std::runtime_error("fork failed");
     if (pid == 0) {
-      // Workers die with their supervisor: SIGTERM when it dies (any way, SIGKILL included; kept
-      // across exec), and the worker checks its parent too (queue::run_worker) in case it died
-      // before the prctl.
       prctl(PR_SET_PDEATHSIG, SIGTERM);
       if (getppid() != supervisor) _exit(kExitInterrupted);
       setenv("GRAVSWEEP_SUPERVISOR_PID", supervisor_env.c_str(), 1);
       sigprocmask(SIG_SETMASK, &old, nullptr);
       std::vector<char*> argv{const_cast<char*>(exe.c_str())};
-      for (auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+      for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
       argv.push_back(nullptr);
       execv(exe.c_str(), argv.data());
       _exit(kExitExecFailed);
     }
     kids.push_back(pid);
   }
-  if (!o.quiet)
-    fmt::print(stderr, "gravsweep work: {} worker processes ({} threads each) on {}\n", o.workers, threads, o.db);
-  bool interrupted = false;
-  int failures = 0;
+  return kids;
+}
+
+/// How the worker processes ended.
+struct WorkersEnded {
+  bool interrupted = false;  ///< a signal reached the supervisor, or a worker was interrupted
+  int failures = 0;          ///< workers that exited with another code than 0 or 4
+};
+
+/// Waits for every child, forwarding SIGINT/SIGTERM (blocked in `signals`) to them.
+WorkersEnded wait_for_workers(std::vector<pid_t> kids, const sigset_t& signals) {
+  WorkersEnded e;
   std::size_t alive = kids.size();
   while (alive > 0) {
     // Wait for a child or a signal, whichever comes first.
-    int sig = 0;
     timespec ts{0, 200'000'000};
     siginfo_t info{};
-    sig = sigtimedwait(&set, &info, &ts);
+    const int sig = sigtimedwait(&signals, &info, &ts);
     if (sig == SIGINT || sig == SIGTERM) {
-      interrupted = true;
+      e.interrupted = true;
       for (pid_t k : kids)
         if (k > 0) kill(k, SIGTERM);
     }
@@ -141,17 +147,32 @@ int supervise(const WorkOptions& o, int threads) {
         --alive;
         const int code = WIFEXITED(status) ? WEXITSTATUS(status) : kExitSignalBase + WTERMSIG(status);
         if (code == kExitInterrupted)
-          interrupted = true;
+          e.interrupted = true;
         else if (code != kExitOk && code != kExitIncomplete) {
-          ++failures;
+          ++e.failures;
           fmt::print(stderr, "gravsweep work: worker {} exited with code {}\n", done, code);
         }
       }
     }
   }
+  return e;
+}
+
+int supervise(const WorkOptions& o, int threads) {
+  const std::vector<std::string> args = worker_args(o, threads);
+  // Block SIGINT/SIGTERM here while forking; the supervisor forwards them to the children.
+  sigset_t set, old;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  sigprocmask(SIG_BLOCK, &set, &old);
+  const std::vector<pid_t> kids = fork_workers(o.workers, args, old);
+  if (!o.quiet)
+    fmt::print(stderr, "gravsweep work: {} worker processes ({} threads each) on {}\n", o.workers, threads, o.db);
+  const WorkersEnded e = wait_for_workers(kids, set);
   sigprocmask(SIG_SETMASK, &old, nullptr);
-  if (interrupted) return kExitInterrupted;
-  if (failures > 0) return kExitFailure;
+  if (e.interrupted) return kExitInterrupted;
+  if (e.failures > 0) return kExitFailure;
   return final_code(o.db);
 }
 
@@ -200,6 +221,63 @@ int run_work(const WorkOptions& o) {
   return final_code(o.db);
 }
 
+/// --workers .. --checkpoint-interval: how many workers, their threads, leases, retries, disk and
+/// checkpoints.
+void add_work_options(CLI::App* sub, WorkOptions& o) {
+  sub->add_option("--workers", o.workers, "worker processes")->check(CLI::Range(1, 256))->capture_default_str();
+  sub->add_option("--threads", o.threads, "engine threads per worker (0: cores / workers)")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
+  sub->add_option("--pool-threads", o.pool_threads,
+                  "threads all the workers hold together (the supervisor passes workers x threads): a bed "
+                  "job that runs alone, with nothing else running or claimable, uses them all (0: --threads)")
+      ->check(CLI::Range(0, 4096))
+      ->capture_default_str();
+  sub->add_flag("--follow", o.follow, "keep waiting for new jobs when none is left");
+  sub->add_option("--lease", o.lease_s, "lease length, s: a worker silent this long is presumed dead")
+      ->check(CLI::Range(0.5, 86400.0))
+      ->capture_default_str();
+  sub->add_option("--heartbeat", o.heartbeat_s,
+                  "heartbeat (lease renewal + progress) interval, s (0: min(lease/4, 2 s))")
+      ->check(CLI::Range(0.0, 3600.0))
+      ->capture_default_str();
+  sub->add_option("--poll", o.poll_s, "wait between claims when nothing is runnable, s")
+      ->check(CLI::Range(0.01, 60.0))
+      ->capture_default_str();
+  sub->add_option("--min-free-mb", o.min_free_mb,
+                  "free space, MB, the files root must keep beyond the largest output so far: below it the "
+                  "worker claims nothing and stops (exit 1; --follow: waits), and an attempt that failed on a "
+                  "full disk goes back without being counted")
+      ->check(CLI::Range(0.0, 1e9))
+      ->capture_default_str();
+  sub->add_option("--db-outage", o.db_outage_s,
+                  "seconds a worker keeps reconnecting, with backoff, to a PostgreSQL server that restarted or "
+                  "went away before it gives up; its running job goes on meanwhile")
+      ->check(CLI::Range(0.0, 86400.0))
+      ->capture_default_str();
+  sub->add_option("--max-releases", o.max_releases,
+                  "a job whose attempts were interrupted (SIGINT/SIGTERM, a Slurm time limit) this many times in a "
+                  "row without saving progress (a drop's checkpoint further on) is stopped (dead, with the reason) "
+                  "instead of looping; `resume --dead` runs it again")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
+  sub->add_option("--backoff", o.backoff_s, "retry backoff base, s (base * 2^(attempt-1), capped at 300 s)")
+      ->check(CLI::Range(0.0, 3600.0))
+      ->capture_default_str();
+  sub->add_option("--max-jobs", o.max_jobs, "stop after this many jobs per worker (-1: no limit)")
+      ->capture_default_str();
+  sub->add_option("--bed-cache", o.bed_cache,
+                  "folder of prepared beds shared between campaigns and machines: a bed job whose bed is "
+                  "there (<bed job id>.h5 + .sha256, checksum and bed key verified) copies it instead of "
+                  "preparing it; a bed job that prepares its bed stores it there");
+  sub->add_option("--checkpoint-interval", o.checkpoint_interval_s,
+                  "wall seconds between two checkpoints of a running drop (<files>/checkpoints/<job>.ckpt.h5; "
+                  "also written at SIGTERM); the next attempt of the job continues from it, bit for bit on "
+                  "the same thread count. 0: no checkpoints")
+      ->check(CLI::Range(0.0, 1e7))
+      ->capture_default_str();
+}
+
 }  // namespace
 
 void setup_work(CLI::App& app) {
@@ -225,58 +303,7 @@ void setup_work(CLI::App& app) {
       "  gravsweep work --db campaign.db --follow          # a worker that waits for new submissions\n"
       "  gravsweep work --db postgresql://me@dbhost:5432/sweep --files /shared/sweep --threads 4");
   add_campaign_options(sub, opt->db, &opt->files);
-  sub->add_option("--workers", opt->workers, "worker processes")->check(CLI::Range(1, 256))->capture_default_str();
-  sub->add_option("--threads", opt->threads, "engine threads per worker (0: cores / workers)")
-      ->check(CLI::Range(0, 1024))
-      ->capture_default_str();
-  sub->add_option("--pool-threads", opt->pool_threads,
-                  "threads all the workers hold together (the supervisor passes workers x threads): a bed "
-                  "job that runs alone, with nothing else running or claimable, uses them all (0: --threads)")
-      ->check(CLI::Range(0, 4096))
-      ->capture_default_str();
-  sub->add_flag("--follow", opt->follow, "keep waiting for new jobs when none is left");
-  sub->add_option("--lease", opt->lease_s, "lease length, s: a worker silent this long is presumed dead")
-      ->check(CLI::Range(0.5, 86400.0))
-      ->capture_default_str();
-  sub->add_option("--heartbeat", opt->heartbeat_s,
-                  "heartbeat (lease renewal + progress) interval, s (0: min(lease/4, 2 s))")
-      ->check(CLI::Range(0.0, 3600.0))
-      ->capture_default_str();
-  sub->add_option("--poll", opt->poll_s, "wait between claims when nothing is runnable, s")
-      ->check(CLI::Range(0.01, 60.0))
-      ->capture_default_str();
-  sub->add_option("--min-free-mb", opt->min_free_mb,
-                  "free space, MB, the files root must keep beyond the largest output so far: below it the "
-                  "worker claims nothing and stops (exit 1; --follow: waits), and an attempt that failed on a "
-                  "full disk goes back without being counted")
-      ->check(CLI::Range(0.0, 1e9))
-      ->capture_default_str();
-  sub->add_option("--db-outage", opt->db_outage_s,
-                  "seconds a worker keeps reconnecting, with backoff, to a PostgreSQL server that restarted or "
-                  "went away before it gives up; its running job goes on meanwhile")
-      ->check(CLI::Range(0.0, 86400.0))
-      ->capture_default_str();
-  sub->add_option("--max-releases", opt->max_releases,
-                  "a job whose attempts were interrupted (SIGINT/SIGTERM, a Slurm time limit) this many times in a "
-                  "row without saving progress (a drop's checkpoint further on) is stopped (dead, with the reason) "
-                  "instead of looping; `resume --dead` runs it again")
-      ->check(CLI::Range(1, 1000000))
-      ->capture_default_str();
-  sub->add_option("--backoff", opt->backoff_s, "retry backoff base, s (base * 2^(attempt-1), capped at 300 s)")
-      ->check(CLI::Range(0.0, 3600.0))
-      ->capture_default_str();
-  sub->add_option("--max-jobs", opt->max_jobs, "stop after this many jobs per worker (-1: no limit)")
-      ->capture_default_str();
-  sub->add_option("--bed-cache", opt->bed_cache,
-                  "folder of prepared beds shared between campaigns and machines: a bed job whose bed is "
-                  "there (<bed job id>.h5 + .sha256, checksum and bed key verified) copies it instead of "
-                  "preparing it; a bed job that prepares its bed stores it there");
-  sub->add_option("--checkpoint-interval", opt->checkpoint_interval_s,
-                  "wall seconds between two checkpoints of a running drop (<files>/checkpoints/<job>.ckpt.h5; "
-                  "also written at SIGTERM); the next attempt of the job continues from it, bit for bit on "
-                  "the same thread count. 0: no checkpoints")
-      ->check(CLI::Range(0.0, 1e7))
-      ->capture_default_str();
+  add_work_options(sub, *opt);
   sub->add_flag("--quiet", opt->quiet, "no per-job log lines");
   sub->callback([opt]() {
     const int code = run_work(*opt);

@@ -455,21 +455,10 @@ std::uint64_t site_seed(const json& s) {
   return std::stoull(hex.substr(0, 16), nullptr, 16);
 }
 
-ScenarioParams scenario_params(const json& s) {
-  ScenarioParams out;
-  out.gravity_m_s2 = s.at("gravity_m_s2");
-  const double settle_g = s["/bed/settle_gravity_m_s2"_json_pointer].get<double>() > 0
-                              ? s["/bed/settle_gravity_m_s2"_json_pointer].get<double>()
-                              : out.gravity_m_s2;
-  out.bed_config = base_config(s, bed_materials(s));
-  out.bed_config.dt_s = s["/bed/dt_s"_json_pointer];
-  out.bed_config.gravity_m_s2 = Vec3(0, 0, -settle_g);
-  out.drop_config = base_config(s, s.at("materials"));
-  out.drop_config.dt_s = s.at("dt_s");
-  out.drop_config.gravity_m_s2 = Vec3(0, 0, -out.gravity_m_s2);
-  out.drop_config.options.min_roll_vel_m_s = drop_min_roll_vel_m_s(s);
-
-  BedSpec& b = out.bed;
+/// /container, /grains and /bed as the engine's BedSpec (`settle_g`: the gravity the bed settles
+/// at; relaxed at `gravity_m_s2` when they differ).
+BedSpec bed_spec_of(const json& s, double settle_g, double gravity_m_s2) {
+  BedSpec b;
   b.container.diameter_m = s["/container/diameter_m"_json_pointer];
   b.grains.diameter_m = s["/grains/diameter_m"_json_pointer];
   b.grains.diameter_spread_m = s["/grains/diameter_spread_m"_json_pointer];
@@ -491,7 +480,7 @@ ScenarioParams scenario_params(const json& s) {
   b.relax_time_s = bj.at("relax_time_s");
   b.grain_material = kGrainMaterial;
   b.wall_material = kWallMaterial;
-  if (settle_g != out.gravity_m_s2) b.relax_gravity_m_s2 = Vec3(0, 0, -out.gravity_m_s2);
+  if (settle_g != gravity_m_s2) b.relax_gravity_m_s2 = Vec3(0, 0, -gravity_m_s2);
   b.gravity_ramp_s = bj.at("gravity_ramp_s");
   if (bj.contains("quench")) {
     b.quench_interval_s = bj["/quench/interval_s"_json_pointer];
@@ -503,9 +492,13 @@ ScenarioParams scenario_params(const json& s) {
     b.time_step.steps_per_contact = bj["/time_step/steps_per_contact"_json_pointer];
     b.time_step.dt_max_s = bj["/time_step/dt_max_s"_json_pointer];
   }
+  return b;
+}
 
+/// /projectile as the engine's ProjectileSpec, its random start drawn from the point's site seed.
+ProjectileSpec projectile_spec_of(const json& s, double grain_diameter_m) {
   const json& pj = s.at("projectile");
-  ProjectileSpec& ps = out.projectile;
+  ProjectileSpec ps;
   ps.diameter_m = pj.at("diameter_m");
   ps.mass_kg = pj.at("mass_kg");
   ps.material = kProjectileMaterial;
@@ -515,13 +508,32 @@ ScenarioParams scenario_params(const json& s) {
   // Random start (paper, Chrono repeats: radial and vertical start within two grain diameters).
   std::mt19937_64 rng(site_seed(s));
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  const double lat = pj.at("lateral_offset_max_grain_diameters").get<double>() * b.grains.diameter_m;
+  const double lat = pj.at("lateral_offset_max_grain_diameters").get<double>() * grain_diameter_m;
   const double r = lat * std::sqrt(u(rng));
   const double phi = 2 * kPi * u(rng);
   ps.lateral_offset_x_m = r * std::cos(phi);
   ps.lateral_offset_y_m = r * std::sin(phi);
-  ps.vertical_offset_m = pj.at("vertical_offset_max_grain_diameters").get<double>() * b.grains.diameter_m * u(rng);
+  ps.vertical_offset_m = pj.at("vertical_offset_max_grain_diameters").get<double>() * grain_diameter_m * u(rng);
+  return ps;
+}
 
+ScenarioParams scenario_params(const json& s) {
+  ScenarioParams out;
+  out.gravity_m_s2 = s.at("gravity_m_s2");
+  const double settle_g = s["/bed/settle_gravity_m_s2"_json_pointer].get<double>() > 0
+                              ? s["/bed/settle_gravity_m_s2"_json_pointer].get<double>()
+                              : out.gravity_m_s2;
+  out.bed_config = base_config(s, bed_materials(s));
+  out.bed_config.dt_s = s["/bed/dt_s"_json_pointer];
+  out.bed_config.gravity_m_s2 = Vec3(0, 0, -settle_g);
+  out.drop_config = base_config(s, s.at("materials"));
+  out.drop_config.dt_s = s.at("dt_s");
+  out.drop_config.gravity_m_s2 = Vec3(0, 0, -out.gravity_m_s2);
+  out.drop_config.options.min_roll_vel_m_s = drop_min_roll_vel_m_s(s);
+
+  out.bed = bed_spec_of(s, settle_g, out.gravity_m_s2);
+  out.projectile = projectile_spec_of(s, out.bed.grains.diameter_m);
+  const ProjectileSpec& ps = out.projectile;
   out.stop = drop_stop(s.at("stop"), out.gravity_m_s2, ps.diameter_m);
   if (s.contains("time_step")) {  // dt_max_s >= dt_s: check_size_and_steps
     out.time_step.steps_per_contact = s["/time_step/steps_per_contact"_json_pointer];
@@ -535,14 +547,6 @@ ScenarioParams scenario_params(const json& s) {
   out.sample_rate_hz = s["/output/sample_rate_hz"_json_pointer];
   out.snapshot_interval_s = s["/output/snapshot_interval_s"_json_pointer];
 
-  results::MetricOptions& mo = out.metric_options;
-  mo.gravity_m_s2 = out.gravity_m_s2;
-  mo.cutoff_hz = s["/output/filter_cutoff_hz"_json_pointer];
-  mo.end_threshold_g = s["/output/end_threshold_g"_json_pointer];
-  mo.end_speed_fraction = s["/output/end_speed_fraction"_json_pointer];
-  mo.fill_height_m = b.fill_height_m;
-  mo.grain_diameter_m = b.grains.diameter_m;
-  mo.projectile_diameter_m = ps.diameter_m;
   return out;
 }
 

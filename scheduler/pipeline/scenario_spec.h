@@ -8,7 +8,6 @@
 #include "engine/scenario/bed.h"
 #include "engine/scenario/impact.h"
 #include "engine/system/system.h"
-#include "results/processing/trace.h"
 #include "spec/json_schema.h"
 
 namespace gravsweep::pipeline {
@@ -67,8 +66,7 @@ struct ScenarioParams {
   AtRestCriterion at_rest;
   double gravity_m_s2 = 9.81;
   double sample_rate_hz = 1e4;
-  double snapshot_interval_s = 0;         ///< /output/snapshot_interval_s: grain snapshots, 0 = none
-  results::MetricOptions metric_options;  ///< fill height and grain diameter set from the bed
+  double snapshot_interval_s = 0;  ///< /output/snapshot_interval_s: grain snapshots, 0 = none
 };
 
 ScenarioParams scenario_params(const nlohmann::json& validated);

@@ -10,28 +10,21 @@ using db::Transaction;
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-SubmitReport submit(Database& db, const SweepRecord& spec, const std::vector<PlannedJob>& jobs) {
-  SubmitReport rep;
-  rep.sweep = spec.name;
-  rep.planned = jobs.size();
-  const double now = clock_s(db);
-  const std::string spec_text = queue::canonical_json(spec.source);
-  Transaction tx(db);
-  {
-    Statement exists(db, "SELECT 1 FROM sweeps WHERE sweep_id=?");
-    exists.bind(1, spec.name);
-    rep.sweep_new = !exists.step();
-  }
-  {
-    Statement st(db,
-                 "INSERT INTO sweeps(sweep_id, job_kind, spec_json, spec_sha256, submitted_at, updated_at) "
-                 "VALUES(?1, ?2, ?3, ?4, ?5, ?5) ON CONFLICT(sweep_id) DO UPDATE SET spec_json=excluded.spec_json, "
-                 "spec_sha256=excluded.spec_sha256, updated_at=excluded.updated_at, submits=sweeps.submits+1");
-    st.bind(1, spec.name).bind(2, spec.job_kind).bind(3, spec_text).bind(4, queue::sha256_hex(spec_text)).bind(5, now);
-    st.run();
-  }
-  // One results column per swept parameter, of a type that fits every value of the axis: 1, 1.5
-  // (canonical 1 is an integer) needs REAL, and so does 2.5 added to an axis that had 1, 2.
+namespace {
+
+/// The sweep's row (its spec as submitted last; `submits` counts the submissions).
+void upsert_sweep(Database& db, const SweepRecord& spec, const std::string& spec_text, double now) {
+  Statement st(db,
+               "INSERT INTO sweeps(sweep_id, job_kind, spec_json, spec_sha256, submitted_at, updated_at) "
+               "VALUES(?1, ?2, ?3, ?4, ?5, ?5) ON CONFLICT(sweep_id) DO UPDATE SET spec_json=excluded.spec_json, "
+               "spec_sha256=excluded.spec_sha256, updated_at=excluded.updated_at, submits=sweeps.submits+1");
+  st.bind(1, spec.name).bind(2, spec.job_kind).bind(3, spec_text).bind(4, queue::sha256_hex(spec_text)).bind(5, now);
+  st.run();
+}
+
+/// One results column per swept parameter, of a type that fits every value of the axis: 1, 1.5
+/// (canonical 1 is an integer) needs REAL, and so does 2.5 added to an axis that had 1, 2.
+void add_param_columns(Database& db, const SweepRecord& spec) {
   auto cols = detail::result_extra_columns(db);
   for (const auto& [name, values] : spec.columns) {
     if (!cols.count(name)) {
@@ -40,6 +33,11 @@ SubmitReport submit(Database& db, const SweepRecord& spec, const std::vector<Pla
     }
     for (const auto& v : values) detail::widen_result_column(db, name, cols[name], v);
   }
+}
+
+/// Each planned job inserted unless present, with its dependencies and its membership of the sweep.
+void insert_jobs(Database& db, const SweepRecord& spec, const std::vector<PlannedJob>& jobs, double now,
+                 SubmitReport& rep) {
   Statement ins(db,
                 "INSERT INTO jobs(job_id, kind, sweep_id, state, priority, deps_pending, max_attempts, params_json, "
                 "scenario_json, created_at) VALUES(?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10) "
@@ -89,6 +87,25 @@ SubmitReport submit(Database& db, const SweepRecord& spec, const std::vector<Pla
     member.bind(1, spec.name).bind(2, j.job_id);
     member.run();
   }
+}
+
+}  // namespace
+
+SubmitReport submit(Database& db, const SweepRecord& spec, const std::vector<PlannedJob>& jobs) {
+  SubmitReport rep;
+  rep.sweep = spec.name;
+  rep.planned = jobs.size();
+  const double now = clock_s(db);
+  const std::string spec_text = queue::canonical_json(spec.source);
+  Transaction tx(db);
+  {
+    Statement exists(db, "SELECT 1 FROM sweeps WHERE sweep_id=?");
+    exists.bind(1, spec.name);
+    rep.sweep_new = !exists.step();
+  }
+  upsert_sweep(db, spec, spec_text, now);
+  add_param_columns(db, spec);
+  insert_jobs(db, spec, jobs, now, rep);
   tx.commit();
   return rep;
 }
