@@ -33,7 +33,7 @@ void add_impact_runners(RunnerTable& table) {
     return out;
   };
   table[JobKind::drop] = [](const RunContext& ctx) {
-    if (ctx.bed_path.empty())
+    if (ctx.dependency_output.empty())
       throw std::runtime_error(fmt::format("drop job {} has no prepared bed", ctx.claim.job_id));
     DropCheckpointing ckpt;
     ckpt.path = ctx.checkpoint;
@@ -41,7 +41,8 @@ void add_impact_runners(RunnerTable& table) {
     ckpt.attempt = ctx.claim.attempt;
     ckpt.save_on_stop = &queue::stop_requested();  // SIGTERM, not a lease taken over
     ckpt.progress_saved = ctx.progress_saved;
-    auto r = run_drop_job(ctx.claim.scenario, ctx.bed_path, ctx.output_tmp, ctx.threads, ctx.progress, ctx.stop, ckpt);
+    auto r = run_drop_job(ctx.claim.scenario, ctx.dependency_output, ctx.output_tmp, ctx.threads, ctx.progress,
+                          ctx.stop, ckpt);
     if (r.trace_path != ctx.output_tmp && !r.trace_path.empty()) std::filesystem::rename(r.trace_path, ctx.output_tmp);
     if (!r.snapshot_path.empty()) {
       // Grain snapshots (/output/snapshot_interval_s > 0): <campaign>.files/snapshots/, a folder that

@@ -146,13 +146,15 @@ std::optional<Claim> claim(Database& db, const WorkerIdentity& who, const Campai
   }
   {
     Statement st(db,
-                 "SELECT coalesce(j.output_path, ''), j.job_id, coalesce(j.output_sha256, '') FROM job_deps d "
-                 "JOIN jobs j ON j.job_id=d.dep_id WHERE d.job_id=? AND j.kind='bed' AND j.state='done'");
+                 "SELECT coalesce(j.output_path, ''), j.job_id, coalesce(j.output_sha256, ''), j.kind FROM job_deps d "
+                 "JOIN jobs j ON j.job_id=d.dep_id WHERE d.job_id=? AND j.state='done' AND j.output_path IS NOT NULL "
+                 "ORDER BY d.dep_id LIMIT 1");
     st.bind(1, c->job_id);
     if (st.step()) {
       c->dep_output_rel = st.get_text(0);
       c->dep_job_id = st.get_text(1);
       c->dep_sha256 = st.get_text(2);
+      c->dep_kind = st.get_text(3);
     }
   }
   c->output_rel = paths.output_rel(c->kind, c->job_id, c->attempt);

@@ -98,7 +98,7 @@ std::string fail(Database& db, const Claim& c, const std::string& error, int exi
   return state;
 }
 
-bool bed_mismatch(Database& db, const Claim& c, const std::string& reason) {
+bool dependency_mismatch(Database& db, const Claim& c, const std::string& reason) {
   const double now = clock_s(db);
   Transaction tx(db);
   {
@@ -112,7 +112,7 @@ bool bed_mismatch(Database& db, const Claim& c, const std::string& reason) {
     if (db.changes() != 1) return false;
   }
   end_attempt(db, c, "failed", now, kExitFailure, reason);
-  {  // the bed is rebuilt once, by whichever drop noticed first
+  {  // the dependency is made again once, by whichever dependent noticed first
     Statement st(db,
                  "UPDATE jobs SET state='queued', output_path=NULL, output_sha256=NULL, output_bytes=NULL, "
                  "finished_at=NULL, last_error=?1, not_before=0, max_attempts=CASE WHEN max_attempts>attempts THEN "
@@ -121,7 +121,7 @@ bool bed_mismatch(Database& db, const Claim& c, const std::string& reason) {
     st.bind(1, reason).bind(2, c.dep_job_id).bind(3, c.dep_sha256);
     st.run();
   }
-  {  // its other drops that have not started wait for the new bed
+  {  // its other dependents that have not started wait for the new output
     Statement st(db,
                  "UPDATE jobs SET state='waiting', deps_pending=deps_pending+1 WHERE state IN ('queued','failed') "
                  "AND job_id IN (SELECT job_id FROM job_deps WHERE dep_id=?)");

@@ -95,9 +95,12 @@ struct Claim {
   std::int64_t token = 0;        ///< fencing token
   std::int64_t attempt_row = 0;  ///< attempts.attempt_id
   std::string output_rel;        ///< where this attempt's output must end up
-  std::string dep_output_rel;    ///< the bed file (drop jobs)
-  std::string dep_job_id;        ///< the bed job (drop jobs)
-  std::string dep_sha256;        ///< the bed file's recorded checksum (verified before use)
+  /// The output this job reads of the job it depends on (a drop: its bed), its job id and its
+  /// recorded checksum, verified before use; empty for a job without a dependency.
+  std::string dep_output_rel;
+  std::string dep_job_id;
+  std::string dep_sha256;
+  std::string dep_kind;  ///< the dependency's job kind, as messages name it
   double claimed_at = 0;
 };
 
@@ -136,10 +139,11 @@ bool complete(db::Database& db, const Claim& c, const Completion& done);
 std::string fail(db::Database& db, const Claim& c, const std::string& error, int exit_code, bool permanent,
                  double backoff_base_s = 2.0, double backoff_cap_s = 300.0);
 
-/// The bed a drop was about to use does not match its recorded checksum: the drop's attempt fails
-/// with `reason`, the drop waits again, and the bed job (if still done with that checksum) is
-/// queued to be rebuilt, its other unstarted drops waiting for it. false = fenced out.
-bool bed_mismatch(db::Database& db, const Claim& c, const std::string& reason);
+/// The dependency's output a job was about to use (a drop's bed) does not match its recorded
+/// checksum: the job's attempt fails with `reason`, the job waits again, and the dependency (if
+/// still done with that checksum) is queued to be made again, its other unstarted dependents
+/// waiting for it. false = fenced out.
+bool dependency_mismatch(db::Database& db, const Claim& c, const std::string& reason);
 
 /// Releases in a row without progress a job may have before it is stopped (dead, with the
 /// reason): a job interrupted at every attempt before it saved anything (a time limit shorter than

@@ -299,7 +299,7 @@ class Worker {
       if (o_.verbose)
         std::fprintf(stderr, "worker %d: %s job %s attempt %d\n", who_.pid, kind_name(c->kind), c->job_id.c_str(),
                      c->attempt);
-      if (!bed_verified(*c)) continue;
+      if (!dependency_verified(*c)) continue;
       if (record(*c, run_attempt(*c)) == Next::stop) break;
     }
     if (queue::stop_requested().load()) rep_.interrupted = true;
@@ -370,20 +370,21 @@ class Worker {
     return c;
   }
 
-  /// The bed is verified before the drop uses it: a changed bit changes every drop's results. A
-  /// mismatch sends the bed back to be rebuilt and the drop to wait for it (false).
-  bool bed_verified(const Claim& c) {
+  /// The dependency's output is verified before the job uses it (a drop's bed: a changed bit changes
+  /// every drop's results). A mismatch sends the dependency back to be made again and the job to
+  /// wait for it (false).
+  bool dependency_verified(const Claim& c) {
     if (c.dep_output_rel.empty() || c.dep_sha256.empty()) return true;
     std::error_code ec;
-    const fs::path bed = paths_.abs(c.dep_output_rel);
-    const std::string found = fs::exists(bed, ec) ? queue::sha256_file(bed) : std::string("missing");
+    const fs::path dep = paths_.abs(c.dep_output_rel);
+    const std::string found = fs::exists(dep, ec) ? queue::sha256_file(dep) : std::string("missing");
     if (found == c.dep_sha256) return true;
+    const std::string& kind = c.dep_kind;
     const std::string why = fmt::format(
-        "bed checksum mismatch: '{}' of bed job {} has sha256 {}, recorded {}; the bed is rebuilt and the drop "
-        "waits for it",
-        bed.string(), c.dep_job_id, found, c.dep_sha256);
+        "{} checksum mismatch: '{}' of {} job {} has sha256 {}, recorded {}; it is made again and job {} waits for it",
+        kind, dep.string(), kind, c.dep_job_id, found, c.dep_sha256, c.job_id);
     std::fprintf(stderr, "worker %d: job %s: %s\n", who_.pid, c.job_id.c_str(), why.c_str());
-    if (with_db_([&] { return bed_mismatch(db_, c, why); }))
+    if (with_db_([&] { return dependency_mismatch(db_, c, why); }))
       ++rep_.failed;
     else
       ++rep_.fenced_out;

@@ -20,8 +20,8 @@ using ProgressFn = std::function<void(const std::string& phase, double fraction,
 
 struct RunContext {
   const Claim& claim;
-  std::filesystem::path output_tmp;  ///< the runner writes its output here (under tmp/)
-  std::filesystem::path bed_path;    ///< drop jobs: the prepared bed (absolute)
+  std::filesystem::path output_tmp;         ///< the runner writes its output here (under tmp/)
+  std::filesystem::path dependency_output;  ///< the output of the job this one depends on (absolute; a drop: its bed)
   int threads = 1;
   ProgressFn progress;
   const std::atomic<bool>* stop = nullptr;  ///< set when the job must end early

@@ -263,7 +263,10 @@ TEST(BedChecksum, AFlippedBitInAFinishedBedFailsTheDropAndRebuildsTheBed) {
   }
   r = run_cli({"work", "--db", "c.db", "--quiet"}, d.path);
   EXPECT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE kind='drop' AND error LIKE 'bed checksum mismatch%'"), 1);
+  EXPECT_EQ(
+      sql_int(db,
+              "SELECT count(*) FROM attempts WHERE kind='drop' AND error LIKE 'bed checksum mismatch: % of bed job %'"),
+      1);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE kind='bed' AND outcome='done'"), 2) << "rebuilt once";
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), 3);
   // Every drop used the rebuilt bed, whose file matches its new checksum.
