@@ -322,7 +322,7 @@ Trial trial_of_row(db::Statement& q, const std::vector<std::string>& cols) {
   nlohmann::json j = nlohmann::json::object();
   for (int c = 0; c < static_cast<int>(cols.size()); ++c) {
     if (q.is_null(c)) continue;
-    const auto& name = cols[static_cast<std::size_t>(c)];
+    const std::string name = trial_field_key(cols[static_cast<std::size_t>(c)]);  // an older column: its field
     const auto it =
         std::find_if(trial_fields().begin(), trial_fields().end(), [&](const TrialField& f) { return name == f.key; });
     if (it != trial_fields().end()) {

@@ -53,10 +53,9 @@ MeasuredTrial dem_trial_of(const TraceData& d, const DemTraceRef& ref) {
     ti.end_speed_fraction = o.value("end_speed_fraction", ti.end_speed_fraction);
   }
   // Impact speed: the trace's own velocity at first contact (the job's metrics), else the release.
-  ti.impact_velocity_m_s = d.release_speed_m_s;
+  ti.impact_speed_m_s = d.release_speed_m_s;
   const auto m = nlohmann::json::parse(d.metrics_json.empty() ? "{}" : d.metrics_json, nullptr, false);
-  if (m.is_object() && m.contains("vc_m_s") && m["vc_m_s"].is_number())
-    ti.impact_velocity_m_s = m["vc_m_s"].get<double>();
+  if (m.is_object() && m.contains("vc_m_s") && m["vc_m_s"].is_number()) ti.impact_speed_m_s = m["vc_m_s"].get<double>();
   t.raw = d.to_trace();
   return t;
 }

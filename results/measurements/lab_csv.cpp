@@ -184,7 +184,7 @@ Trial trial_of_row(const RowCells& row, double cutoff_hz) {
     const bool present = col.count(fd.key) && !row.text(fd.key).empty();
     if (fd.text) {
       if (col.count(fd.key)) ti.*fd.text = row.text(fd.key);
-    } else if (std::string(fd.key) == "impact_velocity_m_s") {
+    } else if (std::string(fd.key) == "impact_speed_m_s") {
       continue;  // below: it may come from drop_height_m
     } else if (fd.csv_required || present) {
       // bulk density is kept, not used by the models: it may be 0; optional fields are checked
@@ -193,11 +193,11 @@ Trial trial_of_row(const RowCells& row, double cutoff_hz) {
     }
   }
   if (ti.trial_id.empty()) throw ParseError{{"trials.csv", row.ln, col.at("trial_id") + 1, "column 'trial_id': empty"}};
-  if (col.count("drop_height_m") && row.text("impact_velocity_m_s").empty()) {
+  if (col.count("drop_height_m") && row.text("impact_speed_m_s").empty()) {
     ti.drop_height_m = row.num("drop_height_m", true);
-    ti.impact_velocity_m_s = std::sqrt(2.0 * ti.gravity_m_s2 * ti.drop_height_m);
+    ti.impact_speed_m_s = std::sqrt(2.0 * ti.gravity_m_s2 * ti.drop_height_m);
   } else {
-    ti.impact_velocity_m_s = row.num("impact_velocity_m_s", true);
+    ti.impact_speed_m_s = row.num("impact_speed_m_s", true);
   }
   for (const auto& [name, i] : col) {
     const bool known =
@@ -276,9 +276,18 @@ Campaign load_campaign(const std::string& directory, double cutoff_hz) {
   }
   std::map<std::string, int> col;
   for (int i = 0; i < static_cast<int>(head.size()); ++i) col[head[i]] = i;
+  for (const auto& [alias, key] : trial_field_aliases())  // an older name, read as the field
+    if (col.count(alias) && !col.count(key)) {
+      col[key] = col.at(alias);
+      col.erase(alias);
+    }
   for (const auto& r : required_columns())
-    if (!col.count(r))
-      throw std::runtime_error(fmt::format("{}:{}: missing required column '{}'", csv.string(), ln, r));
+    if (!col.count(r)) {
+      std::string also;
+      for (const auto& [alias, key] : trial_field_aliases())
+        if (key == r) also += fmt::format(" (or '{}')", alias);
+      throw std::runtime_error(fmt::format("{}:{}: missing required column '{}'{}", csv.string(), ln, r, also));
+    }
   std::set<std::string> ids;
   for (;;) {
     try {

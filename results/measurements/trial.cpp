@@ -15,7 +15,7 @@ const std::vector<TrialField>& trial_fields() {
       {"trial_id", nullptr, "", true, nullptr, &Trial::trial_id},
       {"trace_file", nullptr, "", true, nullptr, &Trial::trace_file},
       {"gravity_m_s2", "gravity_m_s2", "m/s2", true, &Trial::gravity_m_s2, nullptr},
-      {"impact_velocity_m_s", nullptr, "m/s", true, &Trial::impact_velocity_m_s, nullptr},
+      {"impact_speed_m_s", nullptr, "m/s", true, &Trial::impact_speed_m_s, nullptr},
       {"fill_height_m", "surface_height_m", "m", true, &Trial::fill_height_m, nullptr},  // dem: measured
       {"projectile_mass_kg", "projectile_mass_kg", "kg", true, &Trial::projectile_mass_kg, nullptr},
       {"projectile_diameter_m", "projectile_diameter_m", "m", true, &Trial::projectile_diameter_m, nullptr},
@@ -35,6 +35,19 @@ const std::vector<TrialField>& trial_fields() {
   return fields;
 }
 
+const std::vector<std::pair<std::string, std::string>>& trial_field_aliases() {
+  static const std::vector<std::pair<std::string, std::string>> aliases = {
+      {"impact_velocity_m_s", "impact_speed_m_s"},
+  };
+  return aliases;
+}
+
+std::string trial_field_key(const std::string& name) {
+  for (const auto& [alias, key] : trial_field_aliases())
+    if (name == alias) return key;
+  return name;
+}
+
 namespace {
 
 /// The physical range of a numeric field: min < value <= max (min <= value when min_inclusive).
@@ -49,7 +62,7 @@ struct PhysicalRange {
 // real drop is (milligravity asteroid surfaces to 100 g centrifuges, grains to boulders).
 constexpr PhysicalRange kPhysicalRanges[] = {
     {"gravity_m_s2", 0, 1000, false, "a gravity"},
-    {"impact_velocity_m_s", 0, 1000, false, "an impact speed"},
+    {"impact_speed_m_s", 0, 1000, false, "an impact speed"},
     {"fill_height_m", 0, 100, false, "a bed depth"},
     {"projectile_mass_kg", 0, 1000, false, "a projectile mass"},
     {"projectile_diameter_m", 0, 10, false, "a projectile diameter"},
@@ -94,11 +107,14 @@ void from_json(const nlohmann::json& j, Trial& t) {
   t = Trial{};
   if (j.contains("source")) t.source = trace_source_of(j.at("source").get<std::string>());
   for (const auto& f : trial_fields()) {
-    if (!j.contains(f.key) || j.at(f.key).is_null()) continue;
+    const nlohmann::json* v = j.contains(f.key) ? &j.at(f.key) : nullptr;
+    for (const auto& [alias, key] : trial_field_aliases())
+      if ((!v || v->is_null()) && key == f.key && j.contains(alias)) v = &j.at(alias);
+    if (!v || v->is_null()) continue;
     if (f.number)
-      t.*f.number = j.at(f.key).get<double>();
+      t.*f.number = v->get<double>();
     else
-      t.*f.text = j.at(f.key).get<std::string>();
+      t.*f.text = v->get<std::string>();
   }
   if (j.contains("attributes") && j.at("attributes").is_object())
     t.attributes = j.at("attributes").get<std::map<std::string, std::string>>();
@@ -110,7 +126,7 @@ MetricOptions metric_options(const Trial& t) {
   o.cutoff_hz = t.filter_cutoff_hz;
   o.end_threshold_g = t.end_threshold_g;
   o.end_speed_fraction = t.end_speed_fraction;
-  o.impact_velocity_m_s = t.impact_velocity_m_s;
+  o.impact_speed_m_s = t.impact_speed_m_s;
   o.fill_height_m = t.fill_height_m;
   o.grain_diameter_m = t.grain_diameter_m;
   o.projectile_diameter_m = t.projectile_diameter_m;

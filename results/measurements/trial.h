@@ -20,8 +20,8 @@ struct Trial {
   TraceSource source = TraceSource::lab;
   std::string trace_file;  ///< relative to the campaign folder (lab) or absolute (dem)
   double gravity_m_s2 = 0;
-  double impact_velocity_m_s = 0;  ///< downward speed at first contact
-  double fill_height_m = 0;        ///< bed depth: the floor below the surface (dem: measured surface height)
+  double impact_speed_m_s = 0;  ///< downward speed at first contact
+  double fill_height_m = 0;     ///< bed depth: the floor below the surface (dem: measured surface height)
   double projectile_mass_kg = 0;
   double projectile_diameter_m = 0;
   double grain_diameter_m = 0;
@@ -70,6 +70,14 @@ struct TrialField {
 };
 /// The table, in the order of trials.csv's required columns first.
 const std::vector<TrialField>& trial_fields();
+
+/// Read-only older names of trial fields: {older name, the field's key}. A trials.csv header, an
+/// imported database's column or a JSON key of that name is read as the field; nothing is written
+/// under it. `impact_velocity_m_s` is the laboratory format's name of the impact speed
+/// (docs/formats/measurements.md) and the name gravsweep wrote before it had one name for it.
+const std::vector<std::pair<std::string, std::string>>& trial_field_aliases();
+/// The field key `name` stands for: itself, or the key of the field it is an alias of.
+std::string trial_field_key(const std::string& name);
 
 /// Empty when `value` lies in the physical range of the numeric trial field `key` (a field
 /// without a range accepts any finite value), else what was expected, e.g. "a mass 0 < m <= 1000 kg".

@@ -25,7 +25,7 @@ namespace {
 bool structured(const std::vector<AxisResidual>& axes, std::string& where) {
   const AxisResidual* best = nullptr;
   for (const auto& a : axes) {
-    if (a.axis == "gravity_m_s2" || a.axis == "impact_velocity_m_s" || a.axis == "fill_height_m") {
+    if (a.axis == "gravity_m_s2" || a.axis == "impact_speed_m_s" || a.axis == "fill_height_m") {
       if (a.eta2 >= 0.25 && (!best || a.eta2 > best->eta2)) best = &a;
       continue;
     }

@@ -50,7 +50,7 @@ double error_pct(double predicted, double measured) {
 LevelOutTrial predict_held_out(const FittedModel& law, const MeasuredTrial& t,
                                const std::vector<const std::vector<double>*>& fluct) {
   LevelOutTrial r;
-  r.impact_froude = t.info.impact_velocity_m_s / std::sqrt(t.info.gravity_m_s2 * t.info.projectile_diameter_m);
+  r.impact_froude = t.info.impact_speed_m_s / std::sqrt(t.info.gravity_m_s2 * t.info.projectile_diameter_m);
   r.pred = predict(law, t, fluct);
   if (!r.pred.stopped) return r;
   const auto& m = t.processed.metrics;

@@ -183,8 +183,8 @@ TermContext context(const Trial& i) {
   c.fill_height_m = i.fill_height_m;
   c.diameter_m = i.projectile_diameter_m;
   c.mass_kg = i.projectile_mass_kg;
-  c.vc_m_s = i.impact_velocity_m_s;
-  c.v_m_s = i.impact_velocity_m_s;
+  c.vc_m_s = i.impact_speed_m_s;
+  c.v_m_s = i.impact_speed_m_s;
   return c;
 }
 

@@ -15,8 +15,8 @@ namespace {
 constexpr int kAxes = 6;
 constexpr int kFirstTrialAxis = 3;  ///< axes from this one on are constant within a trial
 constexpr int kBins = 6;
-const char* const kAxisNames[kAxes] = {"depth_m",      "speed_m_s",           "time_since_contact_s",
-                                       "gravity_m_s2", "impact_velocity_m_s", "fill_height_m"};
+const char* const kAxisNames[kAxes] = {"depth_m",      "speed_m_s",        "time_since_contact_s",
+                                       "gravity_m_s2", "impact_speed_m_s", "fill_height_m"};
 
 /// One sample of a trial's fitted window: the residual of the acceleration in units of g, its
 /// weight (1 / the trial's sample count: every trial weighs one), its value on each axis.
@@ -37,7 +37,7 @@ std::vector<ResidualSample> residual_samples(const FittedModel& m, const Campaig
       const double a_model = m.force(ctx) / t.info.projectile_mass_kg - g;
       s.push_back({(t.processed.accel_up_m_s2[k] - a_model) / g,
                    1.0 / n,
-                   {ctx.z_m, ctx.v_m_s, ctx.t_since_contact_s, g, t.info.impact_velocity_m_s, t.info.fill_height_m},
+                   {ctx.z_m, ctx.v_m_s, ctx.t_since_contact_s, g, t.info.impact_speed_m_s, t.info.fill_height_m},
                    static_cast<int>(ti)});
     }
   }

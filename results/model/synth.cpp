@@ -150,7 +150,7 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
   truth_csv << "trial_id,zstop_m,tstop_s,t_contact_s\n";
   int id = 0;
   for (double g : o.gravity_m_s2) {
-    for (double v0 : o.impact_velocity_m_s) {
+    for (double v0 : o.impact_speed_m_s) {
       for (int rep = 0; rep < o.repeats; ++rep) {
         ++id;
         const double H = o.fill_height_m[static_cast<std::size_t>(id - 1) % o.fill_height_m.size()];

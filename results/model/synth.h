@@ -11,7 +11,7 @@ namespace gravsweep::results {
 
 struct SynthOptions {
   std::vector<double> gravity_m_s2{9.81, 1.2, 0.1};
-  std::vector<double> impact_velocity_m_s{0.1, 0.25, 0.4, 0.55, 0.7, 0.85, 1.0, 1.2};
+  std::vector<double> impact_speed_m_s{0.1, 0.25, 0.4, 0.55, 0.7, 0.85, 1.0, 1.2};
   std::vector<double> fill_height_m{0.21};  ///< cycled over the trials in order
   int repeats = 3;
   double mass_kg = 1.0;

@@ -168,10 +168,10 @@ PassResult collision_pass(const Trace& trace, const MetricOptions& o, const std:
   if (!trace.velocity_down_m_s.empty() && !trace.depth_m.empty()) {
     ec.speed = &trace.velocity_down_m_s;
     vc_pass = interp_at(t, trace.velocity_down_m_s, r.start.t_start_s);
-  } else if (o.impact_velocity_m_s) {
-    integrate_from_start(t, a, r.start.i_start, r.start.t_start_s, *o.impact_velocity_m_s, v_pass, z_pass);
+  } else if (o.impact_speed_m_s) {
+    integrate_from_start(t, a, r.start.i_start, r.start.t_start_s, *o.impact_speed_m_s, v_pass, z_pass);
     ec.speed = &v_pass;
-    vc_pass = *o.impact_velocity_m_s;
+    vc_pass = *o.impact_speed_m_s;
   }
   ec.v_end_m_s = o.end_speed_fraction * std::abs(vc_pass);
   std::optional<std::size_t> j;
@@ -257,10 +257,10 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
     out.depth_m = trace.depth_m;
     m.vc_m_s = interp_at(t, out.velocity_down_m_s, m.t_start_s);
   } else {
-    if (!o.impact_velocity_m_s)
+    if (!o.impact_speed_m_s)
       throw std::invalid_argument(
           "no velocity in the trace and no impact velocity given: cannot integrate a into v and z");
-    m.vc_m_s = *o.impact_velocity_m_s;
+    m.vc_m_s = *o.impact_speed_m_s;
     integrate_from_start(t, a, i_start, m.t_start_s, m.vc_m_s, out.velocity_down_m_s, out.depth_m);
     // At rest the integrated speed reads zero (trace_steps.h): what it reads is removed from v and z.
     const double end_tolerance_m_s = 0.5 * pass.end.step_height_m_s2 / fs;  // half a sample of the end step

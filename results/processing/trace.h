@@ -49,7 +49,7 @@ struct MetricOptions {
   /// forward search alone, the earlier rule (kept to measure what the change does).
   bool end_from_rest = true;
   /// Speed at first contact, used to integrate a into v and z when the trace has none.
-  std::optional<double> impact_velocity_m_s;
+  std::optional<double> impact_speed_m_s;
   /// For the rebound flag: bed depth (the floor's depth below the surface, m: a lab trial's fill
   /// height, a DEM drop's measured surface height) and grain diameter (a projectile within one
   /// grain of the floor has "hit the bottom").

@@ -97,7 +97,7 @@ Fig2Record load_record(const std::string& path) {
     bare.velocity_down_m_s.clear();
     bare.depth_m.clear();
     MetricOptions o = metric_options(r.trial.info);
-    o.impact_velocity_m_s = p.metrics.vc_m_s;
+    o.impact_speed_m_s = p.metrics.vc_m_s;
     try {
       const ProcessedTrace q = process_trace(bare, o);
       const double z0 = interp(p.t_s, p.depth_m, p.metrics.t_start_s);

@@ -63,6 +63,7 @@ nlohmann::json row_of(const results::MeasuredTrial& t) {
   nlohmann::json j = t.info;
   j.erase("attributes");
   for (const auto& [k, v] : t.info.attributes) j[k] = v;
+  for (const auto& [alias, key] : results::trial_field_aliases()) j[alias] = j[key];  // older --where names
   const nlohmann::json m = t.processed.metrics;
   for (const auto& f : results::metric_fields())
     if (!f.text) j[f.key] = m[f.key];  // the processing note stays out: a trial may have a "note" column

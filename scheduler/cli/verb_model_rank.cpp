@@ -96,7 +96,7 @@ void setup_model_rank(CLI::App& model) {
       "like a named term: --model 'base+z^1*v^1'.\n\n"
       "Examples:\n  gravsweep model rank ../shared/data/measurements/depth-friction-dev\n"
       "  gravsweep model rank campaign.db          # the drops of `gravsweep submit` + `work`\n"
-      "  gravsweep model rank data/reproduction/chrono_1g --where 'impact_velocity_m_s<0.5'  # one regime\n"
+      "  gravsweep model rank data/reproduction/chrono_1g --where 'impact_speed_m_s<0.5'  # one regime\n"
       "  gravsweep model rank data/gravity_sweep/g9.81 data/gravity_sweep/g1.62 --scaled  # one law for all g");
   sub->alias("discover");
   add_model_inputs(sub, o->in);

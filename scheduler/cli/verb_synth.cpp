@@ -38,7 +38,7 @@ void setup_synth(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--seed", o->seed, "random seed")->capture_default_str();
   sub->add_option("--gravity", o->gravity_m_s2, "gravity levels, m/s2")->delimiter(',')->capture_default_str();
-  sub->add_option("--speeds", o->impact_velocity_m_s, "impact speeds, m/s")->delimiter(',')->capture_default_str();
+  sub->add_option("--speeds", o->impact_speed_m_s, "impact speeds, m/s")->delimiter(',')->capture_default_str();
   sub->add_option("--fill", o->fill_height_m, "fill heights, m (cycled over trials)")
       ->delimiter(',')
       ->capture_default_str();

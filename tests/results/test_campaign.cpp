@@ -22,7 +22,7 @@ namespace {
 SynthOptions small() {
   SynthOptions o;
   o.gravity_m_s2 = {9.81, 1.2};
-  o.impact_velocity_m_s = {0.3, 0.8};
+  o.impact_speed_m_s = {0.3, 0.8};
   o.repeats = 2;
   o.seed = 5;
   return o;
@@ -114,7 +114,8 @@ TEST(Campaign, MissingRequiredColumnIsAnErrorNamingIt) {
     load_campaign(d.str());
     FAIL();
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("impact_velocity_m_s"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'impact_speed_m_s' (or 'impact_velocity_m_s')"), std::string::npos)
+        << e.what();
     EXPECT_NE(std::string(e.what()).find("trials.csv:1"), std::string::npos) << e.what();
   }
 }

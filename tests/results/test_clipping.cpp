@@ -25,7 +25,7 @@ namespace {
 SynthOptions lab() {
   SynthOptions o;
   o.gravity_m_s2 = {9.81};
-  o.impact_velocity_m_s = {0.3, 0.5, 0.7, 0.9, 1.1, 1.3};
+  o.impact_speed_m_s = {0.3, 0.5, 0.7, 0.9, 1.1, 1.3};
   o.repeats = 2;
   o.seed = 11;
   return o;

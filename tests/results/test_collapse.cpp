@@ -58,7 +58,7 @@ TEST(Collapse, ALevelWithTwoSpeedsIsFittedByALine) {
   TempDir d;
   Campaign c = four_levels("base", d);
   std::erase_if(c.trials, [](const MeasuredTrial& t) {
-    return same_gravity_level(t.info.gravity_m_s2, 0.01) && t.info.impact_velocity_m_s > 0.3;
+    return same_gravity_level(t.info.gravity_m_s2, 0.01) && t.info.impact_speed_m_s > 0.3;
   });
   const auto rows = collapse(c);
   for (const auto& r : rows) {

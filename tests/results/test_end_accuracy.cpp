@@ -121,7 +121,7 @@ TEST(EndAccuracy, SynthWritesTheTrueStopOfEachTrial) {
   gravsweep::testing::TempDir d;
   SynthOptions so;
   so.gravity_m_s2 = {9.81};
-  so.impact_velocity_m_s = {0.5};
+  so.impact_speed_m_s = {0.5};
   so.repeats = 1;
   so.rest_tail_s = 0.05;
   ASSERT_EQ(write_synthetic_campaign(d.str(), parse_model("base"), so), 1);

@@ -53,7 +53,7 @@ TermContext first_contact(const Trial& t) {
   c.diameter_m = t.projectile_diameter_m;
   c.mass_kg = t.projectile_mass_kg;
   c.fill_height_m = t.fill_height_m;
-  c.vc_m_s = c.v_m_s = t.impact_velocity_m_s;
+  c.vc_m_s = c.v_m_s = t.impact_speed_m_s;
   return c;
 }
 
@@ -163,7 +163,7 @@ TEST(LevelOut, ALawWithAParameterPerLevelAndASingleLevelAreRefused) {
   TempDir d;
   SynthOptions o = four_levels(1);
   o.gravity_m_s2 = {9.81, 1.62};
-  o.impact_velocity_m_s = {0.3, 0.6, 0.9};
+  o.impact_speed_m_s = {0.3, 0.6, 0.9};
   const Campaign c = synth_campaign("base", o, d);
   EXPECT_THROW(leave_level_out(parse_model("base"), c), std::invalid_argument);
   EXPECT_THROW(leave_level_out(parse_model("scaled_base+depth_friction"), c), std::invalid_argument);

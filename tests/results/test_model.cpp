@@ -39,7 +39,7 @@ bool is_depth_friction(const std::string& t) { return t == "depth_friction" || t
 /// A small campaign: 3 gravity levels x 6 speeds x 2 repeats = 36 trials.
 SynthOptions small_synth(unsigned seed) {
   SynthOptions o;
-  o.impact_velocity_m_s = {0.15, 0.35, 0.55, 0.75, 0.95, 1.15};
+  o.impact_speed_m_s = {0.15, 0.35, 0.55, 0.75, 0.95, 1.15};
   o.repeats = 2;
   o.seed = seed;
   return o;
@@ -281,7 +281,7 @@ TEST(Discovery, StructureNoCandidateExplainsIsReportedWithWhereItLies) {
   TempDir d;
   SynthOptions o = small_synth(21);
   o.gravity_m_s2 = {9.81};
-  o.impact_velocity_m_s = {0.5, 0.7, 0.9, 1.1};
+  o.impact_speed_m_s = {0.5, 0.7, 0.9, 1.1};
   o.repeats = 4;
   o.fill_height_m = {0.2};
   write_synthetic_campaign(d.str(), truth, o);

@@ -234,8 +234,7 @@ TEST(Reproduction, ModelVerbsReadSeveralDatasetsAsOneCampaign) {
   // A level with too few trials or speeds is listed, not fitted: one speed cannot separate f0 from
   // 1/d1 (a partial 0.1 m/s2 level of 0.05 m/s drops printed 1/d1 = -1.5e5 1/m before).
   const auto few = gravsweep::testing::run_gravsweep(
-      "model table3 " + both + " --where 'impact_velocity_m_s>0.5' --where 'impact_velocity_m_s<0.7' --format csv",
-      true);
+      "model table3 " + both + " --where 'impact_speed_m_s>0.5' --where 'impact_speed_m_s<0.7' --format csv", true);
   ASSERT_EQ(few.code, 0) << few.out;
   EXPECT_NE(few.out.find("not fitted: Eq. 2 needs >= 3 trials over a vc range"), std::string::npos) << few.out;
   const auto twice = gravsweep::testing::run_gravsweep(

@@ -34,7 +34,7 @@ void expect_recovered(const Poncelet& p, double fs, double noise_g, double bias_
   const Trace tr = sample(p, fs, t_contact, noise_g, bias_g, seed);
   MetricOptions o;
   o.gravity_m_s2 = p.g;
-  o.impact_velocity_m_s = p.v0;
+  o.impact_speed_m_s = p.v0;
   const Metrics m = compute_metrics(tr, o);
   SCOPED_TRACE(::testing::Message() << "fs=" << fs << " g=" << p.g << " v0=" << p.v0 << " noise=" << noise_g
                                     << " seed=" << seed);
@@ -127,7 +127,7 @@ TEST(Metrics, UsesTraceVelocityAndDepthWhenPresent) {
 TEST(Metrics, RejectsBadTracesWithReasons) {
   Poncelet p;
   MetricOptions o;
-  o.impact_velocity_m_s = p.v0;
+  o.impact_speed_m_s = p.v0;
   Trace short_tr;
   short_tr.t_s = {0, 1, 2};
   short_tr.accel_up_m_s2 = {0, 0, 0};
@@ -159,7 +159,7 @@ TEST(Metrics, RejectsBadTracesWithReasons) {
 TEST(Metrics, ReachingTheFloorIsNotedNotFlaggedWithoutARise) {
   Poncelet p;
   MetricOptions o;
-  o.impact_velocity_m_s = p.v0;
+  o.impact_speed_m_s = p.v0;
   o.fill_height_m = p.zstop() + 0.005;
   o.grain_diameter_m = 0.01;
   const Metrics near_floor = compute_metrics(sample(p, 1400, 0.02, 0.0, 0.0, 1), o);
@@ -287,7 +287,7 @@ TEST(Metrics, ALullBetweenBurstsDoesNotEndTheCollision) {
   Trace lab;
   lab.t_s = tr.t_s;
   lab.accel_up_m_s2 = tr.accel_up_m_s2;
-  o.impact_velocity_m_s = v0;
+  o.impact_speed_m_s = v0;
   const Metrics m = compute_metrics(lab, o);
   EXPECT_NEAR(m.tstop_s, t_rest - t_contact, 0.03 * (t_rest - t_contact));
   EXPECT_NEAR(m.zstop_m, z_rest, 0.03 * z_rest);
@@ -370,7 +370,7 @@ TraceError error_of(const Trace& tr, const MetricOptions& o) {
 TEST(Metrics, EachUnmeasurableRecordGetsItsOwnReasonAndSample) {
   Poncelet p;
   MetricOptions o;
-  o.impact_velocity_m_s = p.v0;
+  o.impact_speed_m_s = p.v0;
   const Trace tr = sample(p, 1400, 0.02, 0.01, 0.0, 1);
   const std::size_t contact = static_cast<std::size_t>(0.02 * 1400);
 

@@ -25,7 +25,7 @@ namespace {
 void write_shared_trace_campaign(const std::filesystem::path& dir, int n, const std::vector<double>& speeds = {}) {
   SynthOptions o;
   o.gravity_m_s2 = {9.81};
-  o.impact_velocity_m_s = {0.8};
+  o.impact_speed_m_s = {0.8};
   o.repeats = 1;
   o.rest_tail_s = 2.0;  // a long record: the samples dominate the file
   write_synthetic_campaign(dir.string(), parse_model("base"), o);
@@ -40,7 +40,7 @@ void write_shared_trace_campaign(const std::filesystem::path& dir, int n, const 
     std::string r = row;
     r.replace(0, r.find(','), "T" + std::to_string(i + 1));
     if (!speeds.empty()) {
-      // impact_velocity_m_s is the fourth column of the synthetic trials.csv
+      // impact_speed_m_s is the fourth column of the synthetic trials.csv
       std::vector<std::string> f;
       std::stringstream ss(r);
       for (std::string c; std::getline(ss, c, ',');) f.push_back(c);
@@ -122,7 +122,7 @@ TEST(TraceStore, ReimportRemovesSamplesNoTrialNames) {
   TempDir d;
   SynthOptions o;
   o.gravity_m_s2 = {9.81};
-  o.impact_velocity_m_s = {0.4, 0.8};
+  o.impact_speed_m_s = {0.4, 0.8};
   o.repeats = 1;
   write_synthetic_campaign((d.path / "a").string(), parse_model("base"), o);
   o.seed = 2;  // the same trial ids, other records

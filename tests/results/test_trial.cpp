@@ -123,7 +123,7 @@ TEST(TrialRecord, OneFieldTableGivesCsvSqlHdf5AndJsonNamesAndRoundTrips) {
   std::set<std::string> required;
   for (const auto& f : trial_fields())
     if (f.csv_required) required.insert(f.key);
-  EXPECT_EQ(required, (std::set<std::string>{"trial_id", "trace_file", "gravity_m_s2", "impact_velocity_m_s",
+  EXPECT_EQ(required, (std::set<std::string>{"trial_id", "trace_file", "gravity_m_s2", "impact_speed_m_s",
                                              "fill_height_m", "projectile_mass_kg", "projectile_diameter_m",
                                              "grain_diameter_m", "bulk_density_kg_m3", "sample_rate_hz"}));
   Trial t;
@@ -205,6 +205,28 @@ TEST(LabCampaign, TrialsCsvWithBomAndQuotedNumbersIsRead) {
   ASSERT_EQ(c.trials.size(), 1u) << issues_of(c);
   EXPECT_EQ(c.trials[0].info.gravity_m_s2, 9.81);
   EXPECT_NEAR(c.trials[0].processed.metrics.apeak_m_s2, k.apeak(), 0.03 * k.apeak());
+}
+
+// The impact speed has one name, impact_speed_m_s; the laboratory format's impact_velocity_m_s
+// (and files gravsweep wrote before) are read as it, in a trials.csv header and as a JSON key.
+TEST(LabCampaign, TheLabFormatsImpactVelocityColumnIsReadAsTheImpactSpeed) {
+  TempDir d;
+  Poncelet k;
+  write_lab_trace(d.path / "old/traces/A.csv", k, 1400, 0.0, false);
+  write_lab_trace(d.path / "new/traces/A.csv", k, 1400, 0.0, false);
+  std::string renamed = kHeader;
+  renamed.replace(renamed.find("impact_velocity_m_s"), std::string("impact_velocity_m_s").size(), "impact_speed_m_s");
+  write_text(d.path / "old/trials.csv", std::string(kHeader) + "\n" + row("A", "traces/A.csv", 9.81, 0.8) + "\n");
+  write_text(d.path / "new/trials.csv", renamed + "\n" + row("A", "traces/A.csv", 9.81, 0.8) + "\n");
+  const Campaign a = load_campaign((d.path / "old").string()), b = load_campaign((d.path / "new").string());
+  ASSERT_EQ(a.trials.size(), 1u) << issues_of(a);
+  ASSERT_EQ(b.trials.size(), 1u) << issues_of(b);
+  EXPECT_EQ(a.trials[0].info.impact_speed_m_s, 0.8);
+  EXPECT_EQ(b.trials[0].info.impact_speed_m_s, 0.8);
+  EXPECT_TRUE(a.trials[0].info.attributes.empty()) << "the older name is the field, not an extra column";
+  EXPECT_EQ(nlohmann::json(a.trials[0].info).count("impact_velocity_m_s"), 0u) << "nothing is written under it";
+  const Trial from_old_json = nlohmann::json{{"trial_id", "J"}, {"impact_velocity_m_s", 0.5}}.get<Trial>();
+  EXPECT_EQ(from_old_json.impact_speed_m_s, 0.5);
 }
 
 TEST(LabCampaign, TracePathsOutsideTheCampaignFolderAreRefusedWithTheRow) {

@@ -57,7 +57,7 @@ TEST(CliExport, FinishedDropsBecomeAMeasurementCampaign) {
   EXPECT_NE(r.out.find("2 drops exported"), std::string::npos) << r.out;
   const auto trials = lines_of(d.path / "ds" / "trials.csv");
   ASSERT_EQ(trials.size(), 3u);
-  EXPECT_EQ(trials[0].rfind("trial_id,trace_file,gravity_m_s2,impact_velocity_m_s,fill_height_m,", 0), 0u) << trials[0];
+  EXPECT_EQ(trials[0].rfind("trial_id,trace_file,gravity_m_s2,impact_speed_m_s,fill_height_m,", 0), 0u) << trials[0];
   EXPECT_NE(trials[1].find(",dem,"), std::string::npos) << trials[1];
   // One trace per trial at 2 kHz (every 5th sample of the 10 kHz record), with its scenario.
   const std::string job = trials[1].substr(0, trials[1].find(','));
