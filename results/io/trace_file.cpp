@@ -23,50 +23,84 @@ Trace TraceData::to_trace() const {
   return t;
 }
 
+const std::vector<TraceText>& trace_texts() {
+  static const std::vector<TraceText> t = {{"code_version", &TraceData::code_version},
+                                           {"scenario", &TraceData::scenario_json},
+                                           {"bed_key", &TraceData::bed_key_json},
+                                           {"bed_file", &TraceData::bed_file},
+                                           {"metrics", &TraceData::metrics_json}};
+  return t;
+}
+
+const std::vector<TraceAttribute>& trace_attributes() {
+  static const std::vector<TraceAttribute> t = {{"sample_rate_hz", &TraceData::sample_rate_hz},
+                                                {"dt_s", &TraceData::dt_s},
+                                                {"gravity_m_s2", &TraceData::gravity_m_s2},
+                                                {"surface_height_m", &TraceData::surface_height_m},
+                                                {"release_height_m", &TraceData::release_height_m},
+                                                {"release_speed_m_s", &TraceData::release_speed_m_s},
+                                                {"projectile_diameter_m", &TraceData::projectile_diameter_m},
+                                                {"projectile_mass_kg", &TraceData::projectile_mass_kg},
+                                                {"grain_diameter_m", &TraceData::grain_diameter_m}};
+  return t;
+}
+
+const std::vector<TraceColumn>& trace_columns() {
+  static const std::vector<TraceColumn> t = {
+      {"t_s", &TraceData::t_s, 1, "s", "time since release"},
+      {"depth_m", &TraceData::depth_m, 1, "m",
+       "depth of the projectile's lowest point below the mean bed surface (positive down)"},
+      {"velocity_down_m_s", &TraceData::velocity_down_m_s, 1, "m/s",
+       "vertical velocity of the projectile, positive down"},
+      {"accel_up_m_s2", &TraceData::accel_up_m_s2, 1, "m/s2",
+       "vertical acceleration, positive up (free fall = -g), mean over the preceding sample interval"},
+      {"omega_rad_s", &TraceData::omega_rad_s, 3, "rad/s", "projectile angular velocity (engine frame)"},
+      {"position_m", &TraceData::position_m, 3, "m",
+       "projectile centre, engine frame (z up, container bottom at z = 0)"},
+      {"grain_kinetic_energy_J", &TraceData::grain_kinetic_energy_J, 1, "J",
+       "translational + rotational kinetic energy of all grains"}};
+  return t;
+}
+
+double trace_attribute(const TraceData& d, const std::string& name) {
+  for (const auto& a : trace_attributes())
+    if (name == a.name) return d.*a.value;
+  throw std::logic_error("trace.h5 has no attribute " + name);
+}
+
+namespace {
+
+/// True when every column holds `n` samples of its width.
+bool columns_hold(const TraceData& d, std::size_t n) {
+  for (const auto& c : trace_columns())
+    if ((d.*c.values).size() != c.width * n) return false;
+  return d.contacts.size() == n;
+}
+
+}  // namespace
+
 void write_trace(const std::filesystem::path& path, const TraceData& d) {
   const std::size_t n = d.size();
-  if (d.depth_m.size() != n || d.velocity_down_m_s.size() != n || d.accel_up_m_s2.size() != n ||
-      d.omega_rad_s.size() != 3 * n || d.position_m.size() != 3 * n || d.contacts.size() != n ||
-      d.grain_kinetic_energy_J.size() != n)
+  if (!columns_hold(d, n))
     throw h5::H5Error(fmt::format("trace {}: inconsistent column lengths for {} samples", path.string(), n));
   h5::write_atomically(path, [&](const std::filesystem::path& tmp) {
     h5::File f = h5::File::create(tmp);
     h5::set_attr(f.id(), "format", kTraceFormat);
     h5::set_attr(f.id(), "format_version", kTraceFormatVersion);
-    h5::set_attr(f.id(), "code_version", d.code_version);
-    h5::set_attr(f.id(), "scenario", d.scenario_json);
-    h5::set_attr(f.id(), "bed_key", d.bed_key_json);
-    h5::set_attr(f.id(), "bed_file", d.bed_file);
-    h5::set_attr(f.id(), "metrics", d.metrics_json);
+    for (const auto& a : trace_texts()) h5::set_attr(f.id(), a.name, d.*a.value);
     h5::Handle g = h5::create_group(f.id(), "trace");
     h5::set_attr(g, "description",
                  "projectile record, paper frame: depth positive down from the mean bed surface, "
                  "velocity positive down, acceleration positive up (free fall = -g)");
-    h5::set_attr(g, "sample_rate_hz", d.sample_rate_hz);
-    h5::set_attr(g, "dt_s", d.dt_s);
-    h5::set_attr(g, "gravity_m_s2", d.gravity_m_s2);
-    h5::set_attr(g, "surface_height_m", d.surface_height_m);
-    h5::set_attr(g, "release_height_m", d.release_height_m);
-    h5::set_attr(g, "release_speed_m_s", d.release_speed_m_s);
-    h5::set_attr(g, "projectile_diameter_m", d.projectile_diameter_m);
-    h5::set_attr(g, "projectile_mass_kg", d.projectile_mass_kg);
+    for (const auto& a : trace_attributes()) h5::set_attr(g, a.name, d.*a.value);
     // Format version 1 had both; gravsweep reads surface_height_m, older versions fill_height_m.
     h5::set_attr(g, "fill_height_m", d.surface_height_m);
-    h5::set_attr(g, "grain_diameter_m", d.grain_diameter_m);
     h5::set_attr(g, "stopped", static_cast<long long>(d.stopped ? 1 : 0));
-    h5::write_doubles(g, "t_s", d.t_s, {n}, "s", "time since release");
-    h5::write_doubles(g, "depth_m", d.depth_m, {n}, "m",
-                      "depth of the projectile's lowest point below the mean bed surface (positive down)");
-    h5::write_doubles(g, "velocity_down_m_s", d.velocity_down_m_s, {n}, "m/s",
-                      "vertical velocity of the projectile, positive down");
-    h5::write_doubles(g, "accel_up_m_s2", d.accel_up_m_s2, {n}, "m/s2",
-                      "vertical acceleration, positive up (free fall = -g), mean over the preceding sample interval");
-    h5::write_doubles(g, "omega_rad_s", d.omega_rad_s, {n, 3}, "rad/s", "projectile angular velocity (engine frame)");
-    h5::write_doubles(g, "position_m", d.position_m, {n, 3}, "m",
-                      "projectile centre, engine frame (z up, container bottom at z = 0)");
+    for (const auto& c : trace_columns()) {
+      const std::vector<hsize_t> dims = c.width == 1 ? std::vector<hsize_t>{n} : std::vector<hsize_t>{n, c.width};
+      h5::write_doubles(g, c.name, d.*c.values, dims, c.unit, c.description);
+    }
     h5::write_int32(g, "contacts", d.contacts, "1", "grains and walls touching the projectile");
-    h5::write_doubles(g, "grain_kinetic_energy_J", d.grain_kinetic_energy_J, {n}, "J",
-                      "translational + rotational kinetic energy of all grains");
     f.close();
   });
 }
@@ -81,34 +115,14 @@ TraceData read_trace(const std::filesystem::path& path) {
     throw h5::H5Error(fmt::format("trace {}: format_version {} is not supported (expected {})", path.string(), version,
                                   kTraceFormatVersion));
   TraceData d;
-  d.code_version = h5::get_attr_string(f.id(), "code_version");
-  d.scenario_json = h5::get_attr_string(f.id(), "scenario");
-  d.bed_key_json = h5::get_attr_string(f.id(), "bed_key");
-  d.bed_file = h5::get_attr_string(f.id(), "bed_file");
-  d.metrics_json = h5::get_attr_string(f.id(), "metrics");
+  for (const auto& a : trace_texts()) d.*a.value = h5::get_attr_string(f.id(), a.name);
   h5::Handle g = h5::open_group(f.id(), "trace");
-  d.sample_rate_hz = h5::get_attr_double(g, "sample_rate_hz");
-  d.dt_s = h5::get_attr_double(g, "dt_s");
-  d.gravity_m_s2 = h5::get_attr_double(g, "gravity_m_s2");
-  d.surface_height_m = h5::get_attr_double(g, "surface_height_m");
-  d.release_height_m = h5::get_attr_double(g, "release_height_m");
-  d.release_speed_m_s = h5::get_attr_double(g, "release_speed_m_s");
-  d.projectile_diameter_m = h5::get_attr_double(g, "projectile_diameter_m");
-  d.projectile_mass_kg = h5::get_attr_double(g, "projectile_mass_kg");
-  d.grain_diameter_m = h5::get_attr_double(g, "grain_diameter_m");
+  for (const auto& a : trace_attributes()) d.*a.value = h5::get_attr_double(g, a.name);
   d.stopped = h5::get_attr_int(g, "stopped") != 0;
-  d.t_s = h5::read_doubles(g, "t_s");
-  d.depth_m = h5::read_doubles(g, "depth_m");
-  d.velocity_down_m_s = h5::read_doubles(g, "velocity_down_m_s");
-  d.accel_up_m_s2 = h5::read_doubles(g, "accel_up_m_s2");
-  d.omega_rad_s = h5::read_doubles(g, "omega_rad_s");
-  d.position_m = h5::read_doubles(g, "position_m");
+  for (const auto& c : trace_columns()) d.*c.values = h5::read_doubles(g, c.name);
   d.contacts = h5::read_int32(g, "contacts");
-  d.grain_kinetic_energy_J = h5::read_doubles(g, "grain_kinetic_energy_J");
   const std::size_t n = d.t_s.size();
-  if (d.depth_m.size() != n || d.velocity_down_m_s.size() != n || d.accel_up_m_s2.size() != n ||
-      d.omega_rad_s.size() != 3 * n || d.position_m.size() != 3 * n || d.contacts.size() != n ||
-      d.grain_kinetic_energy_J.size() != n)
+  if (!columns_hold(d, n))
     throw h5::H5Error(fmt::format("trace {}: the /trace columns do not all hold {} samples", path.string(), n));
   return d;
 }

@@ -48,6 +48,31 @@ struct TraceData {
   [[nodiscard]] Trace to_trace() const;
 };
 
+/// The fields of trace.h5, one table each, from which write_trace and read_trace (and a DEM trial's
+/// facts, trial_fields()) are made: the root's text attributes, the numeric attributes of /trace
+/// and its double columns (`width` values a sample). `contacts` (int32) and `stopped` (a flag)
+/// are the two fields outside them.
+struct TraceText {
+  const char* name;
+  std::string TraceData::*value;
+};
+struct TraceAttribute {
+  const char* name;
+  double TraceData::*value;
+};
+struct TraceColumn {
+  const char* name;
+  std::vector<double> TraceData::*values;
+  std::size_t width;
+  const char* unit;
+  const char* description;
+};
+const std::vector<TraceText>& trace_texts();
+const std::vector<TraceAttribute>& trace_attributes();
+const std::vector<TraceColumn>& trace_columns();
+/// The numeric /trace attribute `name` of `d`; std::logic_error naming it when there is none.
+double trace_attribute(const TraceData& d, const std::string& name);
+
 inline constexpr const char* kTraceFormat = "gravsweep-trace";
 inline constexpr long long kTraceFormatVersion = 1;
 

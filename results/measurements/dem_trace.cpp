@@ -17,21 +17,6 @@ namespace gravsweep::results {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-double attr_of(const TraceData& d, const std::string& name) {
-  // The trace.h5 attributes a Trial field comes from (TrialField::hdf5_attr).
-  if (name == "gravity_m_s2") return d.gravity_m_s2;
-  if (name == "surface_height_m") return d.surface_height_m;
-  if (name == "projectile_mass_kg") return d.projectile_mass_kg;
-  if (name == "projectile_diameter_m") return d.projectile_diameter_m;
-  if (name == "grain_diameter_m") return d.grain_diameter_m;
-  if (name == "sample_rate_hz") return d.sample_rate_hz;
-  throw std::logic_error("trace.h5 has no attribute " + name);
-}
-
-}  // namespace
-
 MeasuredTrial read_dem_trial(const DemTraceRef& ref) { return dem_trial_of(read_trace(ref.path), ref); }
 
 MeasuredTrial dem_trial_of(const TraceData& d, const DemTraceRef& ref) {
@@ -43,7 +28,7 @@ MeasuredTrial dem_trial_of(const TraceData& d, const DemTraceRef& ref) {
   ti.trace_file = ref.path.string();
   ti.code_version = d.code_version;
   for (const auto& f : trial_fields())
-    if (f.hdf5_attr) ti.*f.number = attr_of(d, f.hdf5_attr);
+    if (f.hdf5_attr) ti.*f.number = trace_attribute(d, f.hdf5_attr);
   // Processing settings: the scenario's /output (defaults filled when it was validated).
   const auto s = nlohmann::json::parse(d.scenario_json.empty() ? "{}" : d.scenario_json, nullptr, false);
   if (s.is_object() && s.contains("output") && s["output"].is_object()) {

@@ -549,9 +549,7 @@ class Worker {
         give_back_env(c, why);
         return false;
       }
-      const std::string state = with_db_([&] { return fail(db_, c, why, 1, false, o_.backoff_base_s); });
-      ++(state == "dead" ? rep_.dead : state == "failed" ? rep_.failed : rep_.fenced_out);
-      std::fprintf(stderr, "worker %d: %s\n", who_.pid, why.c_str());
+      failed(c, why, 1, false);
       return false;
     }
   }
