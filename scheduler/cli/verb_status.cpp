@@ -88,9 +88,10 @@ std::string render_status(const queue::Status& s, const std::string& db, double 
     out += "\ndead jobs (latest):\n";
     for (const auto& [id, err] : s.recent_errors) out += fmt::format("  {}  {}\n", id, err.substr(0, 160));
   }
-  if (!s.beds_rebuilt.empty()) {
-    out += fmt::format("\nbeds rebuilt after a checksum mismatch ({} drop(s) noticed):\n", s.beds_rebuilt.size());
-    for (const auto& [id, err] : s.beds_rebuilt) out += fmt::format("  drop {}: {}\n", id, err.substr(0, 300));
+  if (!s.dependency_mismatches.empty()) {
+    out +=
+        fmt::format("\nbeds rebuilt after a checksum mismatch ({} drop(s) noticed):\n", s.dependency_mismatches.size());
+    for (const auto& [id, err] : s.dependency_mismatches) out += fmt::format("  drop {}: {}\n", id, err.substr(0, 300));
   }
   out += fmt::format("\n(status query {:.1f} ms)\n", 1000 * query_s);
   return out;
@@ -135,7 +136,7 @@ nlohmann::json status_json(const queue::Status& s) {
   j["dead_recent"] = json::array();
   for (const auto& [id, err] : s.recent_errors) j["dead_recent"].push_back({{"job_id", id}, {"error", err}});
   j["bed_checksum_mismatches"] = json::array();
-  for (const auto& [id, err] : s.beds_rebuilt)
+  for (const auto& [id, err] : s.dependency_mismatches)
     j["bed_checksum_mismatches"].push_back({{"drop_job_id", id}, {"error", err}});
   return j;
 }

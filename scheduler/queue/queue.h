@@ -223,7 +223,9 @@ struct Status {
   std::int64_t active_workers = 0;
   double eta_s = -1;  ///< < 0: unknown (no finished job of some remaining kind)
   std::vector<std::pair<std::string, std::string>> recent_errors;  ///< (job_id, error) of dead jobs
-  std::vector<std::pair<std::string, std::string>> beds_rebuilt;   ///< (bed job_id, why) after a checksum mismatch
+  /// (job_id, why) of the attempts that found their dependency's output changed (dependency_mismatch):
+  /// the dependency was made again (a drop's bed rebuilt).
+  std::vector<std::pair<std::string, std::string>> dependency_mismatches;
 };
 Status status(db::Database& db, std::size_t max_running = 20);
 

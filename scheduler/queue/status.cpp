@@ -211,8 +211,9 @@ void read_troubles(Database& db, Status& s) {
   {
     Statement st(db,
                  "SELECT coalesce(sum(releases), 0), coalesce(sum(CASE WHEN releases>0 AND state!='done' THEN 1 "
-                 "ELSE 0 END), 0), coalesce(sum(CASE WHEN state='dead' AND last_error LIKE 'released % times%without "
-                 "finishing%' THEN 1 ELSE 0 END), 0) FROM jobs");
+                 "ELSE 0 END), 0), coalesce(sum(CASE WHEN state='dead' AND (SELECT a.outcome FROM attempts a WHERE "
+                 "a.job_id=jobs.job_id ORDER BY a.attempt_id DESC LIMIT 1)='released' THEN 1 ELSE 0 END), 0) "
+                 "FROM jobs");  // stopped by releases: dead, and its last attempt was released
     st.step();
     s.released_attempts = st.get_int(0);
     s.released_jobs = st.get_int(1);
@@ -226,9 +227,9 @@ void read_troubles(Database& db, Status& s) {
   }
   {
     Statement st(db,
-                 "SELECT job_id, error FROM attempts WHERE kind='drop' AND error LIKE 'bed checksum mismatch%' "
+                 "SELECT job_id, error FROM attempts WHERE outcome='failed' AND error LIKE '% checksum mismatch: %' "
                  "GROUP BY job_id, error ORDER BY max(ended_at) DESC LIMIT 20");
-    while (st.step()) s.beds_rebuilt.emplace_back(st.get_text(0), st.get_text(1));
+    while (st.step()) s.dependency_mismatches.emplace_back(st.get_text(0), st.get_text(1));
   }
 }
 
