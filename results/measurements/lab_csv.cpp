@@ -276,11 +276,16 @@ Campaign load_campaign(const std::string& directory, double cutoff_hz) {
   }
   std::map<std::string, int> col;
   for (int i = 0; i < static_cast<int>(head.size()); ++i) col[head[i]] = i;
-  for (const auto& [alias, key] : trial_field_aliases())  // an older name, read as the field
-    if (col.count(alias) && !col.count(key)) {
-      col[key] = col.at(alias);
-      col.erase(alias);
-    }
+  for (const auto& [alias, key] : trial_field_aliases()) {  // an older name, read as the field
+    if (!col.count(alias)) continue;
+    if (col.count(key))
+      throw std::runtime_error(
+          fmt::format("{}:{}: columns '{}' and '{}' both name the field {} (the first is its "
+                      "older name): keep one",
+                      csv.string(), ln, alias, key, key));
+    col[key] = col.at(alias);
+    col.erase(alias);
+  }
   for (const auto& r : required_columns())
     if (!col.count(r)) {
       std::string also;

@@ -144,7 +144,7 @@ std::optional<Claim> claim(Database& db, const WorkerIdentity& who, const Campai
     tx.commit();  // keeps the reaped leases
     return std::nullopt;
   }
-  {
+  {  // one dependency a job: the lowest id when a job had several (today only drops have one, their bed)
     Statement st(db,
                  "SELECT coalesce(j.output_path, ''), j.job_id, coalesce(j.output_sha256, ''), j.kind FROM job_deps d "
                  "JOIN jobs j ON j.job_id=d.dep_id WHERE d.job_id=? AND j.state='done' AND j.output_path IS NOT NULL "

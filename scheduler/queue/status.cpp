@@ -209,11 +209,13 @@ void read_troubles(Database& db, Status& s) {
     s.blocked = st.get_int(0);
   }
   {
-    Statement st(db,
-                 "SELECT coalesce(sum(releases), 0), coalesce(sum(CASE WHEN releases>0 AND state!='done' THEN 1 "
-                 "ELSE 0 END), 0), coalesce(sum(CASE WHEN state='dead' AND (SELECT a.outcome FROM attempts a WHERE "
-                 "a.job_id=jobs.job_id ORDER BY a.attempt_id DESC LIMIT 1)='released' THEN 1 ELSE 0 END), 0) "
-                 "FROM jobs");  // stopped by releases: dead, and its last attempt was released
+    Statement st(
+        db,
+        "SELECT coalesce(sum(releases), 0), coalesce(sum(CASE WHEN releases>0 AND state!='done' THEN 1 "
+        "ELSE 0 END), 0), coalesce(sum(CASE WHEN state='dead' AND blocked_by IS NULL AND (SELECT a.outcome FROM "
+        "attempts a WHERE "
+        "a.job_id=jobs.job_id ORDER BY a.attempt_id DESC LIMIT 1)='released' THEN 1 ELSE 0 END), 0) "
+        "FROM jobs");  // stopped by releases: dead of its own (not blocked), its last attempt released
     st.step();
     s.released_attempts = st.get_int(0);
     s.released_jobs = st.get_int(1);

@@ -227,6 +227,15 @@ TEST(LabCampaign, TheLabFormatsImpactVelocityColumnIsReadAsTheImpactSpeed) {
   EXPECT_EQ(nlohmann::json(a.trials[0].info).count("impact_velocity_m_s"), 0u) << "nothing is written under it";
   const Trial from_old_json = nlohmann::json{{"trial_id", "J"}, {"impact_velocity_m_s", 0.5}}.get<Trial>();
   EXPECT_EQ(from_old_json.impact_speed_m_s, 0.5);
+  // Both names in one header: refused, naming both (never one kept as an attribute beside the other).
+  write_text(d.path / "both/trials.csv", renamed + ",impact_velocity_m_s\n" + row("A", "traces/A.csv") + ",0.7\n");
+  try {
+    load_campaign((d.path / "both").string());
+    FAIL() << "a header with both names was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("'impact_velocity_m_s' and 'impact_speed_m_s'"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(LabCampaign, TracePathsOutsideTheCampaignFolderAreRefusedWithTheRow) {
