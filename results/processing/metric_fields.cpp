@@ -32,19 +32,6 @@ void to_json(nlohmann::json& j, const Metrics& m) {
   }
 }
 
-void from_json(const nlohmann::json& j, Metrics& m) {
-  for (const auto& f : metric_fields()) {
-    const auto it = j.find(f.key);
-    if (it == j.end() || it->is_null()) continue;
-    if (f.number)
-      m.*f.number = it->get<double>();
-    else if (f.flag)
-      m.*f.flag = it->is_boolean() ? it->get<bool>() : it->get<double>() != 0;
-    else
-      m.*f.text = it->get<std::string>();
-  }
-}
-
 nlohmann::json null_metrics_json() {
   nlohmann::json j = nlohmann::json::object();
   for (const auto& f : metric_fields())

@@ -30,8 +30,6 @@ const std::vector<MetricField>& metric_fields();
 
 /// Every field (the flag as a JSON boolean, the note as a string).
 void to_json(nlohmann::json& j, const Metrics& m);
-/// Fields present in `j` (null or absent: the default).
-void from_json(const nlohmann::json& j, Metrics& m);
 /// Every numeric and flag field as null: a trace whose metrics could not be found.
 nlohmann::json null_metrics_json();
 /// The keys of the headline figures, in the table's order.
