@@ -64,4 +64,13 @@ void Transaction::commit() {
   done_ = true;
 }
 
+bool has_table(Database& db, std::string_view name) {
+  Statement q(db, db.backend() == Backend::sqlite
+                      ? "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = ?"
+                      : "SELECT 1 FROM information_schema.tables WHERE table_schema = current_schema() AND "
+                        "table_name = ?");
+  q.bind(1, std::string(name));
+  return q.step();
+}
+
 }  // namespace gravsweep::db

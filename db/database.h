@@ -142,6 +142,9 @@ class Statement {
   std::unique_ptr<detail::Cursor> cur_;
 };
 
+/// True when the database has a table of this name (in the current schema on PostgreSQL).
+bool has_table(Database& db, std::string_view name);
+
 class Transaction {
  public:
   using Mode = TxMode;

@@ -79,12 +79,6 @@ std::string content_hash(const char* tag, const std::vector<const std::vector<do
   return h.hex_digest();
 }
 
-bool table_exists(db::Database& db, const char* name, const char* type = "table") {
-  db::Statement q(db, "SELECT 1 FROM sqlite_master WHERE type = ? AND name = ?");
-  q.bind(1, type).bind(2, name);
-  return q.step();
-}
-
 /// The columns of a table (empty when it does not exist).
 std::vector<std::string> columns_of(db::Database& db, const char* table) {
   std::vector<std::string> cols;
@@ -217,7 +211,7 @@ CREATE TABLE IF NOT EXISTS trial_metrics (
   auto add_metric = adder("trial_metrics");
   for (const auto& f : metric_fields()) add_metric(f.key, f.sql_type());
   for (const auto& c : kProcessingColumns) add_metric(c.key, c.sql_type);
-  if (table_exists(db, "trial_samples")) migrate_trial_samples(db);
+  if (db::has_table(db, "trial_samples")) migrate_trial_samples(db);
   db.exec(R"(
 CREATE VIEW IF NOT EXISTS trial_samples AS
   SELECT t.trial_id, s.sample, s.t_s, s.accel_raw_m_s2, p.accel_filtered_m_s2, p.velocity_m_s, p.depth_m

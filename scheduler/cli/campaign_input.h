@@ -1,25 +1,20 @@
 // What the model verbs (`model rank|fit|residuals|table3`, `report`, `measurements import`) read:
 // a campaign database from `submit`/`work` (every finished drop job is a trial, its trace.h5 read
-// from the campaign's files folder), an SQLite file from `measurements import`, or a lab campaign
-// folder (trials.csv + traces/). `--where` filters the trials with the grammar of `gravsweep
-// results` (scheduler/queue/filter.h): on the results table of a campaign database, on the trial
-// fields (results/measurements/trial.h) and metrics otherwise.
+// from the campaign's files folder, `--where` on its results table), read here; an SQLite file from
+// `measurements import` or a lab campaign folder (trials.csv + traces/), read by
+// results/measurements/campaign_input.h. One record for all: results::CampaignInput.
 #pragma once
 #include <CLI/CLI.hpp>
 
 #include <string>
 #include <vector>
 
-#include "results/measurements/campaign.h"
+#include "results/measurements/campaign_input.h"
 
 namespace gravsweep::cli {
 
-struct CampaignInput {
-  results::Campaign campaign;
-  std::string kind;              ///< "campaign database (submit/work)", "imported SQLite file", "lab campaign folder"
-  std::size_t filtered_out = 0;  ///< trials left out by --where
-  std::string note;              ///< e.g. drop jobs not finished
-};
+using results::CampaignInput;
+using results::describe_input;
 
 /// Reads `path` (a file, a folder, or a `postgresql://` campaign whose traces are under `files`,
 /// its files root); throws UsageError for what is not a campaign or a bad --where.
@@ -27,8 +22,8 @@ CampaignInput load_campaign_input(const std::string& path, const std::vector<std
                                   double cutoff_hz = 500.0, const std::string& files = {});
 
 /// Reads several inputs (e.g. one exported dataset per gravity level) into one campaign: each is
-/// read and described (describe_input) in turn, the trials and issues concatenated, `--where`
-/// applied to each. Throws UsageError when a trial id appears in two inputs.
+/// read and described (describe_input) in turn, `--where` applied to each, then
+/// results::concatenate_inputs. Throws UsageError when a trial id appears in two inputs.
 CampaignInput load_campaign_inputs(const std::vector<std::string>& paths, const std::vector<std::string>& where,
                                    double cutoff_hz = 500.0, const std::string& files = {});
 
@@ -38,9 +33,5 @@ inline void add_input_files_option(CLI::App* sub, std::string& files) {
                   "the files root of a campaign given as postgresql://user@host:port/dbname (its traces are "
                   "read there; default for an SQLite campaign: <db stem>.files/ beside it)");
 }
-
-/// Prints to stderr what was read ("<path>: <kind>, n trials") and every trial left out with its
-/// reason (unmeasurable or bad input).
-void describe_input(const std::string& path, const CampaignInput& in);
 
 }  // namespace gravsweep::cli

@@ -24,6 +24,7 @@
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/queue/campaign.h"
+#include "db/where.h"
 #include "scheduler/queue/filter.h"
 #include "scheduler/queue/queue.h"
 
@@ -78,7 +79,7 @@ queue::ResultsTable rows_of_csv_files(const PlotResultsOptions& o, const std::ve
         for (const auto& c : cols)
           if (!row.contains(c)) throw UsageError(fmt::format("--from {}: no column '{}' in its header", file, c));
         if (!o.sweep.empty() && row.value("sweep", json()) != json(o.sweep)) continue;
-        if (!queue::row_matches(row, o.where)) continue;
+        if (!db::row_matches(row, o.where)) continue;
         std::vector<json> r;
         for (const auto& c : cols) r.push_back(row[c]);
         t.rows.push_back(std::move(r));

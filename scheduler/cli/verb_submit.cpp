@@ -15,7 +15,7 @@
 #include "scheduler/cli/verbs.h"
 #include "scheduler/pipeline/impact_runners.h"
 #include "scheduler/queue/campaign.h"
-#include "scheduler/queue/filter.h"
+#include "db/where.h"
 #include "scheduler/queue/queue.h"
 #include "scheduler/sweep/spec.h"
 
@@ -40,10 +40,10 @@ std::size_t keep_matching(const std::string& path, std::vector<queue::PlannedJob
   std::set<std::string> beds_needed;
   std::size_t left_out = 0;
   try {
-    for (const auto& w : where) queue::parse_where(w);
+    for (const auto& w : where) db::parse_where(w);
     for (auto& j : jobs) {
       if (j.kind == queue::JobKind::bed) continue;
-      if (!queue::row_matches(j.params, where)) {
+      if (!db::row_matches(j.params, where)) {
         ++left_out;
         continue;
       }

@@ -1,39 +1,16 @@
-// `--where` filters of `gravsweep results`: parsed into (column, operator, value) conditions; the
-// column is checked against the table's real columns and the value is bound as a parameter, so
-// nothing the user types is ever pasted into SQL.
-//
-// Grammar:  condition (("and" | "&&" | ",") condition)*
-//           condition := column op value
-//           op        := < | <= | > | >= | = | == | != | <> | ~ (substring match on text)
-//           value     := number | 'text' | "text" | true | false | bare-word
+// The results table of a campaign database, queried: `gravsweep results`, its `--where` filters
+// (grammar: db/where.h) checked against the table's real columns, their values bound as
+// parameters, so nothing the user types is ever pasted into SQL.
 #pragma once
 #include <nlohmann/json.hpp>
 
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "db/database.h"
+#include "db/where.h"
 
 namespace gravsweep::queue {
-
-struct Condition {
-  std::string column, op;
-  nlohmann::json value;  ///< a finite number, a boolean, or text
-  std::string text;      ///< the value as typed (without quotes): what `~` looks for, and text columns compare to
-};
-
-/// Throws std::invalid_argument naming the position and what was expected (also for nan and inf:
-/// no value compares with them the same way on both backends).
-std::vector<Condition> parse_where(const std::string& expr);
-
-/// The in-memory twin of query_results, for rows that are not in a database (the trials of a lab
-/// campaign, the planned jobs of `submit --where`): true when `row` ({column: value}) satisfies
-/// every condition of every expression. Numbers (and booleans) compare as numbers, everything else
-/// as text; `~` is a substring match. A column the row lacks, or a value that is not a number
-/// compared (< <= > >= = !=) with a column holding a number, throws std::invalid_argument naming
-/// the expression, the column and the value.
-bool row_matches(const nlohmann::json& row, const std::vector<std::string>& where);
 
 struct ResultsQuery {
   std::vector<std::string> where;    ///< --where expressions (ANDed)

@@ -48,7 +48,10 @@ TEST_P(DbBackends, TypesChangesTransactionsAndErrors) {
   const test::CampaignStore store(GetParam(), dir.path);
   if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
   db::Database db(store.location);
+  EXPECT_FALSE(db::has_table(db, "t"));
   db.exec("CREATE TABLE t(k TEXT PRIMARY KEY, i BIGINT, r DOUBLE PRECISION, s TEXT)");
+  EXPECT_TRUE(db::has_table(db, "t"));
+  EXPECT_FALSE(db::has_table(db, "t2"));
   {
     db::Statement ins(db, "INSERT INTO t(k, i, r, s) VALUES(?1, ?2, ?3, ?4)");
     ins.bind(1, "a").bind(2, std::int64_t{1} << 40).bind(3, 0.1).bind(4, "it's");
