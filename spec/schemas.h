@@ -1,8 +1,12 @@
 // The spec schemas of schemas/ (scenario, sweep, model), compiled into the binary, and their
-// validators: the one way a spec file is checked (spec/json_schema.h). Hand checks stay only for
-// what a schema cannot say (cross-field rules), next to the spec they belong to:
-// scheduler/pipeline/scenario_spec.cpp, scheduler/sweep/spec.cpp, results/model/model.cpp.
+// validators: the one way a spec file is read (read_spec_file) and checked (spec/json_schema.h),
+// problems collected in spec/problems.h. Hand checks stay only for what a schema cannot say
+// (cross-field rules), next to the spec they belong to: scheduler/pipeline/scenario_spec.cpp,
+// scheduler/sweep/spec.cpp, results/model/model.cpp.
 #pragma once
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
 #include <string>
 
 #include "spec/json_schema.h"
@@ -20,5 +24,14 @@ const std::string& schema_text(Schema which);
 
 /// The validator of that schema (built once).
 const SchemaValidator& validator(Schema which);
+
+/// What a file of that schema is called in messages: "scenario file", "sweep spec file", "model spec file".
+const char* file_kind(Schema which);
+
+/// A spec file, read and parsed (validate it with validator(which).collect). Throws SpecError
+/// when it cannot be read (source: the file; found: why, e.g. "a folder, not a file"; expected: "a
+/// readable <file_kind>") or is not JSON (source: "FILE:LINE:COLUMN", as compilers name a place;
+/// found: what is wrong; expected: "valid JSON"); a sweep spec's as SpecError::sweep_spec.
+nlohmann::json read_spec_file(const std::filesystem::path& path, Schema which);
 
 }  // namespace gravsweep::spec

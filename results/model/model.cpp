@@ -16,7 +16,7 @@
 #include <stdexcept>
 
 #include "engine/core/error.h"
-#include "spec/json_text.h"
+#include "spec/problems.h"
 #include "spec/schemas.h"
 
 namespace gravsweep::results {
@@ -48,15 +48,10 @@ namespace {
 /// looked up: a generated form's numbers must be in range). Throws spec::SpecError naming the file
 /// and the JSON pointer of every problem.
 std::vector<ModelTerm> model_file_terms(const std::string& file) {
-  std::string why;
-  const auto text = spec::read_text_file(file, why);
-  if (!text) throw spec::SpecError(file, "", why, "a readable model spec file");
-  nlohmann::json j;
-  if (const auto err = spec::parse_json_text(*text, j))
-    throw ConfigError(fmt::format("{}:{}:{}: not valid JSON: {}", file, err->line, err->column, err->what));
-  std::vector<spec::SpecProblem> problems;
-  spec::validator(spec::Schema::model).collect(j, problems);
-  if (!problems.empty()) throw spec::SpecError(file, std::move(problems));
+  nlohmann::json j = spec::read_spec_file(file, spec::Schema::model);
+  spec::Problems problems;
+  spec::validator(spec::Schema::model).collect(j, problems.list());
+  if (!problems.empty()) throw spec::SpecError(file, std::move(problems.list()));
   std::vector<ModelTerm> terms;
   for (std::size_t i = 0; i < j["terms"].size(); ++i) {
     const auto& e = j["terms"][i];
@@ -65,14 +60,14 @@ std::vector<ModelTerm> model_file_terms(const std::string& file) {
     try {
       mt.term = &find_term(name);
     } catch (const std::invalid_argument& ex) {
-      problems.push_back({fmt::format("/terms/{}/name", i), spec::shown_value(e["name"]), ex.what()});
+      problems.add(fmt::format("/terms/{}/name", i), e["name"], ex.what());
       continue;
     }
     mt.per_gravity = e.contains("shared") ? !e["shared"].get<bool>() : mt.term->per_gravity;
     mt.scale = e.value("scale", 1.0);
     terms.push_back(mt);
   }
-  if (!problems.empty()) throw spec::SpecError(file, std::move(problems));
+  if (!problems.empty()) throw spec::SpecError(file, std::move(problems.list()));
   return terms;
 }
 

@@ -1,7 +1,5 @@
 #include "scheduler/pipeline/scenario_spec.h"
 
-#include "spec/json_text.h"
-
 #include <fmt/format.h>
 
 #include <unistd.h>
@@ -19,6 +17,7 @@
 #include "engine/scenario/paper_params.h"
 #include "scheduler/queue/canonical.h"
 #include "scheduler/sweep/spec.h"
+#include "spec/problems.h"
 #include "spec/schemas.h"
 
 // Typed JSON (nlohmann's from_json, found by argument-dependent lookup) for the engine's material
@@ -115,54 +114,7 @@ SystemConfig base_config(const json& s, const json& m) {
   return c;
 }
 
-/// The cross-field checks of a scenario the schema may have found problems in: each check runs,
-/// records its problems and goes on, so every problem is listed, not only the first. A check that
-/// reads a field already found bad (or missing) is skipped: its problem is listed already.
-class Checks {
- public:
-  Checks(const json& s, std::vector<SpecProblem>& problems) : s_(s), problems_(problems) {}
-
-  /// Runs one check; it stops quietly at the first field it reads that is not sound.
-  template <class F>
-  void run(F&& check) {
-    try {
-      check();
-    } catch (const Unsound&) {
-    }
-  }
-  /// True when `pointer` exists and neither it, a field around it nor one inside it has a problem.
-  [[nodiscard]] bool sound(const std::string& pointer) const {
-    if (!s_.contains(json::json_pointer(pointer))) return false;
-    auto inside = [](const std::string& outer, const std::string& p) {
-      return p == outer || outer.empty() || p.rfind(outer + "/", 0) == 0;
-    };
-    for (const auto& pr : problems_)
-      if (inside(pr.pointer, pointer) || inside(pointer, pr.pointer)) return false;
-    return true;
-  }
-  const json& at(const std::string& pointer) const {
-    if (!sound(pointer)) throw Unsound{};
-    return s_[json::json_pointer(pointer)];
-  }
-  double num(const std::string& pointer) const {
-    const json& v = at(pointer);
-    if (!v.is_number()) throw Unsound{};
-    return v.get<double>();
-  }
-  /// The field at `pointer` is bad: its value is shown as found.
-  void bad(const std::string& pointer, const std::string& expected) {
-    const json::json_pointer jp(pointer);
-    problems_.push_back({pointer, s_.contains(jp) ? s_[jp].dump() : "nothing (missing)", expected});
-  }
-  void bad(const std::string& pointer, const std::string& found, const std::string& expected) {
-    problems_.push_back({pointer, found, expected});
-  }
-
- private:
-  struct Unsound {};
-  const json& s_;
-  std::vector<SpecProblem>& problems_;
-};
+using spec::Checks;
 
 /// Runs the engine's own parameter and time-step checks on a two-body system built from the
 /// scenario (smallest grain, projectile, container walls), so errors surface before any work.
@@ -217,7 +169,8 @@ void engine_checks(const json& s, Checks& ck) {
 /// Systems). The problems it found are kept (up to kEngineCheckMemo scenarios) and given again.
 std::atomic<std::size_t> g_engine_check_runs{0};
 
-void engine_checks_once(const json& s, Checks& ck, std::vector<SpecProblem>& problems) {
+void engine_checks_once(const json& s, Checks& ck) {
+  std::vector<SpecProblem>& problems = ck.problems().list();
   constexpr std::size_t kEngineCheckMemo = 256;
   static const char* const kRead[] = {"/grains",
                                       "/projectile/diameter_m",
@@ -418,27 +371,20 @@ std::size_t engine_check_runs() { return g_engine_check_runs.load(std::memory_or
 
 json validate_scenario(const json& scenario, const std::string& source) {
   json s = scenario;
-  std::vector<SpecProblem> problems;
-  spec::validator(spec::Schema::scenario)
-      .collect(s, problems);  // the schema: types, ranges, unknown and missing fields
-  Checks ck(s, problems);     // then the rules across fields, on the sound fields
+  spec::Problems problems;
+  spec::validator(spec::Schema::scenario).collect(s, problems.list());  // types, ranges, unknown and missing fields
+  Checks ck(s, problems);  // then the rules across fields, on the sound fields
   check_names(ck);
   check_geometry(ck);
   check_size_and_steps(ck);
   check_output(ck);
-  engine_checks_once(s, ck, problems);  // the engine's own checks (materials, pair values, dt bound)
-  if (!problems.empty()) throw SpecError(source, std::move(problems));
+  engine_checks_once(s, ck);  // the engine's own checks (materials, pair values, dt bound)
+  if (!problems.empty()) throw SpecError(source, std::move(problems.list()));
   return s;
 }
 
 json load_scenario(const std::filesystem::path& path) {
-  std::string why;
-  const auto text = spec::read_text_file(path, why);
-  if (!text) throw ConfigError(fmt::format("{}: cannot read the scenario file ({})", path.string(), why));
-  json j;
-  if (const auto err = spec::parse_json_text(*text, j))
-    throw ConfigError(fmt::format("{}:{}:{}: not valid JSON: {}", path.string(), err->line, err->column, err->what));
-  return validate_scenario(j, path.string());
+  return validate_scenario(spec::read_spec_file(path, spec::Schema::scenario), path.string());
 }
 
 std::uint64_t site_seed(const json& s) {

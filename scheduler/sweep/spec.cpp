@@ -1,6 +1,6 @@
 #include "scheduler/sweep/spec.h"
 
-#include "spec/json_text.h"
+#include "spec/problems.h"
 
 #include <fmt/format.h>
 
@@ -42,22 +42,7 @@ bool is_int(const json& v) {
   return false;
 }
 
-/// Collects the problems of the second pass.
-struct Checker {
-  std::vector<SpecProblem> problems;
-  void add(const std::string& ptr, const json& found, std::string expected) {
-    problems.push_back({ptr, show(found), std::move(expected)});
-  }
-  void add_text(const std::string& ptr, std::string found, std::string expected) {
-    problems.push_back({ptr, std::move(found), std::move(expected)});
-  }
-};
-
-/// True when a problem lies at `ptr` or below it.
-bool has_problem_under(const std::vector<SpecProblem>& problems, const std::string& ptr) {
-  return std::any_of(problems.begin(), problems.end(),
-                     [&](const SpecProblem& p) { return p.pointer == ptr || p.pointer.rfind(ptr + "/", 0) == 0; });
-}
+using spec::Problems;
 
 /// Problems of a no-op job's scenario: (pointer, found, expected). sleep_s and fail_attempts are
 /// what the no-op runner reads; anything else is carried along (an axis may sweep any field).
@@ -78,7 +63,7 @@ std::vector<SpecProblem> noop_problems(const json& s, const std::string& ptr) {
 std::string value_kind(const json& v) { return v.is_number() ? "number" : spec::type_name(v); }
 
 /// The field an axis sets, looked up in the base; nullptr (reported) when it is not there.
-const json* base_field(const json& a, const std::string& ptr, const json* base, Checker& ck) {
+const json* base_field(const json& a, const std::string& ptr, const json* base, Problems& ck) {
   const std::string pointer = a["pointer"].get<std::string>();
   try {
     const json::json_pointer jp(pointer);
@@ -93,7 +78,7 @@ const json* base_field(const json& a, const std::string& ptr, const json* base, 
 }
 
 /// The values of a range {start, stop, step | num}; nothing when it is refused (reported).
-std::optional<std::vector<json>> range_values(const json& r, const std::string& rp, bool integer_base, Checker& ck) {
+std::optional<std::vector<json>> range_values(const json& r, const std::string& rp, bool integer_base, Problems& ck) {
   std::vector<json> values;
   const double start = r["start"].get<double>(), stop = r["stop"].get<double>();
   if (r.contains("num")) {
@@ -126,7 +111,7 @@ std::optional<std::vector<json>> range_values(const json& r, const std::string& 
 /// The values of repeats {count, start, step} (defaults inserted by the schema); an integer base
 /// value (a seed) needs integer start and step (reported there).
 std::optional<std::vector<json>> repeat_values(const json& a, const std::string& ptr, const json* base_value,
-                                               const std::string& pointer, Checker& ck) {
+                                               const std::string& pointer, Problems& ck) {
   const json &start = a["start"], &step = a["step"];
   if (base_value && base_value->is_number_integer()) {
     bool ok = true;
@@ -152,7 +137,7 @@ std::optional<std::vector<json>> repeat_values(const json& a, const std::string&
 
 /// Reads one axis the schema found sound ({name?, pointer, values | range} or, for repeats,
 /// {name?, pointer, values | count/start/step}): the checks across fields.
-std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json* base, Checker& ck) {
+std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json* base, Problems& ck) {
   Axis axis;
   axis.pointer = a["pointer"].get<std::string>();
   const json* base_value = base_field(a, ptr, base, ck);
@@ -213,30 +198,23 @@ std::optional<Axis> parse_axis(const json& a, const std::string& ptr, const json
 
 /// The base scenario: inline, or a file relative to the spec (read here). Nothing when it cannot be
 /// read (reported).
-std::optional<json> read_base(const json& doc, const std::filesystem::path& base_dir, Checker& ck) {
+std::optional<json> read_base(const json& doc, const std::filesystem::path& base_dir, Problems& ck) {
   if (doc["base"].is_object()) return doc["base"];
   const std::filesystem::path p = base_dir / doc["base"].get<std::string>();
-  std::string why;
-  const auto text = spec::read_text_file(p, why);
-  json base;
-  if (!text) {
-    ck.add("/base", doc["base"], fmt::format("a readable scenario file ('{}' is {})", p.string(), why));
-  } else if (const auto err = spec::parse_json_text(*text, base)) {
-    ck.add("/base", doc["base"],
-           fmt::format("a JSON scenario file ('{}': {} at {})", p.string(), err->what, err->where()));
-  } else if (!base.is_object()) {
+  try {
+    json base = spec::read_spec_file(p, spec::Schema::scenario);
+    if (base.is_object()) return base;
     ck.add("/base", doc["base"],
            fmt::format("a file holding a JSON object ('{}' holds {})", p.string(), value_kind(base)));
-  } else {
-    return base;
+  } catch (const SpecError& e) {
+    ck.add("/base", doc["base"], fmt::format("{} ('{}' is {})", e.expected(), e.source(), e.found()));
   }
   return std::nullopt;
 }
 
 /// The axes and repeats into groups: a zip of equal lengths is one group; no column name or field
 /// twice. Axes the schema found bad are skipped (already reported).
-void read_axes(const json& doc, const json* base, const std::vector<SpecProblem>& schema_problems, SweepSpec& spec,
-               Checker& ck) {
+void read_axes(const json& doc, const json* base, const Problems& schema_problems, SweepSpec& spec, Problems& ck) {
   std::set<std::string> names, pointers;
   auto add_group = [&](AxisGroup g, const std::string& ptr) {
     for (const auto& a : g.axes) {
@@ -250,7 +228,7 @@ void read_axes(const json& doc, const json* base, const std::vector<SpecProblem>
   const json axes = doc.value("axes", json::array());
   for (std::size_t i = 0; i < axes.size(); ++i) {
     const std::string ap = join("/axes", i);
-    if (has_problem_under(schema_problems, ap)) continue;
+    if (schema_problems.at_or_below(ap)) continue;
     if (!axes[i].contains("zip")) {
       if (auto axis = parse_axis(axes[i], ap, base, ck)) add_group(AxisGroup{{std::move(*axis)}}, ap);
       continue;
@@ -272,7 +250,7 @@ void read_axes(const json& doc, const json* base, const std::vector<SpecProblem>
     }
     if (ok) add_group(std::move(g), ap);
   }
-  if (doc.contains("repeats") && !has_problem_under(schema_problems, "/repeats"))
+  if (doc.contains("repeats") && !schema_problems.at_or_below("/repeats"))
     if (auto axis = parse_axis(doc["repeats"], "/repeats", base, ck))
       add_group(AxisGroup{{std::move(*axis)}}, "/repeats");
 }
@@ -348,32 +326,32 @@ std::string column_from_pointer(const std::string& pointer) {
 
 SweepSpec parse_spec(const json& doc_in, const std::string& file, const std::filesystem::path& base_dir) {
   json doc = doc_in;  // the schema inserts its defaults (job, max_attempts, priority, repeat start/step)
-  std::vector<SpecProblem> problems;
-  spec::validator(spec::Schema::sweep).collect(doc, problems);
-  if (!doc.is_object()) throw SpecError::sweep_spec(file, problems);
+  Problems problems;  // the schema's; then the rules across fields add theirs to `ck`
+  spec::validator(spec::Schema::sweep).collect(doc, problems.list());
+  if (!doc.is_object()) throw SpecError::sweep_spec(file, problems.list());
   SweepSpec spec;
-  auto sound = [&](const char* ptr) { return doc.contains(ptr + 1) && !has_problem_under(problems, ptr); };
+  auto sound = [&](const char* ptr) { return doc.contains(ptr + 1) && !problems.at_or_below(ptr); };
   if (sound("/sweep")) spec.name = doc["sweep"].get<std::string>();
   if (sound("/job")) spec.job_kind = doc["job"].get<std::string>();
   if (sound("/max_attempts")) spec.max_attempts = doc["max_attempts"].get<int>();
   if (sound("/priority")) spec.priority = doc["priority"].get<int>();
 
-  Checker ck;
+  Problems ck;
   std::optional<json> base;
   if (sound("/base")) base = read_base(doc, base_dir, ck);
   if (base) {
     try {
       spec.base = queue::canonicalize(*base);
       if (spec.job_kind == "noop")
-        for (auto& p : noop_problems(spec.base, "/base")) ck.problems.push_back(std::move(p));
+        for (auto& p : noop_problems(spec.base, "/base")) ck.list().push_back(std::move(p));
     } catch (const queue::CanonicalError& e) {
       ck.add_text("/base", e.what(), "finite numbers only");
       base.reset();
     }
   }
   read_axes(doc, base ? &spec.base : nullptr, problems, spec, ck);
-  problems.insert(problems.end(), ck.problems.begin(), ck.problems.end());
-  if (!problems.empty()) throw SpecError::sweep_spec(file, problems);
+  problems.list().insert(problems.list().end(), ck.list().begin(), ck.list().end());
+  if (!problems.empty()) throw SpecError::sweep_spec(file, problems.list());
   refuse_costly(spec, file);
   spec.source = doc_in;
   spec.source["base"] = spec.base;
@@ -382,13 +360,7 @@ SweepSpec parse_spec(const json& doc_in, const std::string& file, const std::fil
 }
 
 SweepSpec load_spec(const std::filesystem::path& path) {
-  std::string why;
-  const auto text = spec::read_text_file(path, why);
-  if (!text) throw SpecError::sweep_spec(path.string(), {{"", why, "a JSON sweep spec file"}});
-  json doc;
-  if (const auto err = spec::parse_json_text(*text, doc))
-    throw SpecError::sweep_spec(path.string(), {{"", fmt::format("{} at {}", err->what, err->where()), "valid JSON"}});
-  return parse_spec(doc, path.string(), path.parent_path());
+  return parse_spec(spec::read_spec_file(path, spec::Schema::sweep), path.string(), path.parent_path());
 }
 
 namespace {

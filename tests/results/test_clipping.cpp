@@ -93,10 +93,11 @@ TEST(Clipping, ImportFlagsTheClippedTrialsAndEq2LeavesTheirApeakOut) {
       // tstop: threshold crossings far below the clip, as without it.
       EXPECT_NEAR(t.processed.metrics.tstop_s, full.trials[i].processed.metrics.tstop_s, 2.0 / o.sample_rate_hz);
       // zstop, when kept, within the stated tolerance of the unclipped record's.
-      if (clip_exclusion(t, ClippedMetric::zstop).empty())
+      if (clip_exclusion(t, ClippedMetric::zstop).empty()) {
         EXPECT_NEAR(t.processed.metrics.zstop_m, full.trials[i].processed.metrics.zstop_m,
                     kClipDepthTolerance * full.trials[i].processed.metrics.zstop_m + 1e-4)
             << t.info.trial_id;
+      }
       EXPECT_NE(clip_summary(t).find("lower bound"), std::string::npos) << clip_summary(t);
     } else {
       EXPECT_TRUE(clip_summary(t).empty());

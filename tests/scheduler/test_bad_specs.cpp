@@ -52,12 +52,12 @@ std::string without(json doc, const std::string& pointer) {
 std::vector<Case> corpus() {
   std::vector<Case> c;
   const json n = noop_doc(), im = impact_doc();
-  c.push_back({"syntax error", "{\n  \"sweep\": \"x\",\n  \"base\": {\n}", "line 4", "JSON"});
-  c.push_back(
-      {"number out of range", "{\"sweep\": \"x\", \"job\": \"noop\",\n \"base\": {\"g\": 1e999}}", "line 2", "1e999"});
+  c.push_back({"syntax error", "{\n  \"sweep\": \"x\",\n  \"base\": {\n}", "bad_spec.json:4:", "JSON"});
+  c.push_back({"number out of range", "{\"sweep\": \"x\", \"job\": \"noop\",\n \"base\": {\"g\": 1e999}}",
+               "bad_spec.json:2:", "1e999"});
   c.push_back({"nested 100000 deep",
                "{\"sweep\": \"x\", \"base\": " + std::string(100000, '[') + std::string(100000, ']') + "}",
-               "line 1, column", "deeper than 64"});
+               "bad_spec.json:1:", "deeper than 64"});
   c.push_back({"not an object", "[1, 2]", "(array)", "an object"});
   c.push_back({"base is a folder", with(n, "/base", "/tmp"), "/base", "a folder"});
   c.push_back({"base file missing", with(n, "/base", "no_such_scenario.json"), "/base", "no readable file"});

@@ -127,10 +127,10 @@ TEST(FilesRoot, AnotherCampaignsFolderIsRefusedBeforeAnythingMoves) {
   // A fresh campaign (no done jobs: the "most outputs missing" check cannot tell) given the wrong folder.
   write_text(d.path / "c.json", noop_sweep(2, "c"));
   ASSERT_EQ(run_cli({"submit", "c.json", "--db", "c.db"}, d.path).code, 0);
-  for (const std::vector<std::string> verb : {std::vector<std::string>{"resume"},
-                                              {"resume", "--dry-run"},
-                                              {"resume", "--keep-orphans"},
-                                              {"work", "--quiet"}}) {
+  for (const std::vector<std::string>& verb : {std::vector<std::string>{"resume"},
+                                               {"resume", "--dry-run"},
+                                               {"resume", "--keep-orphans"},
+                                               {"work", "--quiet"}}) {
     std::vector<std::string> args = verb;
     args.insert(args.end(), {"--db", "c.db", "--files", (d.path / "other.files").string()});
     const auto r = run_cli(args, d.path);

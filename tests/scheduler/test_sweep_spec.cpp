@@ -153,7 +153,7 @@ TEST(SweepSpec, JsonSyntaxErrorNamesLineAndColumn) {
     load_spec(dir.path / "s.json");
     FAIL() << "syntax error accepted";
   } catch (const SpecError& e) {
-    EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("s.json:3:"), std::string::npos) << e.what();
   }
 }
 

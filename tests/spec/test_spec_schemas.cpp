@@ -132,7 +132,7 @@ TEST(SpecSchemas, AModelFileIsCheckedByItsSchemaEveryProblemWithItsPointer) {
 }
 
 TEST(SpecSchemas, AModelFileWithBadJsonNamesItsLineAndColumn) {
-  // Model files are read like scenario and sweep specs (spec/json_text.h): file:line:column.
+  // Model files are read like scenario and sweep specs (spec::read_spec_file): FILE:LINE:COLUMN.
   test::TempDir d;
   const fs::path f = d.path / "model.json";
   std::ofstream(f) << "{\"terms\": [\n  {\"name\": \"base\"},\n  {\"name\": }\n]}\n";
@@ -140,6 +140,8 @@ TEST(SpecSchemas, AModelFileWithBadJsonNamesItsLineAndColumn) {
     results::parse_model(f.string());
     FAIL() << "bad JSON accepted";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find(f.string() + ":3:"), std::string::npos) << e.what();
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind(f.string() + ":3:", 0), 0u) << m;
+    EXPECT_NE(m.find("expected valid JSON"), std::string::npos) << m;
   }
 }
