@@ -197,7 +197,7 @@ bool work_remains(Database& db) {
 }
 
 int threads_for_claim(Database& db, const Claim& c, int threads, int pool_threads) {
-  if (c.kind != JobKind::bed || pool_threads <= threads) return threads;
+  if (!kind_info(c.kind).takes_idle_threads || pool_threads <= threads) return threads;
   Statement st(db, "SELECT EXISTS(SELECT 1 FROM jobs WHERE job_id<>? AND state IN ('queued','running','failed'))");
   st.bind(1, c.job_id);
   st.step();

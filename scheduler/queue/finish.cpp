@@ -68,7 +68,7 @@ bool complete(Database& db, const Claim& c, const Completion& done) {
     st.bind(1, c.job_id);
     st.run();
   }
-  if (c.kind != JobKind::bed) detail::insert_results_row(db, c, done, now, code_version);
+  if (kind_info(c.kind).results_row) detail::insert_results_row(db, c, done, now, code_version);
   tx.commit();
   return true;
 }

@@ -11,9 +11,9 @@ namespace gravsweep::queue {
 namespace {
 
 constexpr std::array<JobKindInfo, 3> kKinds{{
-    {JobKind::bed, "bed", "beds", ".h5"},
-    {JobKind::drop, "drop", "traces", ".h5"},
-    {JobKind::noop, "noop", "noop", ".json"},
+    {JobKind::bed, "bed", "beds", ".h5", false, true},
+    {JobKind::drop, "drop", "traces", ".h5", true, false},
+    {JobKind::noop, "noop", "noop", ".json", true, false},
 }};
 
 constexpr std::array<const char*, 6> kStates{"waiting", "queued", "running", "failed", "done", "dead"};

@@ -19,6 +19,12 @@ struct JobKindInfo {
   const char* name;       ///< stored in jobs.kind
   const char* folder;     ///< outputs under <files root>/<folder>/
   const char* extension;  ///< of the output file, with the dot
+  /// A finished job of this kind is a row of the results table (false: an input other jobs use,
+  /// such as a prepared bed, whose output is found through its dependents).
+  bool results_row;
+  /// A job of this kind takes the whole worker pool's threads when no other job is waiting to run
+  /// beside it (an input every dependent waits for: nothing else would use the idle threads).
+  bool takes_idle_threads;
 };
 
 /// The one table of kinds (in enum order).

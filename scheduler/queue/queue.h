@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -54,11 +55,10 @@ struct CampaignPaths {
 // ---- submit ---------------------------------------------------------------------------------
 struct SubmitReport {
   std::string sweep;
-  std::size_t planned = 0;  ///< jobs in the expanded spec
-  std::size_t added = 0;    ///< new jobs written
-  std::size_t present = 0;  ///< already in the campaign (same content hash)
-  std::size_t beds_added = 0;
-  std::size_t drops_added = 0;
+  std::size_t planned = 0;                       ///< jobs in the expanded spec
+  std::size_t added = 0;                         ///< new jobs written
+  std::size_t present = 0;                       ///< already in the campaign (same content hash)
+  std::map<JobKind, std::size_t> added_by_kind;  ///< new jobs of each kind
   bool sweep_new = false;
 };
 
@@ -167,9 +167,10 @@ bool give_back(db::Database& db, const Claim& c, const std::string& why);
 /// True while some job may still become runnable (queued, waiting, failed, running).
 bool work_remains(db::Database& db);
 
-/// Threads for the claimed job: `pool_threads` (all the threads the workers hold) for a bed job
-/// that runs alone, i.e. no other job is running, queued or waiting to retry (the other workers
-/// would idle until the bed is done: its drops wait for it); `threads` otherwise.
+/// Threads for the claimed job: `pool_threads` (all the threads the workers hold) for a job whose
+/// kind takes idle threads (JobKindInfo::takes_idle_threads, a bed) when it runs alone, i.e. no
+/// other job is running, queued or waiting to retry (the other workers would idle until it is done:
+/// its dependents wait for it); `threads` otherwise.
 int threads_for_claim(db::Database& db, const Claim& c, int threads, int pool_threads);
 
 // ---- resume -----------------------------------------------------------------------------------

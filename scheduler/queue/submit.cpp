@@ -66,10 +66,7 @@ void insert_jobs(Database& db, const SweepRecord& spec, const std::vector<Planne
     const bool added = db.changes() == 1;
     if (added) {
       ++rep.added;
-      if (j.kind == JobKind::bed)
-        ++rep.beds_added;
-      else
-        ++rep.drops_added;
+      ++rep.added_by_kind[j.kind];
       if (!j.deps.empty()) {
         for (const auto& d : j.deps) {
           dep.reset();

@@ -130,8 +130,8 @@ TEST_P(QueueTest, ANonIntegerValueWidensAnIntegerResultsColumnAndKeepsItsValues)
 
 TEST_P(QueueTest, DropsWaitForTheirBedAndBedsAreClaimedFirst) {
   auto r = submit_spec(impact_spec(), bed_key);
-  EXPECT_EQ(r.beds_added, 2u);
-  EXPECT_EQ(r.drops_added, 6u);
+  EXPECT_EQ(r.added_by_kind[JobKind::bed], 2u);
+  EXPECT_EQ(r.added_by_kind[JobKind::drop], 6u);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='waiting'"), 6);
   auto bed = claim(db, me, paths, 60);
   ASSERT_TRUE(bed);
