@@ -87,7 +87,7 @@ void purge_quarantine(Database& db, const CampaignPaths& paths, OrphanReport& re
   const Referenced ref = referenced_files(db);
   for (const auto& batch : fs::directory_iterator(qroot, ec)) {
     if (!is_batch_name(batch.path().filename().string()) || !real_directory(batch.path())) continue;
-    for (const char* dir : kOutputFolders) {
+    for (const std::string& dir : output_folders()) {
       const fs::path d = batch.path() / dir;
       if (!real_directory(d)) continue;
       for (const auto& e : fs::directory_iterator(d, ec)) {
@@ -295,7 +295,7 @@ OrphanReport quarantine_orphans(Database& db, const CampaignPaths& paths, bool d
   };
   std::vector<Candidate> found;
   std::error_code ec;
-  for (const char* dir : kOutputFolders) {
+  for (const std::string& dir : output_folders()) {
     const fs::path d = paths.root / dir;
     if (!fs::is_directory(d, ec)) continue;
     for (const auto& e : fs::directory_iterator(d, ec))

@@ -57,7 +57,7 @@ std::size_t copy_files(const CampaignPaths& from, const CampaignPaths& to) {
   std::error_code ec;
   if (fs::equivalent(from.root, to.root, ec)) return 0;
   std::size_t n = 0;
-  for (const char* dir : {"beds", "traces", "noop"}) {
+  for (const std::string& dir : kind_folders()) {
     const fs::path src = from.root / dir;
     if (!fs::is_directory(src, ec)) continue;
     fs::create_directories(to.root / dir);

@@ -24,8 +24,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// Folders gravsweep makes in a files root; anything else at its top is foreign content.
-constexpr const char* kRootFolders[] = {"beds", "traces", "noop", "tmp", "quarantine", "snapshots"};
+/// Folders gravsweep makes in a files root: the output folders (job_types.h), quarantine/ and
+/// snapshots/; anything else at its top is foreign content.
+bool root_folder(const std::string& name) {
+  const auto& out = output_folders();
+  return std::find(out.begin(), out.end(), name) != out.end() || name == "quarantine" || name == "snapshots";
+}
 
 /// `postgresql://user:secret@host/db` without its password (the marker and messages name it).
 std::string without_password(const std::string& location) {
@@ -88,7 +92,7 @@ std::string first_foreign(Database& db, const fs::path& root) {
   for (const auto& e : fs::directory_iterator(root, ec)) {
     const std::string name = e.path().filename().string();
     if (name == kFilesMarker) continue;
-    const bool ours = std::find(std::begin(kRootFolders), std::end(kRootFolders), name) != std::end(kRootFolders);
+    const bool ours = root_folder(name);
     if (!ours || fs::symlink_status(e.path(), ec).type() != fs::file_type::directory) return e.path().string();
     if (name == "quarantine" || name == "snapshots") {
       if (count_files(e.path()) > 0) return e.path().string();

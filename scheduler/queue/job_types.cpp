@@ -31,6 +31,24 @@ JobKind parse_kind(std::string_view name) {
   throw ConfigError(fmt::format("unknown job kind '{}' (expected one of {})", name, valid));
 }
 
+const std::vector<std::string>& kind_folders() {
+  static const std::vector<std::string> folders = [] {
+    std::vector<std::string> f;
+    for (const auto& k : kKinds) f.emplace_back(k.folder);
+    return f;
+  }();
+  return folders;
+}
+
+const std::vector<std::string>& output_folders() {
+  static const std::vector<std::string> folders = [] {
+    std::vector<std::string> f = kind_folders();
+    f.emplace_back("tmp");
+    return f;
+  }();
+  return folders;
+}
+
 const char* state_name(JobState s) { return kStates.at(static_cast<std::size_t>(s)); }
 
 JobState parse_state(std::string_view name) {

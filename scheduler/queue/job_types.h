@@ -37,8 +37,10 @@ const char* state_name(JobState s);
 /// The state named `name`; throws ConfigError listing the valid names.
 JobState parse_state(std::string_view name);
 
-/// Folders of the files root that hold job outputs and temporary files, in kind order, then tmp.
-inline constexpr const char* kOutputFolders[] = {"beds", "traces", "noop", "tmp"};
+/// Folders of the files root that hold job outputs (the kinds' folders, in kind order).
+const std::vector<std::string>& kind_folders();
+/// The kinds' folders, then tmp (temporary files of running attempts).
+const std::vector<std::string>& output_folders();
 
 inline bool operator==(JobKind k, std::string_view name) { return name == kind_name(k); }
 inline bool operator!=(JobKind k, std::string_view name) { return !(k == name); }

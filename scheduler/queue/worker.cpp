@@ -276,7 +276,7 @@ class Worker {
         with_db_(db_, o.db_path.string(), o.db_outage_s) {
     check_campaign(db_);  // never creates a schema: `work` opened the campaign with open_campaign
     std::error_code ec;
-    for (const char* d : kOutputFolders) fs::create_directories(paths_.root / d, ec);
+    for (const std::string& d : output_folders()) fs::create_directories(paths_.root / d, ec);
     largest_ = with_db_([&] { return largest_output(db_); });
   }
 
