@@ -21,6 +21,8 @@ void Problems::add_text(std::string pointer, std::string found, std::string expe
   list_.push_back({std::move(pointer), std::move(found), std::move(expected)});
 }
 
+void Problems::append(const Problems& other) { list_.insert(list_.end(), other.list_.begin(), other.list_.end()); }
+
 bool Problems::at_or_below(const std::string& pointer) const {
   for (const auto& p : list_)
     if (inside(pointer, p.pointer)) return true;

@@ -24,6 +24,8 @@ class Problems {
   void add(std::string pointer, const nlohmann::json& found, std::string expected);
   /// A problem at `pointer` with the found part as given (an error's text, "nothing (missing)").
   void add_text(std::string pointer, std::string found, std::string expected);
+  /// Appends `other`'s problems after these, in their order.
+  void append(const Problems& other);
   /// True when a problem lies at `pointer` or below it.
   [[nodiscard]] bool at_or_below(const std::string& pointer) const;
   /// True when a problem lies at `pointer`, below it or at a field around it.

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <filesystem>
+#include <optional>
 #include <utility>
 
 #include "db/database.h"
@@ -17,11 +18,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// True for an SQLite campaign database of the job queue (tables jobs and results).
-bool is_queue_database(const std::string& path) {
-  if (!fs::is_regular_file(path) || fs::file_size(path) == 0) return false;
+/// The campaign database of the job queue at `path` (tables jobs and results), opened read-only;
+/// nothing when `path` is anything else (results/ reads those).
+std::optional<db::Database> open_queue_database(const std::string& path) {
+  if (!fs::is_regular_file(path) || fs::file_size(path) == 0) return std::nullopt;
   db::Database db(path, 30000, true);
-  return db::has_table(db, "jobs") && db::has_table(db, "results");
+  if (!db::has_table(db, "jobs") || !db::has_table(db, "results")) return std::nullopt;
+  return db;
 }
 
 /// Every finished drop of a campaign database (filtered on its results table) as a DEM trial.
@@ -66,10 +69,7 @@ CampaignInput load_campaign_input(const std::string& path, const std::vector<std
       db::Database db = queue::open_campaign(path, queue::OpenMode::read, files);  // refuses a non-campaign
       return load_queue_campaign(path, db, where, files);
     }
-    if (is_queue_database(path)) {
-      db::Database db(path, 30000, true);
-      return load_queue_campaign(path, db, where, files);
-    }
+    if (auto db = open_queue_database(path)) return load_queue_campaign(path, *db, where, files);
     return results::load_trial_input(path, where, cutoff_hz);
   } catch (const UsageError&) {
     throw;

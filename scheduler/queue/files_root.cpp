@@ -26,9 +26,12 @@ namespace {
 
 /// Folders gravsweep makes in a files root: the output folders (job_types.h), quarantine/ and
 /// snapshots/; anything else at its top is foreign content.
+/// quarantine/ and snapshots/: folders no job refers to (any file in them is foreign content).
+bool unreferenced_folder(const std::string& name) { return name == "quarantine" || name == "snapshots"; }
+
 bool root_folder(const std::string& name) {
   const auto& out = output_folders();
-  return std::find(out.begin(), out.end(), name) != out.end() || name == "quarantine" || name == "snapshots";
+  return std::find(out.begin(), out.end(), name) != out.end() || unreferenced_folder(name);
 }
 
 /// `postgresql://user:secret@host/db` without its password (the marker and messages name it).
@@ -94,7 +97,7 @@ std::string first_foreign(Database& db, const fs::path& root) {
     if (name == kFilesMarker) continue;
     const bool ours = root_folder(name);
     if (!ours || fs::symlink_status(e.path(), ec).type() != fs::file_type::directory) return e.path().string();
-    if (name == "quarantine" || name == "snapshots") {
+    if (unreferenced_folder(name)) {
       if (count_files(e.path()) > 0) return e.path().string();
       continue;
     }

@@ -350,7 +350,7 @@ SweepSpec parse_spec(const json& doc_in, const std::string& file, const std::fil
     }
   }
   read_axes(doc, base ? &spec.base : nullptr, problems, spec, ck);
-  problems.list().insert(problems.list().end(), ck.list().begin(), ck.list().end());
+  problems.append(ck);
   if (!problems.empty()) throw SpecError::sweep_spec(file, problems.list());
   refuse_costly(spec, file);
   spec.source = doc_in;
