@@ -2,6 +2,7 @@
 // parameter beta, exactly as docs/physics/contact-laws.md section 2.3. The springs rotate with the
 // contact frame and the step's increment is undone when a slider slips.
 #pragma once
+#include <algorithm>
 #include <cmath>
 
 #include "engine/contact/contact.h"
@@ -15,6 +16,23 @@ struct RollingZhang {
       "M_R <= mu_r beta Rbar |F_N|, M_Q <= mu_t mu_s beta Rbar |F_N|";
   /// Needs FrameHistory stored per contact (contact.h).
   static constexpr bool uses_frame_history = true;
+
+  /// The spring a slider keeps when this step's increment is undone: the spring of the step
+  /// before, or, when that spring is itself beyond the limit (the limit falls with |F_N| while
+  /// the spring is loaded), the spring scaled down to the limit. Undoing the increment alone
+  /// would keep a stale spring beyond the limit: the slider would then push at the limit in the
+  /// direction of a motion that never unloads it, doing positive work every step (in a bed at
+  /// 1 g it kept floor grains spinning about the floor's normal at 5-50 rad/s and the bed from
+  /// coming to rest; docs/physics/contact-laws.md section 2.3).
+  GRAVSWEEP_INLINE static double held_at_limit(double phi_rad, double k_N_m_rad, double limit_N_m) {
+    const double held = k_N_m_rad > 0 ? limit_N_m / k_N_m_rad : 0;
+    return std::clamp(phi_rad, -held, held);
+  }
+  GRAVSWEEP_INLINE static Vec3 held_at_limit(const Vec3& phi_rad, double k_N_m_rad, double limit_N_m) {
+    const double held = k_N_m_rad > 0 ? limit_N_m / k_N_m_rad : 0;
+    const double size = phi_rad.norm();
+    return size > held ? Vec3(phi_rad * (held / size)) : phi_rad;
+  }
 
   GRAVSWEEP_INLINE static void apply(const ContactGeometry& g, const PairCoefficients& c, const ContactOptions&,
                                      ContactHistory& /*h*/, FrameHistory& fh, double dt_s, ContactForce& out) {
@@ -40,7 +58,7 @@ struct RollingZhang {
     const double spring_R = kR * fh.roll_rad.norm();
     if (spring_R > MR_max) {
       MR = spring_R > 0 ? Vec3(MR_max * fh.roll_rad.normalized()) : Vec3::Zero();
-      fh.roll_rad = phi_old;  // undo this step's increment
+      fh.roll_rad = held_at_limit(phi_old, kR, MR_max);  // undo this step's increment
     }
     // Twisting spring.
     const double phiQ_old = fh.twist_rad;
@@ -49,7 +67,7 @@ struct RollingZhang {
     double MQ = kQ * fh.twist_rad + CQ * w_twist;
     if (std::abs(kQ * fh.twist_rad) > MQ_max) {
       MQ = (fh.twist_rad > 0 ? 1.0 : -1.0) * MQ_max;
-      fh.twist_rad = phiQ_old;
+      fh.twist_rad = held_at_limit(phiQ_old, kQ, MQ_max);  // undo this step's increment
     }
     out.torque_1 += MR + MQ * n;
     if (!g.wall) out.torque_2 -= MR + MQ * n;
