@@ -17,6 +17,7 @@
 #include "scheduler/queue/campaign.h"
 #include "db/where.h"
 #include "scheduler/queue/queue.h"
+#include "scheduler/sweep/impact_kinds.h"
 #include "scheduler/sweep/spec.h"
 
 namespace gravsweep::cli {
@@ -42,7 +43,7 @@ std::size_t keep_matching(const std::string& path, std::vector<queue::PlannedJob
   try {
     for (const auto& w : where) db::parse_where(w);
     for (auto& j : jobs) {
-      if (j.kind == queue::JobKind::bed) continue;
+      if (j.kind == sweep::bed_kind()) continue;
       if (!db::row_matches(j.params, where)) {
         ++left_out;
         continue;
@@ -55,7 +56,7 @@ std::size_t keep_matching(const std::string& path, std::vector<queue::PlannedJob
   }
   std::vector<queue::PlannedJob> out;
   for (auto& j : jobs)  // beds first, in their planned order, as expand() gives them
-    if (j.kind == queue::JobKind::bed && beds_needed.count(j.job_id)) out.push_back(std::move(j));
+    if (j.kind == sweep::bed_kind() && beds_needed.count(j.job_id)) out.push_back(std::move(j));
   for (auto& j : kept) out.push_back(std::move(j));
   jobs = std::move(out);
   return left_out;
@@ -99,7 +100,7 @@ void run_submit(const SubmitOptions& o) {
   if (o.dry_run) {
     for (const auto& p : planned) {
       std::size_t beds = 0;
-      for (const auto& j : p.jobs) beds += j.kind == queue::JobKind::bed;
+      for (const auto& j : p.jobs) beds += j.kind == sweep::bed_kind();
       fmt::print("sweep {}: {} points -> {} jobs ({} bed, {} {}) [dry run: nothing written]\n", p.spec.name,
                  p.spec.points(), p.jobs.size(), beds, p.jobs.size() - beds,
                  p.spec.job_kind == "noop" ? "noop" : "drop");
@@ -112,8 +113,8 @@ void run_submit(const SubmitOptions& o) {
     const auto r = queue::submit(db, sweep::record(p.spec), p.jobs);
     fmt::print("sweep {} ({}): {} jobs planned ({} bed, {} {}): {} new, {} already present\n", r.sweep,
                r.sweep_new ? "new sweep" : "existing sweep", r.planned,
-               std::count_if(p.jobs.begin(), p.jobs.end(), [](const auto& j) { return j.kind == queue::JobKind::bed; }),
-               std::count_if(p.jobs.begin(), p.jobs.end(), [](const auto& j) { return j.kind != queue::JobKind::bed; }),
+               std::count_if(p.jobs.begin(), p.jobs.end(), [](const auto& j) { return j.kind == sweep::bed_kind(); }),
+               std::count_if(p.jobs.begin(), p.jobs.end(), [](const auto& j) { return j.kind != sweep::bed_kind(); }),
                p.spec.job_kind == "noop" ? "noop" : "drop", r.added, r.present);
   }
 }

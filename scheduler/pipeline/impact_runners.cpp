@@ -5,10 +5,10 @@
 #include "scheduler/pipeline/bed_cache.h"
 #include "scheduler/pipeline/impact_job.h"
 #include "scheduler/queue/stop.h"
+#include "scheduler/sweep/impact_kinds.h"
 
 namespace gravsweep::pipeline {
 
-using queue::JobKind;
 using queue::RunContext;
 using queue::RunnerTable;
 using queue::RunOutput;
@@ -18,7 +18,7 @@ sweep::BedKeyFn impact_bed_key() {
 }
 
 void add_impact_runners(RunnerTable& table) {
-  table[JobKind::bed] = [](const RunContext& ctx) {
+  table[sweep::bed_kind()] = [](const RunContext& ctx) {
     RunOutput out;
     if (!ctx.bed_cache.empty()) {
       if (auto cached = take_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.claim.scenario, ctx.output_tmp)) {
@@ -32,7 +32,7 @@ void add_impact_runners(RunnerTable& table) {
     out.report = r.report;
     return out;
   };
-  table[JobKind::drop] = [](const RunContext& ctx) {
+  table[sweep::drop_kind()] = [](const RunContext& ctx) {
     if (ctx.dependency_output.empty())
       throw std::runtime_error(fmt::format("drop job {} has no prepared bed", ctx.claim.job_id));
     DropCheckpointing ckpt;
@@ -59,7 +59,7 @@ void add_impact_runners(RunnerTable& table) {
 
 RunnerTable all_runners() {
   RunnerTable t;
-  t[JobKind::noop] = queue::noop_runner();
+  t[queue::noop_kind()] = queue::noop_runner();
   add_impact_runners(t);
   return t;
 }

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <deque>
+#include <mutex>
 
 #include "engine/core/error.h"
 
@@ -10,42 +12,77 @@ namespace gravsweep::queue {
 
 namespace {
 
-constexpr std::array<JobKindInfo, 3> kKinds{{
-    {JobKind::bed, "bed", "beds", ".h5", false, true},
-    {JobKind::drop, "drop", "traces", ".h5", true, false},
-    {JobKind::noop, "noop", "noop", ".json", true, false},
-}};
+/// The table of kinds: rows are only appended (JobKind is an index), so references stay valid.
+struct KindTable {
+  std::mutex mutex;
+  std::deque<JobKindInfo> rows{{"noop", "noop", ".json", true, false}};
+};
+
+KindTable& kind_table() {
+  static KindTable table;
+  return table;
+}
+
+bool same_row(const JobKindInfo& a, const JobKindInfo& b) {
+  return a.name == b.name && a.folder == b.folder && a.extension == b.extension && a.results_row == b.results_row &&
+         a.takes_idle_threads == b.takes_idle_threads;
+}
 
 constexpr std::array<const char*, 6> kStates{"waiting", "queued", "running", "failed", "done", "dead"};
 
 }  // namespace
 
-const JobKindInfo& kind_info(JobKind k) { return kKinds.at(static_cast<std::size_t>(k)); }
+JobKind register_kind(JobKindInfo info) {
+  KindTable& t = kind_table();
+  const std::lock_guard lock(t.mutex);
+  for (std::size_t i = 0; i < t.rows.size(); ++i) {
+    const JobKindInfo& row = t.rows[i];
+    if (row.name == info.name) {
+      if (same_row(row, info)) return JobKind(i);
+      throw ConfigError(fmt::format("job kind '{}' is registered twice, with different table rows", info.name));
+    }
+    if (row.folder == info.folder)
+      throw ConfigError(
+          fmt::format("job kinds '{}' and '{}' cannot share the output folder '{}'", row.name, info.name, info.folder));
+  }
+  if (info.name.empty() || info.folder.empty() || info.folder == "tmp")
+    throw ConfigError(fmt::format("job kind '{}': a kind needs a name and an output folder other than tmp", info.name));
+  t.rows.push_back(std::move(info));
+  return JobKind(t.rows.size() - 1);
+}
+
+std::vector<JobKind> registered_kinds() {
+  KindTable& t = kind_table();
+  const std::lock_guard lock(t.mutex);
+  std::vector<JobKind> kinds;
+  for (std::size_t i = 0; i < t.rows.size(); ++i) kinds.push_back(JobKind(i));
+  return kinds;
+}
+
+const JobKindInfo& kind_info(JobKind k) {
+  KindTable& t = kind_table();
+  const std::lock_guard lock(t.mutex);
+  return t.rows.at(k.index());
+}
 
 JobKind parse_kind(std::string_view name) {
   std::string valid;
-  for (const auto& k : kKinds) {
-    if (name == k.name) return k.kind;
-    valid += (valid.empty() ? "" : ", ") + std::string(k.name);
+  for (JobKind k : registered_kinds()) {
+    if (name == kind_info(k).name) return k;
+    valid += (valid.empty() ? "" : ", ") + kind_info(k).name;
   }
   throw ConfigError(fmt::format("unknown job kind '{}' (expected one of {})", name, valid));
 }
 
-const std::vector<std::string>& kind_folders() {
-  static const std::vector<std::string> folders = [] {
-    std::vector<std::string> f;
-    for (const auto& k : kKinds) f.emplace_back(k.folder);
-    return f;
-  }();
+std::vector<std::string> kind_folders() {
+  std::vector<std::string> folders;
+  for (JobKind k : registered_kinds()) folders.push_back(kind_info(k).folder);
   return folders;
 }
 
-const std::vector<std::string>& output_folders() {
-  static const std::vector<std::string> folders = [] {
-    std::vector<std::string> f = kind_folders();
-    f.emplace_back("tmp");
-    return f;
-  }();
+std::vector<std::string> output_folders() {
+  std::vector<std::string> folders = kind_folders();
+  folders.emplace_back("tmp");
   return folders;
 }
 

@@ -89,7 +89,7 @@ WorkerIdentity make_identity(const std::string& code_version, int threads);
 
 struct Claim {
   std::string job_id, sweep_id;
-  JobKind kind = JobKind::noop;
+  JobKind kind;  ///< noop unless set
   nlohmann::json scenario, params;
   int attempt = 0;               ///< 1-based attempt number of this claim
   std::int64_t token = 0;        ///< fencing token

@@ -28,7 +28,7 @@ CREATE TABLE IF NOT EXISTS sweeps(
 CREATE TABLE IF NOT EXISTS jobs(
   seq {key},
   job_id TEXT NOT NULL UNIQUE,
-  kind TEXT NOT NULL CHECK(kind IN ('bed','drop','noop')),
+  kind TEXT NOT NULL CHECK(kind IN ({kinds})),  -- the kinds registered when the database was made
   sweep_id TEXT NOT NULL REFERENCES sweeps(sweep_id),
   state TEXT NOT NULL CHECK(state IN ('waiting','queued','running','failed','done','dead')),
   priority {integer} NOT NULL DEFAULT 0,
@@ -117,9 +117,17 @@ CREATE TABLE IF NOT EXISTS results_columns(
 ) {strict};
 )SQL";
 
+/// The registered job kinds as an SQL list: 'noop', 'bed', ...
+std::string kind_list_sql() {
+  std::string list;
+  for (JobKind k : registered_kinds()) list += fmt::format("{}'{}'", list.empty() ? "" : ",", kind_name(k));
+  return list;
+}
+
 std::string schema_sql(const SchemaTypes& t) {
-  return fmt::format(kSchemaTemplate, fmt::arg("key", t.key), fmt::arg("integer", t.integer), fmt::arg("real", t.real),
-                     fmt::arg("strict", t.strict), fmt::arg("strict_without_rowid", t.strict_without_rowid));
+  return fmt::format(kSchemaTemplate, fmt::arg("kinds", kind_list_sql()), fmt::arg("key", t.key),
+                     fmt::arg("integer", t.integer), fmt::arg("real", t.real), fmt::arg("strict", t.strict),
+                     fmt::arg("strict_without_rowid", t.strict_without_rowid));
 }
 
 }  // namespace

@@ -396,7 +396,8 @@ class Worker {
     try {
       const int threads = with_db_([&] { return threads_for_claim(db_, c, o_.threads, o_.pool_threads); });
       if (threads != o_.threads && o_.verbose)
-        std::fprintf(stderr, "worker %d: bed job %s runs alone: %d threads\n", who_.pid, c.job_id.c_str(), threads);
+        std::fprintf(stderr, "worker %d: %s job %s runs alone: %d threads\n", who_.pid, kind_name(c.kind),
+                     c.job_id.c_str(), threads);
       return threads;
     } catch (const db::DbError& e) {
       if (!e.busy()) throw;  // busy: run with the worker's own threads

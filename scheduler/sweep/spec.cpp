@@ -1,4 +1,5 @@
 #include "scheduler/sweep/spec.h"
+#include "scheduler/sweep/impact_kinds.h"
 
 #include "spec/problems.h"
 
@@ -460,11 +461,11 @@ std::optional<json> point_bed_key(const BedKeyFn& bed_key, const queue::PlannedJ
 /// between drops of one bed are not bed parameters (null, dropped at the end).
 void add_to_bed(const SweepSpec& spec, const json& key, queue::PlannedJob& job, std::vector<queue::PlannedJob>& beds,
                 std::map<std::string, std::size_t>& bed_index) {
-  const std::string bed_id = queue::job_id(queue::kind_name(queue::JobKind::bed), key);
+  const std::string bed_id = queue::job_id(queue::kind_name(bed_kind()), key);
   auto [it, inserted] = bed_index.emplace(bed_id, beds.size());
   if (inserted) {
     queue::PlannedJob bed;
-    bed.kind = queue::JobKind::bed;
+    bed.kind = bed_kind();
     bed.job_id = bed_id;
     bed.scenario = job.scenario;  // any scenario with this key prepares the same bed
     bed.params = job.params;
@@ -501,12 +502,12 @@ std::vector<queue::PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed
     if (noop) {
       for (auto& np : noop_problems(job.scenario, "/base"))
         problems.add(std::move(np), job.params, [](const SpecProblem&) { return false; });
-      job.kind = queue::JobKind::noop;
+      job.kind = queue::noop_kind();
       job.job_id = queue::job_id(queue::kind_name(job.kind), job.scenario);
       drops.push_back(std::move(job));
       continue;
     }
-    job.kind = queue::JobKind::drop;
+    job.kind = drop_kind();
     job.job_id = queue::job_id(queue::kind_name(job.kind), job.scenario);
     const auto key = point_bed_key(bed_key, job, problems);
     if (!key) continue;

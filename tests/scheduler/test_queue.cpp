@@ -3,12 +3,14 @@
 // fencing, retries with backoff, the dead state, release, resume and the results table.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 
 #include <nlohmann/json.hpp>
 #include <thread>
 
 #include "scheduler/queue/queue.h"
+#include "scheduler/sweep/impact_kinds.h"
 #include "scheduler/sweep/spec.h"
 #include "campaign_store.h"
 #include "scheduler_test_helpers.h"
@@ -130,8 +132,8 @@ TEST_P(QueueTest, ANonIntegerValueWidensAnIntegerResultsColumnAndKeepsItsValues)
 
 TEST_P(QueueTest, DropsWaitForTheirBedAndBedsAreClaimedFirst) {
   auto r = submit_spec(impact_spec(), bed_key);
-  EXPECT_EQ(r.added_by_kind[JobKind::bed], 2u);
-  EXPECT_EQ(r.added_by_kind[JobKind::drop], 6u);
+  EXPECT_EQ(r.added_by_kind[sweep::bed_kind()], 2u);
+  EXPECT_EQ(r.added_by_kind[sweep::drop_kind()], 6u);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='waiting'"), 6);
   auto bed = claim(db, me, paths, 60);
   ASSERT_TRUE(bed);
@@ -459,3 +461,32 @@ INSTANTIATE_TEST_SUITE_P(Postgres, QueueTest, ::testing::Values(test::Store::pos
 INSTANTIATE_TEST_SUITE_P(Sqlite, QueueTest, ::testing::Values(test::Store::sqlite),
                          [](const auto& info) { return test::store_name(info.param); });
 #endif
+
+// A kind registered by the library that plans and runs it: its name enters a new database's check
+// of jobs.kind and its folder the files root; a name registered again with another row, or a
+// folder two kinds would share, is refused; an unknown name lists the registered ones.
+TEST(JobKinds, AreRegisteredByTheLibrariesThatRunThem) {
+  const JobKind probe = register_kind({"kind_probe", "kind_probe_out", ".json", true, false});
+  EXPECT_EQ(register_kind({"kind_probe", "kind_probe_out", ".json", true, false}), probe) << "same row: same kind";
+  EXPECT_EQ(parse_kind("kind_probe"), probe);
+  EXPECT_EQ(parse_kind("bed"), sweep::bed_kind());
+  EXPECT_EQ(parse_kind("noop"), noop_kind());
+  EXPECT_THROW(register_kind({"kind_probe", "elsewhere", ".json", true, false}), gravsweep::ConfigError);
+  EXPECT_THROW(register_kind({"another", "beds", ".h5", true, false}), gravsweep::ConfigError)
+      << "beds/ is the bed kind's";
+  EXPECT_THROW(register_kind({"scratch", "tmp", ".h5", true, false}), gravsweep::ConfigError)
+      << "tmp/ holds running attempts";
+  try {
+    parse_kind("gpu");
+    ADD_FAILURE() << "an unknown kind was accepted";
+  } catch (const gravsweep::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("noop, bed, drop, kind_probe"), std::string::npos) << e.what();
+  }
+  const auto folders = kind_folders();
+  EXPECT_NE(std::find(folders.begin(), folders.end(), "kind_probe_out"), folders.end());
+  test::TempDir dir;
+  db::Database db((dir.path / "kinds.db").string());
+  ensure_schema(db);
+  const std::string sql = sql_text(db, "SELECT sql FROM sqlite_master WHERE name='jobs'");
+  EXPECT_NE(sql.find("'noop','bed','drop','kind_probe'"), std::string::npos) << sql;
+}
