@@ -101,6 +101,9 @@ class VerletList {
   double skin_m_ = 0;
   bool keep_frame_ = false;
   long long builds_ = 0;
+  /// The end of build(): the new rows replace the old, each listed pair keeping the histories it
+  /// had; then the work prefix (work_offset).
+  void carry_histories(std::vector<std::uint32_t> new_offset, std::vector<std::uint32_t> new_neighbor, int threads);
   // Scratch of one build (released at its end).
   std::vector<std::uint32_t> cell_start_, cell_particles_, particle_cell_;
   std::vector<std::uint32_t> count_;
