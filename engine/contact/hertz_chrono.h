@@ -13,6 +13,8 @@
 
 namespace gravsweep {
 
+struct HertzBatch;  // engine/system/hertz_batch.h
+
 struct HertzChrono {
   static constexpr const char* name = "hertz";
   static constexpr const char* description =
@@ -20,6 +22,9 @@ struct HertzChrono {
       "history projected onto the tangent plane with Coulomb back-solve";
   /// Needs FrameHistory stored per contact (contact.h).
   static constexpr bool uses_frame_history = false;
+  /// The particle-particle contacts evaluated a batch at a time (optional in a law: the force loop
+  /// uses Batch when the law names one and Batch::supports the rolling model, kHasBatch).
+  using Batch = HertzBatch;
 
   /// Chrono's damping factor -2 sqrt(5/6) beta with beta = ln e / sqrt(ln^2 e + pi^2) >= 0.
   static double damping_factor(double cor) {

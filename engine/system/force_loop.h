@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -215,10 +216,20 @@ GRAVSWEEP_INLINE void evaluate_contact(const ContactGeometry& g, const PairCoeff
   if (c.track_energy) energy += Law::normal_energy_J(g, pc);
 }
 
-/// The particle-particle part of force_loop for the laws HertzBatch evaluates (hertz with sunday
-/// or none rolling): the touching pairs of this thread's share are gathered into batches,
-/// evaluated vectorised, and scattered back in list order.
-template <bool kRolling, bool kFilter>
+/// A law's batched kernel for this rolling model: Law::Batch, when the law names one and
+/// Batch::supports<Rolling> (hertz with sunday or none rolling); otherwise the scalar loop.
+template <class Law, class Rolling, class = void>
+struct HasBatch : std::false_type {};
+template <class Law, class Rolling>
+struct HasBatch<Law, Rolling, std::void_t<typename Law::Batch>>
+    : std::bool_constant<Law::Batch::template supports<Rolling>> {};
+template <class Law, class Rolling>
+inline constexpr bool kHasBatch = HasBatch<Law, Rolling>::value;
+
+/// The particle-particle part of force_loop for a law with a Batch (kHasBatch): the touching
+/// pairs of this thread's share are gathered into batches, evaluated vectorised, and scattered
+/// back in list order.
+template <class Batch, bool kRolling, bool kFilter>
 void pair_loop_batched(ForceContext& c, const ThreadRows& rows, Vec3* F, Vec3* T, long long& contacts, double& energy,
                        OverlapFailure& worst) {
   const Particles& p = c.p;
@@ -227,9 +238,9 @@ void pair_loop_batched(ForceContext& c, const ThreadRows& rows, Vec3* F, Vec3* T
   const double* R = p.radius_m.data();
   const std::uint8_t* mat = p.material.data();
   ContactHistory* hist = c.nlist.history.data();
-  HertzBatch batch;
+  Batch batch;
   auto flush = [&] {
-    batch.compute<kRolling>(c.options, c.dt_s);
+    batch.template compute<kRolling>(c.options, c.dt_s);
     for (int b = 0; b < batch.count; ++b) {
       ContactHistory& h = hist[batch.k[b]];
       h.shear_m = Vec3(batch.sx[b], batch.sy[b], batch.sz[b]);
@@ -420,12 +431,13 @@ void force_loop(ForceContext& c) {
     Vec3* T = t == 0 ? p.torque_N_m.data() : c.thread_torque[t].data();
     std::fill(F + rows.begin, F + n, Vec3::Zero());
     std::fill(T + rows.begin, T + n, Vec3::Zero());
-    if constexpr (kHasHertzBatch<Law, Rolling>) {
-      constexpr bool kRolling = std::is_same_v<Rolling, RollingSunday>;
+    if constexpr (kHasBatch<Law, Rolling>) {
+      using Batch = typename Law::Batch;
+      constexpr bool kRolling = Batch::template with_rolling<Rolling>;
       if (filter_pairs(c, rows))
-        pair_loop_batched<kRolling, true>(c, rows, F, T, mine.contacts, mine.energy_J, mine.worst);
+        pair_loop_batched<Batch, kRolling, true>(c, rows, F, T, mine.contacts, mine.energy_J, mine.worst);
       else
-        pair_loop_batched<kRolling, false>(c, rows, F, T, mine.contacts, mine.energy_J, mine.worst);
+        pair_loop_batched<Batch, kRolling, false>(c, rows, F, T, mine.contacts, mine.energy_J, mine.worst);
     } else {
       if (filter_pairs(c, rows))
         pair_loop_scalar<Law, Rolling, true>(c, rows, F, T, mine.contacts, mine.energy_J, mine.worst);

@@ -23,12 +23,13 @@
 
 namespace gravsweep {
 
-/// True for the (law, rolling) pairs HertzBatch evaluates.
-template <class Law, class Rolling>
-inline constexpr bool kHasHertzBatch = std::is_same_v<Law, HertzChrono> &&
-                                       (std::is_same_v<Rolling, RollingSunday> || std::is_same_v<Rolling, RollingNone>);
-
+/// HertzChrono::Batch.
 struct HertzBatch {
+  /// The rolling models compute() evaluates with the law: sunday (with_rolling) and none.
+  template <class Rolling>
+  static constexpr bool supports = std::is_same_v<Rolling, RollingSunday> || std::is_same_v<Rolling, RollingNone>;
+  template <class Rolling>
+  static constexpr bool with_rolling = std::is_same_v<Rolling, RollingSunday>;
   static constexpr int kSize = 64;  ///< contacts per batch (about 30 KB: stays in L1)
   int count = 0;
   // Where to scatter.

@@ -12,6 +12,9 @@
 #include "engine/contact/hertz_chrono.h"
 #include "engine/rolling/rolling_none.h"
 #include "engine/rolling/rolling_sunday.h"
+#include "engine/rolling/rolling_zhang.h"
+#include "engine/contact/hooke_pkdgrav.h"
+#include "engine/system/force_loop.h"
 #include "engine/scenario/paper_params.h"
 
 using namespace gravsweep;
@@ -149,6 +152,8 @@ TEST(HertzBatch, MatchesScalarKernelWithoutRolling) {
 }
 
 TEST(HertzBatch, CoversThePaperModels) {
-  EXPECT_TRUE((kHasHertzBatch<HertzChrono, RollingSunday>));
-  EXPECT_TRUE((kHasHertzBatch<HertzChrono, RollingNone>));
+  EXPECT_TRUE((kHasBatch<HertzChrono, RollingSunday>));
+  EXPECT_TRUE((kHasBatch<HertzChrono, RollingNone>));
+  EXPECT_FALSE((kHasBatch<HertzChrono, RollingZhang>)) << "the Zhang springs need the scalar kernel";
+  EXPECT_FALSE((kHasBatch<HookePkdgrav, RollingSunday>)) << "a law without a Batch";
 }
