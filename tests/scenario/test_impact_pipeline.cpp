@@ -380,7 +380,7 @@ TEST(PileVerb, PrintsTheAngleForEachRollingFrictionAndRefusesBadOptions) {
 
 // `gravsweep pile --set pkdgrav` takes Table 1's pkdgrav grains (mu_s 1.0, 1 cm beads, Hooke +
 // Zhang) with the beta given; the small heap measured 13 degrees at beta 0.05 (the full 2,000-grain
-// heap 22.2, Table 2: 22.1; REPRODUCTION.md, part 5). The set itself: pkdgrav_table1_config.
+// heap 23.2, Table 2: 22.1; REPRODUCTION.md, part 5). The set itself: pkdgrav_table1_config.
 TEST(PileVerb, ThePkdgravSetPilesWithItsOwnFrictionAndBeta) {
   const SystemConfig set = pkdgrav_table1_config(1.05, 0.1);
   EXPECT_EQ(set.contact_law, "hooke");
