@@ -166,9 +166,8 @@ struct SmallNeighbours {
 /// (BENCHMARKS.md).
 void list_rows(std::size_t n, const SmallNeighbours& small, const std::vector<std::uint32_t>& particle_cell,
                const std::vector<std::pair<std::uint32_t, std::uint32_t>>& large_pairs, int threads,
-               std::vector<std::uint32_t>& count, std::vector<std::uint32_t>& new_offset,
-               std::vector<std::uint32_t>& new_neighbor) {
-  count.assign(n + 1, 0);
+               std::vector<std::uint32_t>& new_offset, std::vector<std::uint32_t>& new_neighbor) {
+  std::vector<std::uint32_t> count(n + 1, 0);  // count[i + 1]: row i's pairs
   const std::size_t n_chunks = (n + kBuildChunk - 1) / kBuildChunk;
   std::vector<std::vector<std::uint32_t>> chunk_neighbors(n_chunks);
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
@@ -217,9 +216,7 @@ void VerletList::set_frame_history(bool keep) {
 std::size_t VerletList::bytes() const {
   return offset.capacity() * sizeof(std::uint32_t) + neighbor.capacity() * sizeof(std::uint32_t) +
          history.capacity() * sizeof(ContactHistory) + frame_history.capacity() * sizeof(FrameHistory) +
-         position_at_build_.capacity() * sizeof(Vec3) + work_offset.capacity() * sizeof(std::uint32_t) +
-         (cell_start_.capacity() + cell_particles_.capacity() + particle_cell_.capacity() + count_.capacity()) *
-             sizeof(std::uint32_t);
+         position_at_build_.capacity() * sizeof(Vec3) + work_offset.capacity() * sizeof(std::uint32_t);
 }
 
 void VerletList::remap(const std::vector<long long>& new_index) {
@@ -287,30 +284,30 @@ void VerletList::build(const Particles& p, double skin_m, int threads) {
     offset.assign(1, 0);
     return;
   }
+  // The cell scratch lives for this build only (a settled bed rebuilds rarely: never in the 2,000
+  // steps of `gravsweep bench`), so the list holds none of it between builds.
   const Classified c = classify(p);
   const CellGrid grid = make_grid(c, skin_m);
-  sort_into_cells(p, c, grid, cell_start_, cell_particles_, particle_cell_);
+  std::vector<std::uint32_t> cell_start, cell_particles, particle_cell;
+  sort_into_cells(p, c, grid, cell_start, cell_particles, particle_cell);
   const std::vector<std::pair<std::uint32_t, std::uint32_t>> large_pairs =
-      pairs_with_large(p, c, grid, skin_m, cell_start_, cell_particles_);
-  const SmallNeighbours small{p, grid, skin_m, cell_start_, cell_particles_};
+      pairs_with_large(p, c, grid, skin_m, cell_start, cell_particles);
+  const SmallNeighbours small{p, grid, skin_m, cell_start, cell_particles};
   std::vector<std::uint32_t> new_offset, new_neighbor;
-  list_rows(n, small, particle_cell_, large_pairs, threads, count_, new_offset, new_neighbor);
+  list_rows(n, small, particle_cell, large_pairs, threads, new_offset, new_neighbor);
   carry_histories(std::move(new_offset), std::move(new_neighbor), threads);
   position_at_build_ = p.position_m;
-  // The cell scratch is rebuilt from nothing at every build (rare in a settled bed: none in the
-  // 2,000 steps of `gravsweep bench`): release it instead of holding ~16 bytes per particle.
-  for (auto* v : {&cell_start_, &cell_particles_, &particle_cell_, &count_}) std::vector<std::uint32_t>().swap(*v);
 }
 
 void VerletList::carry_histories(std::vector<std::uint32_t> new_offset, std::vector<std::uint32_t> new_neighbor,
                                  int threads) {
   // Both lists are sorted by j within each i, so merge. The touching pairs carried over (active
-  // histories) of row i are counted on the way, into count_[i + 1], for the work prefix below.
+  // histories) of row i are counted on the way, into touching_in_row[i + 1], for the work prefix below.
   const std::size_t n = new_offset.size() - 1;
   std::vector<ContactHistory> new_history(new_neighbor.size());
   std::vector<FrameHistory> new_frame(keep_frame_ ? new_neighbor.size() : 0);
   const bool have_old = offset.size() == n + 1;
-  count_.assign(n + 1, 0u);
+  std::vector<std::uint32_t> touching_in_row(n + 1, 0u);
 #pragma omp parallel for schedule(dynamic, 256) num_threads(threads)
   for (std::size_t i = 0; i < n; ++i) {
     if (!have_old) continue;
@@ -325,7 +322,7 @@ void VerletList::carry_histories(std::vector<std::uint32_t> new_offset, std::vec
         touching += history[a].active ? 1u : 0u;
       }
     }
-    count_[i + 1] = touching;
+    touching_in_row[i + 1] = touching;
   }
   offset = std::move(new_offset);
   neighbor = std::move(new_neighbor);
@@ -333,7 +330,8 @@ void VerletList::carry_histories(std::vector<std::uint32_t> new_offset, std::vec
   frame_history = std::move(new_frame);
   work_offset.assign(n + 1, 0);
   for (std::size_t i = 0; i < n; ++i)
-    work_offset[i + 1] = work_offset[i] + (offset[i + 1] - offset[i]) + kTouchingWork * count_[i + 1] + kRowWork;
+    work_offset[i + 1] =
+        work_offset[i] + (offset[i + 1] - offset[i]) + kTouchingWork * touching_in_row[i + 1] + kRowWork;
 }
 
 void VerletList::add_wall_work(const std::vector<std::uint32_t>& codes, std::size_t walls, std::uint32_t work) {

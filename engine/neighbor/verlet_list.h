@@ -104,9 +104,6 @@ class VerletList {
   /// The end of build(): the new rows replace the old, each listed pair keeping the histories it
   /// had; then the work prefix (work_offset).
   void carry_histories(std::vector<std::uint32_t> new_offset, std::vector<std::uint32_t> new_neighbor, int threads);
-  // Scratch of one build (released at its end).
-  std::vector<std::uint32_t> cell_start_, cell_particles_, particle_cell_;
-  std::vector<std::uint32_t> count_;
 };
 
 }  // namespace gravsweep

@@ -25,13 +25,16 @@ struct RollingZhang {
   /// 1 g it kept floor grains spinning about the floor's normal at 5-50 rad/s and the bed from
   /// coming to rest; docs/physics/contact-laws.md section 2.3).
   GRAVSWEEP_INLINE static double held_at_limit(double phi_rad, double k_N_m_rad, double limit_N_m) {
-    const double held = k_N_m_rad > 0 ? limit_N_m / k_N_m_rad : 0;
+    const double held = limit_angle_rad(k_N_m_rad, limit_N_m);
     return std::clamp(phi_rad, -held, held);
   }
   GRAVSWEEP_INLINE static Vec3 held_at_limit(const Vec3& phi_rad, double k_N_m_rad, double limit_N_m) {
-    const double held = k_N_m_rad > 0 ? limit_N_m / k_N_m_rad : 0;
-    const double size = phi_rad.norm();
+    const double held = limit_angle_rad(k_N_m_rad, limit_N_m), size = phi_rad.norm();
     return size > held ? Vec3(phi_rad * (held / size)) : phi_rad;
+  }
+  /// The angle at which a spring of stiffness k reaches the torque limit (0 without a spring).
+  GRAVSWEEP_INLINE static double limit_angle_rad(double k_N_m_rad, double limit_N_m) {
+    return k_N_m_rad > 0 ? limit_N_m / k_N_m_rad : 0;
   }
 
   GRAVSWEEP_INLINE static void apply(const ContactGeometry& g, const PairCoefficients& c, const ContactOptions&,

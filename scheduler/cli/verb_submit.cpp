@@ -79,12 +79,21 @@ std::vector<queue::PlannedJob> expand_with_progress(const sweep::SweepSpec& spec
   return jobs;
 }
 
+/// A sweep spec and the jobs it plans.
+struct Planned {
+  sweep::SweepSpec spec;
+  std::vector<queue::PlannedJob> jobs;
+};
+
+/// "B bed, N drop" (or noop): the planned jobs by kind, as `submit` prints them.
+std::string jobs_by_kind(const Planned& p) {
+  const auto beds = static_cast<std::size_t>(
+      std::count_if(p.jobs.begin(), p.jobs.end(), [](const auto& j) { return j.kind == sweep::bed_kind(); }));
+  return fmt::format("{} bed, {} {}", beds, p.jobs.size() - beds, p.spec.job_kind == "noop" ? "noop" : "drop");
+}
+
 void run_submit(const SubmitOptions& o) {
   // Validate and expand every spec before the database is even opened: a bad spec writes nothing.
-  struct Planned {
-    sweep::SweepSpec spec;
-    std::vector<queue::PlannedJob> jobs;
-  };
   std::vector<Planned> planned;
   for (const auto& path : o.specs) {
     try {
@@ -98,24 +107,17 @@ void run_submit(const SubmitOptions& o) {
     }
   }
   if (o.dry_run) {
-    for (const auto& p : planned) {
-      std::size_t beds = 0;
-      for (const auto& j : p.jobs) beds += j.kind == sweep::bed_kind();
-      fmt::print("sweep {}: {} points -> {} jobs ({} bed, {} {}) [dry run: nothing written]\n", p.spec.name,
-                 p.spec.points(), p.jobs.size(), beds, p.jobs.size() - beds,
-                 p.spec.job_kind == "noop" ? "noop" : "drop");
-    }
+    for (const auto& p : planned)
+      fmt::print("sweep {}: {} points -> {} jobs ({}) [dry run: nothing written]\n", p.spec.name, p.spec.points(),
+                 p.jobs.size(), jobs_by_kind(p));
     return;
   }
   db::Database db = queue::open_campaign(o.db, queue::OpenMode::create, o.files);
   queue::bind_files_root(db, queue::CampaignPaths(o.db, o.files));  // the marker naming this campaign
   for (const auto& p : planned) {
     const auto r = queue::submit(db, sweep::record(p.spec), p.jobs);
-    fmt::print("sweep {} ({}): {} jobs planned ({} bed, {} {}): {} new, {} already present\n", r.sweep,
-               r.sweep_new ? "new sweep" : "existing sweep", r.planned,
-               std::count_if(p.jobs.begin(), p.jobs.end(), [](const auto& j) { return j.kind == sweep::bed_kind(); }),
-               std::count_if(p.jobs.begin(), p.jobs.end(), [](const auto& j) { return j.kind != sweep::bed_kind(); }),
-               p.spec.job_kind == "noop" ? "noop" : "drop", r.added, r.present);
+    fmt::print("sweep {} ({}): {} jobs planned ({}): {} new, {} already present\n", r.sweep,
+               r.sweep_new ? "new sweep" : "existing sweep", r.planned, jobs_by_kind(p), r.added, r.present);
   }
 }
 

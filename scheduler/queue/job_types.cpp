@@ -68,8 +68,9 @@ const JobKindInfo& kind_info(JobKind k) {
 JobKind parse_kind(std::string_view name) {
   std::string valid;
   for (JobKind k : registered_kinds()) {
-    if (name == kind_info(k).name) return k;
-    valid += (valid.empty() ? "" : ", ") + kind_info(k).name;
+    const std::string& known = kind_info(k).name;
+    if (name == known) return k;
+    valid += (valid.empty() ? "" : ", ") + known;
   }
   throw ConfigError(fmt::format("unknown job kind '{}' (expected one of {})", name, valid));
 }
