@@ -15,6 +15,20 @@ namespace gravsweep {
 
 struct HertzBatch;  // engine/system/hertz_batch.h
 
+/// Stiffness and damping of a Hertz contact at overlap delta (docs/physics/contact-laws.md
+/// section 1.3): Sn = 2 E* sqrt(R* delta), kn = 2/3 Sn, kt = St = 8 G* sqrt(R* delta),
+/// gn = f_n sqrt(Sn m*), gt = f_t sqrt(Sn m*) with the damping factors of HertzChrono::prepare.
+struct HertzSprings {
+  double kn_N_m, kt_N_m, gn_N_s_m, gt_N_s_m;
+};
+GRAVSWEEP_INLINE HertzSprings hertz_springs(double E_eff_Pa, double G_eff_Pa, double damping_n, double damping_t,
+                                            double R_eff_m, double delta_m, double m_eff_kg) {
+  const double sqrt_Rd = std::sqrt(R_eff_m * delta_m);
+  const double Sn = 2.0 * E_eff_Pa * sqrt_Rd;
+  const double sqrt_Sn_m = std::sqrt(Sn * m_eff_kg);
+  return {(2.0 / 3.0) * Sn, 8.0 * G_eff_Pa * sqrt_Rd, damping_n * sqrt_Sn_m, damping_t * sqrt_Sn_m};
+}
+
 struct HertzChrono {
   static constexpr const char* name = "hertz";
   static constexpr const char* description =
@@ -43,8 +57,20 @@ struct HertzChrono {
   /// Normal spring energy U = integral of (4/3) E* sqrt(R*) d^1.5 = (8/15) E* sqrt(R*) d^2.5,
   /// evaluated only when energy is tracked.
   static double normal_energy_J(const ContactGeometry& g, const PairCoefficients& c) {
-    const double d = g.overlap_m;
-    return (8.0 / 15.0) * c.E_eff_Pa * std::sqrt(g.R_eff_m) * d * d * std::sqrt(d);
+    return normal_energy_J(c.E_eff_Pa, g.R_eff_m, g.overlap_m);
+  }
+  GRAVSWEEP_INLINE static double normal_energy_J(double E_eff_Pa, double R_eff_m, double d_m) {
+    return (8.0 / 15.0) * E_eff_Pa * std::sqrt(R_eff_m) * d_m * d_m * std::sqrt(d_m);
+  }
+
+  /// The rolling and spinning activation gate t_collision of a new contact (section 1.5): the
+  /// half period of the damped oscillator with the delta-free Hertz constants
+  /// kn_s = 4/3 E* sqrt(R*), gn_s = f_n sqrt(2 E* sqrt(R*) m*); 0 when overdamped.
+  static double gate_s(double E_eff_Pa, double damping_n, double R_eff_m, double m_eff_kg) {
+    const double kn_s = (4.0 / 3.0) * E_eff_Pa * std::sqrt(R_eff_m);
+    const double gn_s = damping_n * std::sqrt(2.0 * E_eff_Pa * std::sqrt(R_eff_m) * m_eff_kg);
+    const double d = gn_s / (2.0 * m_eff_kg * std::sqrt(kn_s / m_eff_kg));
+    return d < 1 ? kPi * std::sqrt(m_eff_kg / (kn_s * (1 - d * d))) : 0.0;
   }
 
   /// Rayleigh time T_R = pi R sqrt(rho/G) / (0.1631 nu + 0.8766), G = E / (2(1+nu))
@@ -104,16 +130,8 @@ struct HertzChrono {
     const double v_n = v_rel.dot(n);  // negative while approaching
     const Vec3 v_t = v_rel - v_n * n;
 
-    // Stiffness and damping, docs/physics/contact-laws.md section 1.3.
-    const double sqrt_Rd = std::sqrt(g.R_eff_m * delta);
-    const double Sn = 2.0 * c.E_eff_Pa * sqrt_Rd;
-    const double St = 8.0 * c.G_eff_Pa * sqrt_Rd;
-    const double kn = (2.0 / 3.0) * Sn;
-    const double kt = St;
-    const double damp_n = c.damping_prefactor_n;
-    const double sqrt_Sn_m = std::sqrt(Sn * g.m_eff_kg);
-    const double gn = damp_n * sqrt_Sn_m;
-    const double gt = c.damping_prefactor_t * sqrt_Sn_m;
+    const auto [kn, kt, gn, gt] = hertz_springs(c.E_eff_Pa, c.G_eff_Pa, c.damping_prefactor_n, c.damping_prefactor_t,
+                                                g.R_eff_m, delta, g.m_eff_kg);
     double Fn = kn * delta - gn * v_n;  // unclamped, as in Chrono
     if (opt.clamp_normal && Fn < 0) Fn = 0;
 
@@ -121,11 +139,7 @@ struct HertzChrono {
     if (!h.active) {
       h = ContactHistory{};
       h.active = true;
-      // Rolling/spinning activation gate t_collision (1.5), with delta-free Hertz constants.
-      const double kn_s = (4.0 / 3.0) * c.E_eff_Pa * std::sqrt(g.R_eff_m);
-      const double gn_s = damp_n * std::sqrt(2.0 * c.E_eff_Pa * std::sqrt(g.R_eff_m) * g.m_eff_kg);
-      const double d = gn_s / (2.0 * g.m_eff_kg * std::sqrt(kn_s / g.m_eff_kg));
-      h.gate_s = d < 1 ? kPi * std::sqrt(g.m_eff_kg / (kn_s * (1 - d * d))) : 0.0;
+      h.gate_s = gate_s(c.E_eff_Pa, c.damping_prefactor_n, g.R_eff_m, g.m_eff_kg);
     } else {
       h.duration_s += dt_s;
     }

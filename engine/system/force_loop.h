@@ -256,8 +256,7 @@ void pair_loop_batched(ForceContext& c, const ThreadRows& rows, Vec3* F, Vec3* T
     }
     if (c.track_energy)
       for (int b = 0; b < batch.count; ++b) {
-        const double d = batch.overlap[b];
-        energy += (8.0 / 15.0) * batch.E[b] * std::sqrt(batch.R_eff[b]) * d * d * std::sqrt(d);
+        energy += HertzChrono::normal_energy_J(batch.E[b], batch.R_eff[b], batch.overlap[b]);
       }
     contacts += batch.count;
     batch.count = 0;

@@ -1,8 +1,10 @@
 // The particle-particle contacts of `hertz` (with `sunday` or `none` rolling) evaluated a batch at
 // a time, structure of arrays, so the compiler vectorises the arithmetic across contacts (8
 // doubles per AVX-512 instruction: the square roots and divisions that bound the scalar kernel
-// run 8 at a time). The same formulas as HertzChrono::evaluate and RollingSunday::apply
-// (docs/physics/contact-laws.md sections 1.3-1.5); every branch is a per-lane select. The force
+// run 8 at a time). The law is HertzChrono's: its stiffness and damping (hertz_springs), gate
+// (HertzChrono::gate_s) and spring energy are the same functions; the geometry, the tangential
+// spring and RollingSunday::apply are written per lane (docs/physics/contact-laws.md sections
+// 1.3-1.5), every branch a per-lane select. The force
 // loop fills a batch with the touching pairs (gathering positions, velocities, coefficients and
 // histories), calls compute(), then scatters forces, torques and histories back in the order of the
 // list, so the sums keep the order of the scalar loop. Walls keep the scalar kernel.
@@ -51,15 +53,6 @@ struct HertzBatch {
 
   [[nodiscard]] bool full() const { return count == kSize; }
 
-  /// HertzChrono's activation gate t_collision of a new contact (hertz_chrono.h,
-  /// docs/physics/contact-laws.md section 1.5).
-  static double gate_s(double E_eff_Pa, double damping_n, double R_eff_m, double m_eff_kg) {
-    const double kn_s = (4.0 / 3.0) * E_eff_Pa * std::sqrt(R_eff_m);
-    const double gn_s = damping_n * std::sqrt(2.0 * E_eff_Pa * std::sqrt(R_eff_m) * m_eff_kg);
-    const double d = gn_s / (2.0 * m_eff_kg * std::sqrt(kn_s / m_eff_kg));
-    return d < 1 ? kPi * std::sqrt(m_eff_kg / (kn_s * (1 - d * d))) : 0.0;
-  }
-
   /// Appends one touching pair; h is its history (a new contact when !h.active).
   GRAVSWEEP_INLINE void add(std::uint32_t kk, std::uint32_t ii, std::uint32_t jj, const Vec3& d, double d2, double ri,
                             double rj, double meff, const Vec3& vi, const Vec3& vj, const Vec3& wi, const Vec3& wj,
@@ -101,7 +94,7 @@ struct HertzBatch {
     } else {
       sx[b] = sy[b] = sz[b] = 0;
       duration[b] = 0;
-      gate[b] = gate_s(pc.E_eff_Pa, pc.damping_prefactor_n, ri * rj / (ri + rj), meff);
+      gate[b] = HertzChrono::gate_s(pc.E_eff_Pa, pc.damping_prefactor_n, ri * rj / (ri + rj), meff);
       fresh[b] = 1;
     }
   }
@@ -109,7 +102,67 @@ struct HertzBatch {
   /// Evaluates the batch: HertzChrono::evaluate, then (kRolling) RollingSunday::apply.
   template <bool kRolling>
   void compute(const ContactOptions& opt, double dt_s);
+
+ private:
+  struct Lever;
+  struct Spins;
+  struct Torques;
+  /// RollingSunday::apply (docs/physics/contact-laws.md section 1.5) for contact b with normal
+  /// force Fn, on once the contact is older than its gate: added to the torques q.
+  GRAVSWEEP_INLINE void add_sunday(int b, bool on, double Fn, const Lever& L, const Spins& w, double min_roll,
+                                   double min_spin, Torques q) const;
 };
+
+/// The contact's normal n (from body 1 to 2), radii and centre distance, for add_sunday.
+struct HertzBatch::Lever {
+  double nx, ny, nz, ra, rb, dist;
+};
+/// The spins of bodies 1 (a) and 2 (b), rad/s.
+struct HertzBatch::Spins {
+  double ax, ay, az, bx, by, bz;
+};
+/// The torques on bodies 1 and 2 being summed, N m (references to compute()'s lane values).
+struct HertzBatch::Torques {
+  double &q1x, &q1y, &q1z, &q2x, &q2y, &q2z;
+};
+
+inline void HertzBatch::add_sunday(int b, bool on, double Fn, const Lever& L, const Spins& w, double min_roll,
+                                   double min_spin, Torques q) const {
+  constexpr double kTiny2 = kTinyLength_m * kTinyLength_m;
+  const double nx = L.nx, ny = L.ny, nz = L.nz, ra = L.ra, rb = L.rb;
+  // v_rot = -(R1 w1 + R2 w2) x n; both bodies get mu_r F_n R_k along n x v_rot / |v_rot|.
+  const double Rwx = ra * w.ax + rb * w.bx, Rwy = ra * w.ay + rb * w.by, Rwz = ra * w.az + rb * w.bz;
+  const double vox = -(Rwy * nz - Rwz * ny), voy = -(Rwz * nx - Rwx * nz), voz = -(Rwx * ny - Rwy * nx);
+  const double vr = std::sqrt(vox * vox + voy * voy + voz * voz);
+  const bool roll = on & (mu_r[b] > 0) & (vr > min_roll);
+  const double inv_vr = 1.0 / vr;
+  const double ux = vox * inv_vr, uy = voy * inv_vr, uz = voz * inv_vr;
+  const double dirx = ny * uz - nz * uy, diry = nz * ux - nx * uz, dirz = nx * uy - ny * ux;
+  const double mr = mu_r[b] * Fn;
+  const double c1 = mr * ra, c2 = mr * rb;
+  q.q1x = roll ? q.q1x + c1 * dirx : q.q1x;
+  q.q1y = roll ? q.q1y + c1 * diry : q.q1y;
+  q.q1z = roll ? q.q1z + c1 * dirz : q.q1z;
+  q.q2x = roll ? q.q2x + c2 * dirx : q.q2x;
+  q.q2y = roll ? q.q2y + c2 * diry : q.q2y;
+  q.q2z = roll ? q.q2z + c2 * dirz : q.q2z;
+  // Spinning: mu_t r_c F_n along n, r_c the radius of the contact lens.
+  const double wrx = w.bx - w.ax, wry = w.by - w.ay, wrz = w.bz - w.az;
+  const double wr = std::sqrt(wrx * wrx + wry * wry + wrz * wrz);
+  const bool spin = on & (mu_t[b] > 0) & (wr > min_spin);
+  const double dcc = L.dist;
+  const double xc = (ra * ra - rb * rb) / (2 * dcc) + dcc / 2;
+  const double rc = std::sqrt(std::max(ra * ra - xc * xc, kTiny2));
+  const double wn = (wrx * nx + wry * ny + wrz * nz) / wr;
+  const double Mm = mu_t[b] * rc * Fn * wn;
+  const double Mx = Mm * nx, My = Mm * ny, Mz = Mm * nz;
+  q.q1x = spin ? q.q1x + Mx : q.q1x;
+  q.q1y = spin ? q.q1y + My : q.q1y;
+  q.q1z = spin ? q.q1z + Mz : q.q1z;
+  q.q2x = spin ? q.q2x - Mx : q.q2x;
+  q.q2y = spin ? q.q2y - My : q.q2y;
+  q.q2z = spin ? q.q2z - Mz : q.q2z;
+}
 
 template <bool kRolling>
 void HertzBatch::compute(const ContactOptions& opt, double dt_s) {
@@ -138,13 +191,7 @@ void HertzBatch::compute(const ContactOptions& opt, double dt_s) {
     const double v_n = vrx * nx + vry * ny + vrz * nz;
     const double vtx = vrx - v_n * nx, vty = vry - v_n * ny, vtz = vrz - v_n * nz;
     // Stiffness and damping (docs/physics/contact-laws.md section 1.3).
-    const double sqrt_Rd = std::sqrt(Reff * delta);
-    const double Sn = 2.0 * E[b] * sqrt_Rd;
-    const double kt = 8.0 * G[b] * sqrt_Rd;
-    const double kn = (2.0 / 3.0) * Sn;
-    const double sqrt_Sn_m = std::sqrt(Sn * m);
-    const double gn = damp_n[b] * sqrt_Sn_m;
-    const double gt = damp_t[b] * sqrt_Sn_m;
+    const auto [kn, kt, gn, gt] = hertz_springs(E[b], G[b], damp_n[b], damp_t[b], Reff, delta, m);
     double Fn = kn * delta - gn * v_n;
     Fn = (clamp & (Fn < 0)) ? 0.0 : Fn;
     // MultiStep history (1.4).
@@ -175,42 +222,9 @@ void HertzBatch::compute(const ContactOptions& opt, double dt_s) {
     // torque_1 = s1 x (-f2), torque_2 = s2 x f2.
     double q1x = -(s1y * f2z - s1z * f2y), q1y = -(s1z * f2x - s1x * f2z), q1z = -(s1x * f2y - s1y * f2x);
     double q2x = s2y * f2z - s2z * f2y, q2y = s2z * f2x - s2x * f2z, q2z = s2x * f2y - s2y * f2x;
-    if constexpr (kRolling) {
-      // RollingSunday::apply: off until the contact is older than its gate.
-      const bool on = dur > gate[b];
-      // v_rot = -(R1 w1 + R2 w2) x n; both bodies get mu_r F_n R_k along n x v_rot / |v_rot|.
-      const double Rwx = ra * ax + rb * bx, Rwy = ra * ay + rb * by, Rwz = ra * az + rb * bz;
-      const double vox = -(Rwy * nz - Rwz * ny), voy = -(Rwz * nx - Rwx * nz), voz = -(Rwx * ny - Rwy * nx);
-      const double vr = std::sqrt(vox * vox + voy * voy + voz * voz);
-      const bool roll = on & (mu_r[b] > 0) & (vr > min_roll);
-      const double inv_vr = 1.0 / vr;
-      const double ux = vox * inv_vr, uy = voy * inv_vr, uz = voz * inv_vr;
-      const double dirx = ny * uz - nz * uy, diry = nz * ux - nx * uz, dirz = nx * uy - ny * ux;
-      const double mr = mu_r[b] * Fn;
-      const double c1 = mr * ra, c2 = mr * rb;
-      q1x = roll ? q1x + c1 * dirx : q1x;
-      q1y = roll ? q1y + c1 * diry : q1y;
-      q1z = roll ? q1z + c1 * dirz : q1z;
-      q2x = roll ? q2x + c2 * dirx : q2x;
-      q2y = roll ? q2y + c2 * diry : q2y;
-      q2z = roll ? q2z + c2 * dirz : q2z;
-      // Spinning: mu_t r_c F_n along n, r_c the radius of the contact lens.
-      const double wrx = bx - ax, wry = by - ay, wrz = bz - az;
-      const double wr = std::sqrt(wrx * wrx + wry * wry + wrz * wrz);
-      const bool spin = on & (mu_t[b] > 0) & (wr > min_spin);
-      const double dcc = rsum - delta;
-      const double xc = (ra * ra - rb * rb) / (2 * dcc) + dcc / 2;
-      const double rc = std::sqrt(std::max(ra * ra - xc * xc, kTiny2));
-      const double wn = (wrx * nx + wry * ny + wrz * nz) / wr;
-      const double Mm = mu_t[b] * rc * Fn * wn;
-      const double Mx = Mm * nx, My = Mm * ny, Mz = Mm * nz;
-      q1x = spin ? q1x + Mx : q1x;
-      q1y = spin ? q1y + My : q1y;
-      q1z = spin ? q1z + Mz : q1z;
-      q2x = spin ? q2x - Mx : q2x;
-      q2y = spin ? q2y - My : q2y;
-      q2z = spin ? q2z - Mz : q2z;
-    }
+    if constexpr (kRolling)
+      add_sunday(b, dur > gate[b], Fn, Lever{nx, ny, nz, ra, rb, rsum - delta}, Spins{ax, ay, az, bx, by, bz}, min_roll,
+                 min_spin, Torques{q1x, q1y, q1z, q2x, q2y, q2z});
     fx[b] = f2x;
     fy[b] = f2y;
     fz[b] = f2z;
