@@ -285,6 +285,20 @@ double trial_force_scale_m_s2(const MeasuredTrial& t) {
   return n > 0 && s > 0 ? std::sqrt(s / static_cast<double>(n)) : t.info.gravity_m_s2;
 }
 
+/// The names of the fit's columns, in the order of layout(): term.param, with @g=<level> for a
+/// term fitted per gravity level.
+std::vector<std::string> column_names(const ModelSpec& spec, const std::vector<double>& gravity_levels) {
+  std::vector<std::string> names;
+  for (const auto& st : spec.terms)
+    for (const auto& param : st.term->params) {
+      if (st.per_gravity)
+        for (double g : gravity_levels) names.push_back(fmt::format("{}.{}@g={}", st.term->name, param, g));
+      else
+        names.push_back(fmt::format("{}.{}", st.term->name, param));
+    }
+  return names;
+}
+
 /// The least-squares fit of fit_model, unchecked; `not_finite` gets the trials whose rows of the
 /// problem (features or m (a_up + g)) hold a value that is not finite.
 FittedModel fit_unchecked(const ModelSpec& spec, const Campaign& c, const std::vector<bool>& mask,
@@ -294,16 +308,7 @@ FittedModel fit_unchecked(const ModelSpec& spec, const Campaign& c, const std::v
   m.gravity_levels = c.gravity_levels();
   const int G = static_cast<int>(m.gravity_levels.size());
   const Layout L = layout(spec, G);
-  for (std::size_t i = 0; i < spec.terms.size(); ++i) {
-    const auto& t = *spec.terms[i].term;
-    for (std::size_t j = 0; j < t.params.size(); ++j) {
-      if (spec.terms[i].per_gravity)
-        for (int gi = 0; gi < G; ++gi)
-          m.column_names.push_back(fmt::format("{}.{}@g={}", t.name, t.params[j], m.gravity_levels[gi]));
-      else
-        m.column_names.push_back(fmt::format("{}.{}", t.name, t.params[j]));
-    }
-  }
+  m.column_names = column_names(spec, m.gravity_levels);
   std::size_t rows = 0;
   std::vector<int> used;
   for (std::size_t ti = 0; ti < c.trials.size(); ++ti)
