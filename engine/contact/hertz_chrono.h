@@ -15,20 +15,6 @@ namespace gravsweep {
 
 struct HertzBatch;  // engine/system/hertz_batch.h
 
-/// Stiffness and damping of a Hertz contact at overlap delta (docs/physics/contact-laws.md
-/// section 1.3): Sn = 2 E* sqrt(R* delta), kn = 2/3 Sn, kt = St = 8 G* sqrt(R* delta),
-/// gn = f_n sqrt(Sn m*), gt = f_t sqrt(Sn m*) with the damping factors of HertzChrono::prepare.
-struct HertzSprings {
-  double kn_N_m, kt_N_m, gn_N_s_m, gt_N_s_m;
-};
-GRAVSWEEP_INLINE HertzSprings hertz_springs(double E_eff_Pa, double G_eff_Pa, double damping_n, double damping_t,
-                                            double R_eff_m, double delta_m, double m_eff_kg) {
-  const double sqrt_Rd = std::sqrt(R_eff_m * delta_m);
-  const double Sn = 2.0 * E_eff_Pa * sqrt_Rd;
-  const double sqrt_Sn_m = std::sqrt(Sn * m_eff_kg);
-  return {(2.0 / 3.0) * Sn, 8.0 * G_eff_Pa * sqrt_Rd, damping_n * sqrt_Sn_m, damping_t * sqrt_Sn_m};
-}
-
 struct HertzChrono {
   static constexpr const char* name = "hertz";
   static constexpr const char* description =
@@ -47,6 +33,21 @@ struct HertzChrono {
     return -2.0 * std::sqrt(5.0 / 6.0) * beta;
   }
 
+  /// Stiffness and damping at overlap delta (docs/physics/contact-laws.md section 1.3):
+  /// Sn = 2 E* sqrt(R* delta), kn = 2/3 Sn, kt = St = 8 G* sqrt(R* delta), gn = f_n sqrt(Sn m*),
+  /// gt = f_t sqrt(Sn m*) with the damping factors of prepare(). Evaluate and the batched kernel
+  /// (HertzBatch) both call it.
+  struct Springs {
+    double kn_N_m, kt_N_m, gn_N_s_m, gt_N_s_m;
+  };
+  GRAVSWEEP_INLINE static Springs springs(double E_eff_Pa, double G_eff_Pa, double damping_n, double damping_t,
+                                          double R_eff_m, double delta_m, double m_eff_kg) {
+    const double sqrt_Rd = std::sqrt(R_eff_m * delta_m);
+    const double Sn = 2.0 * E_eff_Pa * sqrt_Rd;
+    const double sqrt_Sn_m = std::sqrt(Sn * m_eff_kg);
+    return {(2.0 / 3.0) * Sn, 8.0 * G_eff_Pa * sqrt_Rd, damping_n * sqrt_Sn_m, damping_t * sqrt_Sn_m};
+  }
+
   /// Caches the damping factors of the pair. Chrono uses the normal COR for both directions:
   /// gn = f sqrt(Sn m*), gt = f sqrt(St m*) = [f sqrt(4 G*/E*)] sqrt(Sn m*) since St/Sn = 4 G*/E*.
   static void prepare(PairCoefficients& c) {
@@ -59,6 +60,7 @@ struct HertzChrono {
   static double normal_energy_J(const ContactGeometry& g, const PairCoefficients& c) {
     return normal_energy_J(c.E_eff_Pa, g.R_eff_m, g.overlap_m);
   }
+  /// The same from E*, R* and the overlap d (the batched kernel's energy).
   GRAVSWEEP_INLINE static double normal_energy_J(double E_eff_Pa, double R_eff_m, double d_m) {
     return (8.0 / 15.0) * E_eff_Pa * std::sqrt(R_eff_m) * d_m * d_m * std::sqrt(d_m);
   }
@@ -130,8 +132,8 @@ struct HertzChrono {
     const double v_n = v_rel.dot(n);  // negative while approaching
     const Vec3 v_t = v_rel - v_n * n;
 
-    const auto [kn, kt, gn, gt] = hertz_springs(c.E_eff_Pa, c.G_eff_Pa, c.damping_prefactor_n, c.damping_prefactor_t,
-                                                g.R_eff_m, delta, g.m_eff_kg);
+    const auto [kn, kt, gn, gt] =
+        springs(c.E_eff_Pa, c.G_eff_Pa, c.damping_prefactor_n, c.damping_prefactor_t, g.R_eff_m, delta, g.m_eff_kg);
     double Fn = kn * delta - gn * v_n;  // unclamped, as in Chrono
     if (opt.clamp_normal && Fn < 0) Fn = 0;
 

@@ -1,7 +1,7 @@
 // The particle-particle contacts of `hertz` (with `sunday` or `none` rolling) evaluated a batch at
 // a time, structure of arrays, so the compiler vectorises the arithmetic across contacts (8
 // doubles per AVX-512 instruction: the square roots and divisions that bound the scalar kernel
-// run 8 at a time). The law is HertzChrono's: its stiffness and damping (hertz_springs), gate
+// run 8 at a time). The law is HertzChrono's: its stiffness and damping (HertzChrono::springs), gate
 // (HertzChrono::gate_s) and spring energy are the same functions; the geometry, the tangential
 // spring and RollingSunday::apply are written per lane (docs/physics/contact-laws.md sections
 // 1.3-1.5), every branch a per-lane select. The force
@@ -191,7 +191,7 @@ void HertzBatch::compute(const ContactOptions& opt, double dt_s) {
     const double v_n = vrx * nx + vry * ny + vrz * nz;
     const double vtx = vrx - v_n * nx, vty = vry - v_n * ny, vtz = vrz - v_n * nz;
     // Stiffness and damping (docs/physics/contact-laws.md section 1.3).
-    const auto [kn, kt, gn, gt] = hertz_springs(E[b], G[b], damp_n[b], damp_t[b], Reff, delta, m);
+    const auto [kn, kt, gn, gt] = HertzChrono::springs(E[b], G[b], damp_n[b], damp_t[b], Reff, delta, m);
     double Fn = kn * delta - gn * v_n;
     Fn = (clamp & (Fn < 0)) ? 0.0 : Fn;
     // MultiStep history (1.4).
