@@ -71,7 +71,7 @@ std::vector<queue::PlannedJob> expand_with_progress(const sweep::SweepSpec& spec
     std::fprintf(stderr, "sweep %s: expanding and validating %zu points (about %.2g GB and %s estimated)\n",
                  spec.name.c_str(), spec.points(), c.memory_bytes / 1e9, format_duration(c.seconds).c_str());
   }
-  auto jobs = sweep::expand(spec, pipeline::impact_bed_key(), [&](std::size_t done, std::size_t total) {
+  auto jobs = sweep::expand(spec, pipeline::impact_point_check(), [&](std::size_t done, std::size_t total) {
     bar.update("expand", static_cast<double>(done) / static_cast<double>(total),
                fmt::format("{} of {} points validated", done, total));
   });

@@ -26,7 +26,7 @@ std::optional<json> take_cached_bed(const fs::path& cache, const std::string& be
   results::BedData bed;
   try {
     bed = read_user_bed(cached, nullptr);  // checksum verified here
-    require_bed_key(bed, validate_scenario(scenario), cached);
+    require_bed_key(bed, job_scenario(scenario), cached);
   } catch (const ConfigError& e) {
     throw ConfigError(fmt::format("bed cache: {}; delete {} and its checksum file to prepare the bed again", e.what(),
                                   cached.string()));

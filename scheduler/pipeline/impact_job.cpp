@@ -35,24 +35,6 @@ void check_stop(const std::atomic<bool>* stop, const char* what) {
   if (stop && stop->load(std::memory_order_relaxed)) throw Interrupted(fmt::format("{} interrupted", what));
 }
 
-json bed_key_of_validated(const json& s) {
-  json k;
-  k["bed_format_version"] = results::kBedFormatVersion;
-  k["container"] = s.at("container");
-  k["grains"] = s.at("grains");
-  k["gravity_m_s2"] = s.at("gravity_m_s2");
-  // The bed's own materials (/bed/materials, when given) are the ones it is prepared with: a bed
-  // prepared with them has the key of a scenario whose /materials are those, so drops that differ
-  // from it only in their materials reuse it (scenario.schema.json, /bed/materials).
-  json bed = s.at("bed");
-  k["materials"] = bed.contains("materials") ? bed.at("materials") : s.at("materials");
-  bed.erase("materials");
-  k["contact"] = s.at("contact");
-  k["integrator"] = s.at("integrator");
-  k["bed"] = bed;
-  return k;
-}
-
 /// JSON pointer of the first difference between two keys, for messages.
 std::string first_difference(const json& a, const json& b) {
   const json patch = json::diff(a, b);
@@ -117,11 +99,29 @@ DropResult resume_or_start(DropCheckpointer& ckpt, const Drop& drop) {
 
 }  // namespace
 
+json bed_key_of_validated(const json& s) {
+  json k;
+  k["bed_format_version"] = results::kBedFormatVersion;
+  k["container"] = s.at("container");
+  k["grains"] = s.at("grains");
+  k["gravity_m_s2"] = s.at("gravity_m_s2");
+  // The bed's own materials (/bed/materials, when given) are the ones it is prepared with: a bed
+  // prepared with them has the key of a scenario whose /materials are those, so drops that differ
+  // from it only in their materials reuse it (scenario.schema.json, /bed/materials).
+  json bed = s.at("bed");
+  k["materials"] = bed.contains("materials") ? bed.at("materials") : s.at("materials");
+  bed.erase("materials");
+  k["contact"] = s.at("contact");
+  k["integrator"] = s.at("integrator");
+  k["bed"] = bed;
+  return k;
+}
+
 json bed_key(const json& scenario) { return bed_key_of_validated(validate_scenario(scenario)); }
 
 BedJobResult run_bed_job(const json& scenario, const std::filesystem::path& bed_out, int threads,
                          const Progress& progress, const std::atomic<bool>* stop) {
-  const json s = validate_scenario(scenario);
+  const json s = job_scenario(scenario);
   ScenarioParams p = scenario_params(s);
   check_stop(stop, "bed preparation");
   if (threads > 0) p.bed_config.threads = threads;
@@ -373,7 +373,7 @@ void add_dem_metrics(json& m, const results::TraceData& td, const DropResult& dr
 DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& bed_in,
                            const std::filesystem::path& trace_out, int threads, const Progress& progress,
                            const std::atomic<bool>* stop, const DropCheckpointing& checkpointing) {
-  const json s = validate_scenario(scenario);
+  const json s = job_scenario(scenario);
   ScenarioParams p = scenario_params(s);
   if (threads > 0) p.drop_config.threads = threads;
   const results::BedData bed = results::read_bed(bed_in);

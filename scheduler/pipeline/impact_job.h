@@ -40,9 +40,9 @@ struct DropJobResult {
   std::size_t snapshots = 0, snapshot_bytes = 0;  ///< count, state bytes per snapshot
 };
 
-/// Validates `scenario` (throws SpecError, a ConfigError, with the JSON pointer on bad input),
-/// prepares the bed and writes it to bed_out (HDF5), written under a temporary name then renamed.
-/// threads <= 0: the scenario's "threads", else OpenMP's default.
+/// Validates `scenario` unless this build validated it at submit (job_scenario; throws SpecError,
+/// a ConfigError, with the JSON pointer on bad input), prepares the bed and writes it to bed_out (HDF5), written under
+/// a temporary name then renamed. threads <= 0: the scenario's "threads", else OpenMP's default.
 BedJobResult run_bed_job(const nlohmann::json& scenario, const std::filesystem::path& bed_out, int threads,
                          const Progress& progress, const std::atomic<bool>* stop);
 
@@ -60,6 +60,8 @@ DropJobResult run_drop_job(const nlohmann::json& scenario, const std::filesystem
 /// Canonical key of the bed a scenario needs (container, grains, fill, gravity, materials, contact
 /// law, preparation settings and seed): drops with equal keys share a bed. Validates the scenario.
 nlohmann::json bed_key(const nlohmann::json& scenario);
+/// The same for a scenario validate_scenario (or job_scenario) returned, without validating it again.
+nlohmann::json bed_key_of_validated(const nlohmann::json& validated);
 
 /// `<bed>.sha256`, beside a bed that `gravsweep run` prepared: the bed file's SHA-256, the checksum
 /// a campaign records for its beds (queue::sha256_file), as sha256sum writes it ("<hex>  <name>").

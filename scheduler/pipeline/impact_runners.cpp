@@ -4,6 +4,7 @@
 
 #include "scheduler/pipeline/bed_cache.h"
 #include "scheduler/pipeline/impact_job.h"
+#include "scheduler/pipeline/scenario_spec.h"
 #include "scheduler/queue/stop.h"
 #include "scheduler/sweep/impact_kinds.h"
 
@@ -13,8 +14,12 @@ using queue::RunContext;
 using queue::RunnerTable;
 using queue::RunOutput;
 
-sweep::BedKeyFn impact_bed_key() {
-  return [](const nlohmann::json& scenario) { return bed_key(scenario); };
+sweep::PointCheckFn impact_point_check() {
+  return [](const nlohmann::json& scenario) {
+    nlohmann::json validated = validate_scenario(scenario);
+    nlohmann::json key = bed_key_of_validated(validated);
+    return sweep::CheckedPoint{stored_scenario(std::move(validated)).dump(), std::move(key)};
+  };
 }
 
 void add_impact_runners(RunnerTable& table) {

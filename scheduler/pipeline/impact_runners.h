@@ -8,7 +8,7 @@
 namespace gravsweep::pipeline {
 
 /// Drops with equal keys share a bed (pipeline::bed_key).
-sweep::BedKeyFn impact_bed_key();
+sweep::PointCheckFn impact_point_check();
 /// Adds the "bed" and "drop" runners.
 void add_impact_runners(queue::RunnerTable& table);
 /// Every runner: noop, bed and drop.

@@ -19,6 +19,8 @@
 #include "scheduler/sweep/spec.h"
 #include "spec/problems.h"
 #include "spec/schemas.h"
+#include "spec/sha256.h"
+#include "scheduler/pipeline/build_version.h"
 
 // Typed JSON (nlohmann's from_json, found by argument-dependent lookup) for the engine's material
 // types, read from a scenario the schema has validated (schemas/scenario.schema.json: /materials,
@@ -381,6 +383,27 @@ json validate_scenario(const json& scenario, const std::string& source) {
   engine_checks_once(s, ck);  // the engine's own checks (materials, pair values, dt bound)
   if (!problems.empty()) throw SpecError(source, std::move(problems.list()));
   return s;
+}
+
+const std::string& validated_by() {
+  static const std::string mark = fmt::format(
+      "{} schema:{}", build_version(), spec::sha256_hex(spec::schema_text(spec::Schema::scenario)).substr(0, 12));
+  return mark;
+}
+
+json stored_scenario(json validated) {
+  validated[kValidatedByKey] = validated_by();
+  return validated;
+}
+
+json job_scenario(const json& stored) {
+  if (stored.is_object() && stored.contains(kValidatedByKey)) {
+    json s = stored;
+    const bool mine = s[kValidatedByKey] == validated_by();
+    s.erase(kValidatedByKey);
+    return mine ? s : validate_scenario(s);
+  }
+  return validate_scenario(stored);
 }
 
 json load_scenario(const std::filesystem::path& path) {

@@ -23,6 +23,19 @@ using spec::SpecProblem;
 /// expected; a rule that needs a field already found bad is skipped rather than reported twice.
 nlohmann::json validate_scenario(const nlohmann::json& scenario, const std::string& source = "scenario");
 
+/// The key under which a job's stored scenario names the validation it passed: the build and the
+/// scenario schema's SHA-256 (validated_by()).
+inline constexpr const char* kValidatedByKey = "$validated_by";
+/// This build's validation: "<build version> schema:<first 12 hex of the schema's SHA-256>".
+const std::string& validated_by();
+/// A validated scenario as a queue job stores it (sweep expansion at submit): marked with
+/// validated_by(), so that a worker of the same build reads it without validating it again.
+nlohmann::json stored_scenario(nlohmann::json validated);
+/// The validated scenario of a job (what validate_scenario returns, without the mark): the stored
+/// one as it is when this build validated it at submit, else validated now (a job submitted by
+/// another build, or before scenarios were stored validated). Throws as validate_scenario.
+nlohmann::json job_scenario(const nlohmann::json& stored);
+
 /// How many times validation has run the engine's own checks (each builds an engine System four
 /// times) in this process: once per distinct set of the fields they read, not once per scenario.
 std::size_t engine_check_runs();

@@ -78,8 +78,10 @@ inline std::ostream& operator<<(std::ostream& os, JobState s) { return os << sta
 /// One job to submit: what a sweep's expansion (scheduler/sweep/spec.h) plans.
 struct PlannedJob {
   std::string job_id;
-  JobKind kind;                   ///< noop unless set
-  nlohmann::json scenario;        ///< canonical scenario the job runs
+  JobKind kind;  ///< noop unless set
+  /// The scenario the job runs, as jobs.scenario_json stores it: text rather than a JSON tree,
+  /// a fraction of the memory when a sweep plans many points (BENCHMARKS.md, "Sweep expansion").
+  std::string scenario_json;
   nlohmann::json params;          ///< swept parameter values {column name: value}
   std::vector<std::string> deps;  ///< job ids this job waits for
   int priority = 0;

@@ -61,7 +61,7 @@ void insert_jobs(Database& db, const SweepRecord& spec, const std::vector<Planne
     ins.bind(1, j.job_id).bind(2, kind_name(j.kind)).bind(3, spec.name);
     ins.bind(4, state_name(j.deps.empty() ? JobState::queued : JobState::waiting));
     ins.bind(5, j.priority).bind(6, static_cast<std::int64_t>(j.deps.size())).bind(7, spec.max_attempts);
-    ins.bind(8, queue::canonical_json(j.params)).bind(9, queue::canonical_json(j.scenario)).bind(10, now);
+    ins.bind(8, queue::canonical_json(j.params)).bind(9, j.scenario_json).bind(10, now);
     ins.run();
     const bool added = db.changes() == 1;
     if (added) {

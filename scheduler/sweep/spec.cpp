@@ -293,9 +293,10 @@ double machine_memory_bytes() {
 }
 
 ExpansionCost expansion_cost(const SweepSpec& spec) {
-  // Calibrated on examples/sweep_tiny.json's scenario swept to 200,000 points (BENCHMARKS.md):
-  // bytes and seconds per node of a point's scenario tree, and per point.
-  constexpr double kBytesPerNode = 110, kBytesPerPoint = 800, kSecondsPerNode = 1e-5, kSecondsPerPoint = 2.5e-5;
+  // Calibrated on examples/sweep_tiny.json's scenario swept to 200,000 points (BENCHMARKS.md,
+  // "Sweep expansion"): bytes and seconds per node of the base scenario, and per point. The bytes
+  // are mostly each job's stored scenario, validated with its defaults filled (2 kB of text here).
+  constexpr double kBytesPerNode = 140, kBytesPerPoint = 950, kSecondsPerNode = 1e-5, kSecondsPerPoint = 2.5e-5;
   ExpansionCost c;
   c.points = 1;
   for (const auto& g : spec.groups) c.points *= static_cast<double>(g.size());
@@ -397,17 +398,18 @@ class PointProblems {
   std::vector<std::size_t> repeats_;
 };
 
-/// The scenario and swept values of point p: its mixed-radix digits, last group fastest.
-queue::PlannedJob point_job(const SweepSpec& spec, std::size_t p) {
+/// The scenario of point p as written (the base with its swept values: its mixed-radix digits,
+/// last group fastest) into `scenario`, and its job with the swept values.
+queue::PlannedJob point_job(const SweepSpec& spec, std::size_t p, json& scenario) {
   queue::PlannedJob job;
-  job.scenario = spec.base;
+  scenario = spec.base;
   job.params = json::object();
   std::size_t rem = p;
   for (std::size_t g = spec.groups.size(); g-- > 0;) {
     const std::size_t i = rem % spec.groups[g].size();
     rem /= spec.groups[g].size();
     for (const auto& axis : spec.groups[g].axes) {
-      job.scenario[json::json_pointer(axis.pointer)] = axis.values[i];
+      scenario[json::json_pointer(axis.pointer)] = axis.values[i];
       job.params[axis.name] = axis.values[i];
     }
   }
@@ -417,7 +419,7 @@ queue::PlannedJob point_job(const SweepSpec& spec, std::size_t p) {
 
 /// A problem of a base field no axis replaces is reported once, at its pointer under /base (a
 /// swept field is checked at each point instead: its base value may be a placeholder).
-void check_base(const SweepSpec& spec, const BedKeyFn& bed_key) {
+void check_base(const SweepSpec& spec, const PointCheckFn& check) {
   auto swept = [&](const std::string& pointer) {
     for (const auto& g : spec.groups)
       for (const auto& ax : g.axes)
@@ -427,7 +429,7 @@ void check_base(const SweepSpec& spec, const BedKeyFn& bed_key) {
   };
   std::vector<SpecProblem> problems;
   try {
-    (void)bed_key(spec.base);
+    (void)check(spec.base);
   } catch (const SpecError& e) {
     for (const auto& p : e.problems())
       if (!swept(p.pointer)) problems.push_back({"/base" + p.pointer, p.found, p.expected});
@@ -437,11 +439,12 @@ void check_base(const SweepSpec& spec, const BedKeyFn& bed_key) {
   }
 }
 
-/// The bed key of a drop's scenario; nothing (its problems added) when the point is invalid.
-std::optional<json> point_bed_key(const BedKeyFn& bed_key, const queue::PlannedJob& job, PointProblems& problems) {
+/// A drop's scenario checked; nothing (its problems added) when the point is invalid.
+std::optional<CheckedPoint> check_point(const PointCheckFn& check, const json& scenario, const queue::PlannedJob& job,
+                                        PointProblems& problems) {
   try {
-    if (!bed_key) throw std::runtime_error("no bed key function (the impact pipeline is not built in)");
-    return bed_key(job.scenario);
+    if (!check) throw std::runtime_error("no scenario check (the impact pipeline is not built in)");
+    return check(scenario);
   } catch (const SpecError& e) {
     // The base was sound, so these are problems of swept values.
     for (const auto& sp : e.problems())
@@ -467,7 +470,7 @@ void add_to_bed(const SweepSpec& spec, const json& key, queue::PlannedJob& job, 
     queue::PlannedJob bed;
     bed.kind = bed_kind();
     bed.job_id = bed_id;
-    bed.scenario = job.scenario;  // any scenario with this key prepares the same bed
+    bed.scenario_json = job.scenario_json;  // any scenario with this key prepares the same bed
     bed.params = job.params;
     bed.priority = spec.priority + 1;  // beds first: drops wait for them
     beds.push_back(std::move(bed));
@@ -488,30 +491,34 @@ queue::SweepRecord record(const SweepSpec& spec) {
   return r;
 }
 
-std::vector<queue::PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key, const ExpandProgress& progress) {
+std::vector<queue::PlannedJob> expand(const SweepSpec& spec, const PointCheckFn& check,
+                                      const ExpandProgress& progress) {
   std::vector<queue::PlannedJob> beds, drops;
   std::map<std::string, std::size_t> bed_index;
   const std::size_t n = spec.points();
   const bool noop = spec.job_kind == "noop";
   PointProblems problems;
-  if (!noop && bed_key) check_base(spec, bed_key);
+  if (!noop && check) check_base(spec, check);
   drops.reserve(n);
   for (std::size_t p = 0; p < n; ++p) {
     if (progress && p % kExpandProgressEvery == 0) progress(p, n);
-    queue::PlannedJob job = point_job(spec, p);
+    json scenario;
+    queue::PlannedJob job = point_job(spec, p, scenario);
     if (noop) {
-      for (auto& np : noop_problems(job.scenario, "/base"))
+      for (auto& np : noop_problems(scenario, "/base"))
         problems.add(std::move(np), job.params, [](const SpecProblem&) { return false; });
       job.kind = queue::noop_kind();
-      job.job_id = queue::job_id(queue::kind_name(job.kind), job.scenario);
+      job.job_id = queue::job_id(queue::kind_name(job.kind), scenario);
+      job.scenario_json = queue::canonical_json(scenario);
       drops.push_back(std::move(job));
       continue;
     }
     job.kind = drop_kind();
-    job.job_id = queue::job_id(queue::kind_name(job.kind), job.scenario);
-    const auto key = point_bed_key(bed_key, job, problems);
-    if (!key) continue;
-    add_to_bed(spec, *key, job, beds, bed_index);
+    job.job_id = queue::job_id(queue::kind_name(job.kind), scenario);
+    auto checked = check_point(check, scenario, job, problems);
+    if (!checked) continue;
+    job.scenario_json = std::move(checked->scenario_json);
+    add_to_bed(spec, checked->bed_key, job, beds, bed_index);
     drops.push_back(std::move(job));
   }
   if (progress) progress(n, n);

@@ -65,8 +65,15 @@ SweepSpec load_spec(const std::filesystem::path& path);
 /// per axis with its values.
 queue::SweepRecord record(const SweepSpec& spec);
 
-/// bed key of a scenario: drops with equal keys share a bed job.
-using BedKeyFn = std::function<nlohmann::json(const nlohmann::json& scenario)>;
+/// A point's scenario as checked by the pipeline that runs it: the scenario its jobs store
+/// (validated, defaults filled, marked so that the worker need not validate it again) and its bed
+/// key (drops with equal keys share a bed job).
+struct CheckedPoint {
+  std::string scenario_json;  ///< the text the jobs store (PlannedJob::scenario_json)
+  nlohmann::json bed_key;
+};
+/// Checks a point's scenario; throws SpecError naming its problems.
+using PointCheckFn = std::function<CheckedPoint(const nlohmann::json& scenario)>;
 
 /// Told how many of the points are expanded and validated so far (every kExpandProgressEvery
 /// points, and at the end).
@@ -74,9 +81,10 @@ using ExpandProgress = std::function<void(std::size_t done, std::size_t total)>;
 inline constexpr std::size_t kExpandProgressEvery = 1000;
 
 /// Expands the spec. Bed jobs come first (in order of first use), then drops in product order.
-/// `bed_key` is required for impact sweeps. Errors from bed_key (invalid scenario) become
-/// SpecError naming the point.
-std::vector<queue::PlannedJob> expand(const SweepSpec& spec, const BedKeyFn& bed_key,
+/// `check` is required for impact sweeps: each point is checked once, here, and its jobs store
+/// the checked scenario (their ids are those of the point's scenario as written). Errors from
+/// check (invalid scenario) become SpecError naming the point.
+std::vector<queue::PlannedJob> expand(const SweepSpec& spec, const PointCheckFn& check,
                                       const ExpandProgress& progress = {});
 
 /// What expanding and validating a sweep takes, estimated from its points and the size of its

@@ -334,4 +334,23 @@ TEST(ScenarioSpec, AnAdaptiveStepsCapBelowTheFixedStepIsRefusedAtValidation) {
   EXPECT_NO_THROW(validate_scenario(s));
 }
 
+// A sweep point is validated once, at submit: its jobs store the validated scenario marked with
+// this build's validation, and the worker's job_scenario takes it as it is. A scenario marked by
+// another build (or not marked: jobs of older campaigns) is validated again.
+TEST(ScenarioSpec, AScenarioThisBuildValidatedAtSubmitIsNotValidatedAgainByTheWorker) {
+  const json validated = validate_scenario(minimal());
+  const json stored = pipeline::stored_scenario(validated);
+  EXPECT_EQ(stored.at(pipeline::kValidatedByKey), pipeline::validated_by());
+  EXPECT_EQ(pipeline::job_scenario(stored), validated);  // the mark removed, nothing else changed
+  // The mark is trusted: a value broken after submit is not looked at again...
+  json broken = stored;
+  broken["dt_s"] = -1;
+  EXPECT_NO_THROW((void)pipeline::job_scenario(broken));
+  // ...unless another build (another schema or other checks) marked it, or nobody did.
+  broken[pipeline::kValidatedByKey] = "0.0.0+another schema:000000000000";
+  EXPECT_THROW((void)pipeline::job_scenario(broken), SpecError);
+  broken.erase(pipeline::kValidatedByKey);
+  EXPECT_THROW((void)pipeline::job_scenario(broken), SpecError);
+}
+
 }  // namespace gravsweep

@@ -34,7 +34,7 @@ sweep::SweepSpec noop_spec(const std::string& name, std::vector<double> gs, int 
   return sweep::parse_spec(doc, "test", ".");
 }
 
-json bed_key(const json& s) { return {{"g", s["g"]}}; }
+sweep::CheckedPoint bed_key(const json& s) { return {s.dump(), {{"g", s["g"]}}}; }
 
 /// An impact-shaped sweep (bed + drop jobs) for the dependency logic; no job is run here.
 sweep::SweepSpec impact_spec() {
@@ -64,7 +64,7 @@ struct QueueTest : ::testing::TestWithParam<test::Store> {
     while (st.step()) out += (out.empty() ? "" : ",") + st.get_text(0);
     return out;
   }
-  SubmitReport submit_spec(const sweep::SweepSpec& s, const sweep::BedKeyFn& key = {}) {
+  SubmitReport submit_spec(const sweep::SweepSpec& s, const sweep::PointCheckFn& key = {}) {
     return submit(db, sweep::record(s), sweep::expand(s, key));
   }
   Completion done_for(const Claim& c, double value = 1.0) {

@@ -38,11 +38,18 @@ json tiny_sweep(long speeds, long repeats) {
 TEST(SweepScale, EngineChecksRunOncePerDistinctSetupNotPerPoint) {
   const SweepSpec spec = parse_spec(tiny_sweep(50, 40), "big.json", GRAVSWEEP_SOURCE_DIR "/examples");
   const std::size_t before = pipeline::engine_check_runs();
-  const auto jobs = expand(spec, pipeline::impact_bed_key());
+  const auto jobs = expand(spec, pipeline::impact_point_check());
   EXPECT_EQ(jobs.size(), 2001u);  // one bed, 2,000 drops
   // Speeds and seeds are not read by the engine's checks: one run for the whole sweep (two with
   // the base checked alone first), not 2,000.
   EXPECT_LE(pipeline::engine_check_runs() - before, 2u);
+  // Every job stores its point validated at submit (defaults filled, marked for the worker), under
+  // the id of the point as written; the bed job stores its first drop's.
+  for (const auto& job : jobs) {
+    const json stored = json::parse(job.scenario_json);
+    EXPECT_EQ(stored.at(pipeline::kValidatedByKey), pipeline::validated_by());
+    EXPECT_TRUE(stored.contains("at_rest")) << "a default the base does not write";
+  }
 }
 
 TEST(SweepScale, AnEngineProblemIsStillFoundAtEveryPointThatHasIt) {
@@ -51,7 +58,7 @@ TEST(SweepScale, AnEngineProblemIsStillFoundAtEveryPointThatHasIt) {
   s["axes"].push_back({{"name", "dt_s"}, {"pointer", "/dt_s"}, {"values", {1e-5, 1e-2}}});
   const SweepSpec spec = parse_spec(s, "big.json", GRAVSWEEP_SOURCE_DIR "/examples");
   try {
-    expand(spec, pipeline::impact_bed_key());
+    expand(spec, pipeline::impact_point_check());
     FAIL() << "a time step the contact law refuses was accepted";
   } catch (const SpecError& e) {
     const std::string what = e.what();
