@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "engine/core/error.h"
+#include "engine/core/registry.h"
 
 namespace gravsweep {
 
@@ -127,13 +128,7 @@ const std::vector<IntegratorEntry>& integrator_table() {
 }
 
 std::unique_ptr<Integrator> make_integrator(std::string_view name) {
-  std::string valid;
-  for (const auto& e : integrator_table()) {
-    if (name == e.name) return e.make();
-    valid += valid.empty() ? "" : ", ";
-    valid += e.name;
-  }
-  throw ConfigError(fmt::format("unknown integrator '{}'; valid integrators: {}", name, valid));
+  return find_row(integrator_table(), name, "integrator").make();
 }
 
 }  // namespace gravsweep

@@ -2,11 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <tuple>
 
 #include "engine/contact/hertz_chrono.h"
 #include "engine/contact/hooke_pkdgrav.h"
 #include "engine/core/error.h"
+#include "engine/core/registry.h"
 #include "engine/rolling/rolling_none.h"
 #include "engine/rolling/rolling_sunday.h"
 #include "engine/rolling/rolling_zhang.h"
@@ -14,103 +16,105 @@
 
 namespace gravsweep {
 
-// ---- The tables: one row per law / model. ------------------------------------------------------
+// ---- The lists: one entry per law / model. ------------------------------------------------------
 using ContactLaws = std::tuple<HertzChrono, HookePkdgrav>;
 using RollingModels = std::tuple<RollingNone, RollingSunday, RollingZhang>;
 // -------------------------------------------------------------------------------------------------
 
 namespace {
 
-template <class Tuple>
-std::vector<std::string> names_of() {
+/// A rolling model's row: what is known of it by name.
+struct RollingRow {
+  const char* name;
+  const char* description;
+  bool uses_frame_history;
+};
+
+/// A contact law's row: its static functions, and its force function with each rolling model
+/// (force_loop<Law, Rolling>, in the order of RollingModels).
+struct LawRow {
+  const char* name;
+  const char* description;
+  bool uses_frame_history;
+  void (*prepare)(PairCoefficients&);
+  void (*check)(const LawSetup&);
+  double (*shortest_contact_time_s)(const LawSetup&, double);
+  std::array<ForceFunction, std::tuple_size_v<RollingModels>> force_with_rolling;
+};
+
+template <class Law>
+LawRow law_row() {
+  return std::apply(
+      [](auto... r) {
+        return LawRow{Law::name,
+                      Law::description,
+                      Law::uses_frame_history,
+                      &Law::prepare,
+                      &Law::check,
+                      &Law::shortest_contact_time_s,
+                      {&force_loop<Law, decltype(r)>...}};
+      },
+      RollingModels{});
+}
+
+/// The tables, built once from the lists above.
+const std::vector<LawRow>& law_rows() {
+  static const std::vector<LawRow> rows =
+      std::apply([](auto... l) { return std::vector<LawRow>{law_row<decltype(l)>()...}; }, ContactLaws{});
+  return rows;
+}
+
+const std::vector<RollingRow>& rolling_rows() {
+  static const std::vector<RollingRow> rows = std::apply(
+      [](auto... r) {
+        return std::vector<RollingRow>{
+            RollingRow{decltype(r)::name, decltype(r)::description, decltype(r)::uses_frame_history}...};
+      },
+      RollingModels{});
+  return rows;
+}
+
+const LawRow& law(std::string_view name) { return find_row(law_rows(), name, "contact law"); }
+const RollingRow& rolling(std::string_view name) { return find_row(rolling_rows(), name, "rolling model"); }
+
+template <class Rows>
+std::vector<std::string> names_of(const Rows& rows) {
   std::vector<std::string> out;
-  std::apply([&](auto... e) { (out.emplace_back(decltype(e)::name), ...); }, Tuple{});
+  for (const auto& row : rows) out.emplace_back(row.name);
   return out;
 }
 
-template <class Tuple>
-std::string description_of(const std::string& name) {
-  std::string d;
-  std::apply([&](auto... e) { ((name == decltype(e)::name ? (d = decltype(e)::description, 0) : 0), ...); }, Tuple{});
-  return d;
-}
-
-std::string join(const std::vector<std::string>& v) {
-  std::string s;
-  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
-  return s;
-}
-
-template <class Law>
-ForceFunction with_rolling(std::string_view rolling) {
-  ForceFunction f = nullptr;
-  std::apply([&](auto... r) { ((rolling == decltype(r)::name ? (f = &force_loop<Law, decltype(r)>, 0) : 0), ...); },
-             RollingModels{});
-  return f;
+template <class Rows>
+std::string description_of(const Rows& rows, const std::string& name) {
+  const auto* row = find_row_or_null(rows, name);
+  return row ? row->description : "";
 }
 
 }  // namespace
 
-std::vector<std::string> contact_law_names() { return names_of<ContactLaws>(); }
-std::vector<std::string> rolling_model_names() { return names_of<RollingModels>(); }
-std::string contact_law_description(const std::string& n) { return description_of<ContactLaws>(n); }
-std::string rolling_model_description(const std::string& n) { return description_of<RollingModels>(n); }
+std::vector<std::string> contact_law_names() { return names_of(law_rows()); }
+std::vector<std::string> rolling_model_names() { return names_of(rolling_rows()); }
+std::string contact_law_description(const std::string& n) { return description_of(law_rows(), n); }
+std::string rolling_model_description(const std::string& n) { return description_of(rolling_rows(), n); }
 
-ForceFunction select_force_function(std::string_view law, std::string_view rolling) {
-  ForceFunction f = nullptr;
-  bool law_found = false;
-  std::apply(
-      [&](auto... l) {
-        ((law == decltype(l)::name ? (law_found = true, f = with_rolling<decltype(l)>(rolling), 0) : 0), ...);
-      },
-      ContactLaws{});
-  if (!law_found)
-    throw ConfigError(fmt::format("unknown contact law '{}'; valid contact laws: {}", law, join(contact_law_names())));
-  if (f == nullptr)
-    throw ConfigError(
-        fmt::format("unknown rolling model '{}'; valid rolling models: {}", rolling, join(rolling_model_names())));
-  return f;
+ForceFunction select_force_function(std::string_view law_name, std::string_view rolling_name) {
+  const LawRow& l = law(law_name);
+  const RollingRow& r = rolling(rolling_name);
+  return l.force_with_rolling[static_cast<std::size_t>(&r - rolling_rows().data())];
 }
 
-bool uses_frame_history(std::string_view law, std::string_view rolling) {
-  bool uses = false;
-  std::apply([&](auto... l) { ((law == decltype(l)::name ? (uses |= decltype(l)::uses_frame_history, 0) : 0), ...); },
-             ContactLaws{});
-  std::apply(
-      [&](auto... r) { ((rolling == decltype(r)::name ? (uses |= decltype(r)::uses_frame_history, 0) : 0), ...); },
-      RollingModels{});
-  return uses;
+bool uses_frame_history(std::string_view law_name, std::string_view rolling_name) {
+  const auto* l = find_row_or_null(law_rows(), law_name);
+  const auto* r = find_row_or_null(rolling_rows(), rolling_name);
+  return (l && l->uses_frame_history) || (r && r->uses_frame_history);
 }
 
-void prepare_contact_law(std::string_view law, PairTable& pairs) {
-  std::apply(
-      [&](auto... l) {
-        ((law == decltype(l)::name ? (pairs.for_each([](PairCoefficients& c) { decltype(l)::prepare(c); }), 0) : 0),
-         ...);
-      },
-      ContactLaws{});
-}
+void prepare_contact_law(std::string_view law_name, PairTable& pairs) { pairs.for_each(law(law_name).prepare); }
 
-void check_contact_law(std::string_view law, const LawSetup& setup) {
-  bool found = false;
-  std::apply([&](auto... l) { ((law == decltype(l)::name ? (found = true, decltype(l)::check(setup), 0) : 0), ...); },
-             ContactLaws{});
-  if (!found)
-    throw ConfigError(fmt::format("unknown contact law '{}'; valid contact laws: {}", law, join(contact_law_names())));
-}
+void check_contact_law(std::string_view law_name, const LawSetup& setup) { law(law_name).check(setup); }
 
-double shortest_contact_time_s(std::string_view law, const LawSetup& setup, double v_rel_m_s) {
-  double t = 0;
-  bool found = false;
-  std::apply(
-      [&](auto... l) {
-        ((law == decltype(l)::name ? (found = true, t = decltype(l)::shortest_contact_time_s(setup, v_rel_m_s), 0) : 0),
-         ...);
-      },
-      ContactLaws{});
-  if (!found)
-    throw ConfigError(fmt::format("unknown contact law '{}'; valid contact laws: {}", law, join(contact_law_names())));
-  return t;
+double shortest_contact_time_s(std::string_view law_name, const LawSetup& setup, double v_rel_m_s) {
+  return law(law_name).shortest_contact_time_s(setup, v_rel_m_s);
 }
 
 }  // namespace gravsweep

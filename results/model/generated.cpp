@@ -1,6 +1,8 @@
 // The generated family of candidate terms (see generated.h).
 #include "results/model/generated.h"
 
+#include "engine/core/error.h"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -57,9 +59,9 @@ std::optional<Factor> parse_factor(const std::string& s) {
   f.p = *p;
   const bool power = f.kind == Factor::depth_power || f.kind == Factor::speed_power;
   if (power && (f.p < 0 || f.p > 10))
-    throw std::invalid_argument(fmt::format("generated term '{}': a power in [0, 10] expected, found {:g}", s, f.p));
+    throw ConfigError(fmt::format("generated term '{}': a power in [0, 10] expected, found {:g}", s, f.p));
   if (!power && !(f.p > 0))
-    throw std::invalid_argument(fmt::format("generated term '{}': a length l > 0 (m) expected, found {:g}", s, f.p));
+    throw ConfigError(fmt::format("generated term '{}': a length l > 0 (m) expected, found {:g}", s, f.p));
   return f;
 }
 

@@ -24,7 +24,7 @@ inline constexpr double kGeneratedRefDepth_m = 0.02;
 inline constexpr double kGeneratedRefSpeed_m_s = 0.5;
 
 /// The term of a generated form (stable address, built once per name); nullptr when `name` is not
-/// written in the grammar above. Throws std::invalid_argument when it is, but a number is out of
+/// written in the grammar above. Throws ConfigError when it is, but a number is out of
 /// range (a negative power, a length l <= 0), naming the factor.
 const TermInfo* generated_term(const std::string& name);
 

@@ -59,7 +59,7 @@ std::vector<ModelTerm> model_file_terms(const std::string& file) {
     ModelTerm mt;
     try {
       mt.term = &find_term(name);
-    } catch (const std::invalid_argument& ex) {
+    } catch (const ConfigError& ex) {
       problems.add(fmt::format("/terms/{}/name", i), e["name"], ex.what());
       continue;
     }

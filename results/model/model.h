@@ -28,7 +28,7 @@ struct ModelSpec {
 /// "*2.5" a synth scale), or a JSON spec file ({"terms": [{"name": ..., "shared": bool,
 /// "scale": x}]}, schemas/model.schema.json). A file is checked against its schema (spec/schemas.h):
 /// spec::SpecError (a ConfigError) names the file and the JSON pointer of every problem; a bad name
-/// in the text form throws std::invalid_argument.
+/// in the text form throws ConfigError (find_term), a bad ":mode" std::invalid_argument.
 ModelSpec parse_model(const std::string& text_or_path);
 /// No term of the spec has a parameter per gravity level (scaled_base, terms with ":shared"): the
 /// fitted law holds at any g, levels it was not fitted on included.

@@ -61,7 +61,7 @@ GRAVSWEEP_MODEL_TERMS(GRAVSWEEP_DECLARE_TERM)
 /// All registered terms, in registry order.
 const std::vector<TermInfo>& term_registry();
 /// The term of that name: a registered one, or a form of the generated family (generated.h, e.g.
-/// "z^1*v^1"); throws std::invalid_argument listing the known names otherwise.
+/// "z^1*v^1"); throws ConfigError listing the known names otherwise (engine/core/registry.h).
 const TermInfo& find_term(const std::string& name);
 
 }  // namespace gravsweep::results

@@ -7,6 +7,7 @@
 #include <mutex>
 
 #include "engine/core/error.h"
+#include "engine/core/registry.h"
 
 namespace gravsweep::queue {
 
@@ -66,13 +67,14 @@ const JobKindInfo& kind_info(JobKind k) {
 }
 
 JobKind parse_kind(std::string_view name) {
-  std::string valid;
-  for (JobKind k : registered_kinds()) {
-    const std::string& known = kind_info(k).name;
-    if (name == known) return k;
-    valid += (valid.empty() ? "" : ", ") + known;
+  KindTable& t = kind_table();
+  std::size_t index = 0;
+  {
+    const std::lock_guard lock(t.mutex);
+    const JobKindInfo& row = find_row(t.rows, name, "job kind");
+    while (&t.rows[index] != &row) ++index;
   }
-  throw ConfigError(fmt::format("unknown job kind '{}' (expected one of {})", name, valid));
+  return registered_kinds().at(index);
 }
 
 std::vector<std::string> kind_folders() {

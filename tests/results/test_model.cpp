@@ -51,7 +51,7 @@ TEST(Terms, RegistryHasTheLibraryAndRejectsUnknownNames) {
   for (const char* n : {"base", "scaled_base", "depth_friction", "gravity_depth_friction", "viscous_drag",
                         "immersion_drag", "bottom_stiffening", "cohesion"})
     EXPECT_EQ(find_term(n).name, n);
-  EXPECT_THROW(find_term("warp_drive"), std::invalid_argument);
+  EXPECT_THROW(find_term("warp_drive"), gravsweep::ConfigError);
   const auto s = parse_model("base+depth_friction:shared");
   ASSERT_EQ(s.terms.size(), 2u);
   EXPECT_FALSE(s.terms[1].per_gravity);

@@ -6,6 +6,14 @@
 
 #include "engine/system/law_registry.h"
 #include "engine/core/error.h"
+#include "engine/core/registry.h"
+#include "engine/integrate/integrators.h"
+#include "engine/system/force_loop.h"
+#include "engine/contact/hertz_chrono.h"
+#include "engine/contact/hooke_pkdgrav.h"
+#include "engine/rolling/rolling_none.h"
+#include "engine/rolling/rolling_sunday.h"
+#include "engine/rolling/rolling_zhang.h"
 #include "engine/scenario/paper_params.h"
 #include "engine/system/system.h"
 
@@ -46,6 +54,37 @@ TEST(Registry, UnknownRollingModelAndIntegrator) {
   cfg = chrono_table1_config();
   cfg.integrator = "rk4";
   EXPECT_NE(init_error(cfg).find("valid integrators: semi_implicit_euler"), std::string::npos);
+}
+
+// Every table is looked up the same way (engine/core/registry.h): the row, or one message shape.
+TEST(Registry, EveryTableIsLookedUpTheSameWay) {
+  struct Row {
+    const char* name;
+    int value;
+  };
+  const std::vector<Row> rows{{"a", 1}, {"b", 2}};
+  EXPECT_EQ(find_row(rows, "b", "thing").value, 2);
+  EXPECT_EQ(find_row_or_null(rows, "c"), nullptr);
+  try {
+    (void)find_row(rows, "c", "thing", "; or d");
+    ADD_FAILURE() << "an unknown name was found";
+  } catch (const ConfigError& e) {
+    EXPECT_STREQ(e.what(), "unknown thing 'c'; valid things: a, b; or d");
+  }
+  EXPECT_EQ(&find_row(integrator_table(), "leapfrog_kdk", "integrator"), &integrator_table()[1]);
+}
+
+// The (law, rolling) table hands out the force loop of that very pair, for every pair.
+TEST(Registry, EachLawAndRollingModelSelectsItsOwnForceLoop) {
+  EXPECT_EQ(select_force_function("hertz", "none"), (&force_loop<HertzChrono, RollingNone>));
+  EXPECT_EQ(select_force_function("hertz", "sunday"), (&force_loop<HertzChrono, RollingSunday>));
+  EXPECT_EQ(select_force_function("hertz", "zhang"), (&force_loop<HertzChrono, RollingZhang>));
+  EXPECT_EQ(select_force_function("hooke", "none"), (&force_loop<HookePkdgrav, RollingNone>));
+  EXPECT_EQ(select_force_function("hooke", "sunday"), (&force_loop<HookePkdgrav, RollingSunday>));
+  EXPECT_EQ(select_force_function("hooke", "zhang"), (&force_loop<HookePkdgrav, RollingZhang>));
+  EXPECT_TRUE(uses_frame_history("hooke", "none"));
+  EXPECT_TRUE(uses_frame_history("hertz", "zhang"));
+  EXPECT_FALSE(uses_frame_history("hertz", "sunday"));
 }
 
 TEST(Validation, PoissonRatioOutsideRange) {

@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "engine/core/registry.h"
+
 #include "results/model/generated.h"
 #include "results/model/term.h"
 
@@ -15,16 +17,10 @@ const std::vector<TermInfo>& term_registry() {
 }
 
 const TermInfo& find_term(const std::string& name) {
-  std::string known;
-  for (const auto& t : term_registry()) {
-    if (t.name == name) return t;
-    known += (known.empty() ? "" : ", ") + t.name;
-  }
+  if (const TermInfo* t = find_row_or_null(term_registry(), name)) return *t;
   if (const TermInfo* g = generated_term(name)) return *g;
-  throw std::invalid_argument(
-      fmt::format("unknown model term '{}' (known: {}; or a generated form such as z^1*v^1, exp(-z/0.01), "
-                  "(1-exp(-z/0.01)), v^2*exp(-z/0.02))",
-                  name, known));
+  throw unknown_name(term_registry(), name, "model term",
+                     "; or a generated form such as z^1*v^1, exp(-z/0.01), (1-exp(-z/0.01)), v^2*exp(-z/0.02)");
 }
 
 }  // namespace gravsweep::results
