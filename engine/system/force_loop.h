@@ -147,7 +147,7 @@ GRAVSWEEP_INLINE void visit_touching(const Particles& p, ContactHistory* hist, s
 /// distance test (whether a listed pair touches is a coin toss at rest, about 60 % of the listed
 /// pairs), then the visits in list order. Otherwise one pass with a branch per listed pair.
 /// Always inlined: called through a lambda, the batch state of the caller would otherwise be read
-/// through references on every pair (+10 % on the 1 g drop, measured).
+/// through references on every pair (slower on the 1 g drop, measured: BENCHMARKS.md).
 template <bool kFilter, class Visit>
 GRAVSWEEP_INLINE void for_each_touching_pair(ForceContext& c, std::size_t row_begin, std::size_t row_end,
                                              OverlapFailure& worst, Visit&& visit) {
@@ -198,7 +198,7 @@ GRAVSWEEP_INLINE void for_each_touching_pair(ForceContext& c, std::size_t row_be
 
 /// True when this thread's rows hold at least c.filter_min_pairs listed pairs: its pair loop
 /// then filters (for_each_touching_pair<true>). Each way is its own instantiation of the pair
-/// loop: with both inlined into one function the branch-per-pair way ran 4-8 % slower on the
+/// loop: with both inlined into one function the branch-per-pair way ran slower on the
 /// paper's bed (BENCHMARKS.md).
 inline bool filter_pairs(const ForceContext& c, const ThreadRows& rows) {
   const std::uint32_t* off = c.nlist.offset.data();
@@ -424,7 +424,7 @@ void force_loop(ForceContext& c) {
     // Thread 0 accumulates straight into the particles' force and torque arrays (one buffer pair
     // per extra thread; the sum below keeps the order gravity + thread 0 + thread 1 + ...), and
     // clears them whole; thread t >= 1 clears its buffers from its first row on (zeroing them as
-    // the sum reads them instead measured +8 %, BENCHMARKS.md).
+    // the sum reads them instead was slower, BENCHMARKS.md).
     // Nothing reads force_N / torque_N_m between here and the sum.
     Vec3* F = t == 0 ? p.force_N.data() : c.thread_force[t].data();
     Vec3* T = t == 0 ? p.torque_N_m.data() : c.thread_torque[t].data();
