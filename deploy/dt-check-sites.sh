@@ -17,7 +17,7 @@
 # already finished (WORK/<run>/metrics.json) are kept: the script resumes where it stopped.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-work="${1:?usage: dt-check-sites.sh WORK LEVEL SITES [N] [CAP]}"
+work="${1:?usage: dt-check-sites.sh WORK LEVEL SITES [N] [CAP] [CONTROL_DT]}"
 g="${2:?level (m/s2)}"
 sites="${3:?number of sites}"
 n="${4:-20}"
@@ -41,13 +41,13 @@ run() {  # run NAME SPEC
   else
     "$gs" run "$s" --out "$work/$name" --threads 2 --snapshot-interval 0 --quiet >"$work/$name.log" 2>&1 ||
       { tail -3 "$work/$name.log" >&2; exit 1; }
-    cp "$work/$name/bed.h5" "$bed"
+    cp "$work/$name/bed.h5" "$bed.tmp" && cp "$work/$name/bed.h5.sha256" "$bed.sha256" && mv "$bed.tmp" "$bed"
   fi
 }
 
 for site in $(seq 1 "$sites"); do
   fixed="$work/fixed_g${g}_s$site.json"
-  fast="$work/fast_g${g}_n${n}_s$site.json"
+  fast="$work/fast_g${g}_n${n}_cap${cap}_s$site.json"
   ctl="$work/control_g${g}_dt${control}_s$site.json"
   "$py" - "$spec" "$site" "$n" "$cap" "$fixed" "$fast" "$control" "$ctl" <<'PY'
 import json, sys
@@ -63,18 +63,18 @@ s["time_step"] = {"steps_per_contact": float(sys.argv[3]), "dt_max_s": float(sys
 json.dump(s, open(sys.argv[6], "w"), indent=1)
 PY
   run "fixed_g${g}_s$site" "$fixed"
-  run "fast_g${g}_n${n}_s$site" "$fast"
+  run "fast_g${g}_n${n}_cap${cap}_s$site" "$fast"
   [ -z "$control" ] || run "control_g${g}_dt${control}_s$site" "$ctl"
 done
 
 echo "dt check over $sites sites at g = $g m/s2, N = $n, cap $cap s; load average $(cut -d' ' -f1-3 /proc/loadavg)"
-"$py" - "$work" "$g" "$sites" "$n" "$control" <<'PY'
+"$py" - "$work" "$g" "$sites" "$n" "$control" "$cap" <<'PY'
 import json, math, sys
-work, g, sites, n, control = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4], sys.argv[5]
+work, g, sites, n, control, cap = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4], sys.argv[5], sys.argv[6]
 rows, controls = [], []
 for s in range(1, sites + 1):
     f = json.load(open(f"{work}/fixed_g{g}_s{s}/metrics.json"))
-    a = json.load(open(f"{work}/fast_g{g}_n{n}_s{s}/metrics.json"))
+    a = json.load(open(f"{work}/fast_g{g}_n{n}_cap{cap}_s{s}/metrics.json"))
     rows.append((s, f, a))
     if control:
         controls.append((s, f, json.load(open(f"{work}/control_g{g}_dt{control}_s{s}/metrics.json"))))

@@ -2,7 +2,7 @@
 // models, integrators, job kinds, model terms). A table is a std::vector (or a std::deque) of
 // rows built in one place; find_row returns the row of a name, or throws a ConfigError that says
 // what was asked for and lists the valid names:
-//   unknown contact law 'hooke'; valid contact laws: hertz, hooke_pkdgrav
+//   unknown contact law 'hertzz'; valid contact laws: hertz, hooke
 // Adding a physics term or a kind is one row in its table (see the table's header).
 #pragma once
 #include <fmt/format.h>

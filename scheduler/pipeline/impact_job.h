@@ -46,7 +46,8 @@ struct DropJobResult {
 BedJobResult run_bed_job(const nlohmann::json& scenario, const std::filesystem::path& bed_out, int threads,
                          const Progress& progress, const std::atomic<bool>* stop);
 
-/// Loads the bed (its bed_key must equal bed_key(scenario)), drops the projectile, writes the trace
+/// Validates `scenario` unless this build validated it at submit (job_scenario), loads the bed (its
+/// key must equal the validated scenario's, bed_key_of_validated), drops the projectile, writes the trace
 /// (HDF5, temporary name then rename) and returns the metrics: the paper's vc, apeak, zstop, tstop,
 /// rebound, plus wall time. A collision the metrics cannot resolve (e.g. no contact before the time
 /// cap) is not an error: the metrics carry "metrics_error" with the reason, and null values.

@@ -18,7 +18,7 @@ sweep::PointCheckFn impact_point_check() {
   return [](const nlohmann::json& scenario) {
     nlohmann::json validated = validate_scenario(scenario);
     nlohmann::json key = bed_key_of_validated(validated);
-    return sweep::CheckedPoint{stored_scenario(std::move(validated)).dump(), std::move(key)};
+    return sweep::CheckedPoint{stored_scenario(std::move(validated), scenario).dump(), std::move(key)};
   };
 }
 

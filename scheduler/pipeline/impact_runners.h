@@ -7,7 +7,8 @@
 
 namespace gravsweep::pipeline {
 
-/// Drops with equal keys share a bed (pipeline::bed_key).
+/// Validates a sweep point once, at submit: the text its jobs store (stored_scenario: validated,
+/// marked, with the point as written) and its bed key (drops with equal keys share a bed).
 sweep::PointCheckFn impact_point_check();
 /// Adds the "bed" and "drop" runners.
 void add_impact_runners(queue::RunnerTable& table);

@@ -11,6 +11,7 @@
 #include <mutex>
 #include <random>
 #include <sstream>
+#include <string_view>
 
 #include "engine/system/law_registry.h"
 #include "engine/integrate/integrators.h"
@@ -391,19 +392,28 @@ const std::string& validated_by() {
   return mark;
 }
 
-json stored_scenario(json validated) {
+bool validation_is_named() {
+  const std::string_view v = build_version();
+  constexpr std::string_view kDirty = "-dirty", kUnknown = "+unknown";
+  const bool dirty = v.size() >= kDirty.size() && v.substr(v.size() - kDirty.size()) == kDirty;
+  return !dirty && v.find(kUnknown) == std::string_view::npos;
+}
+
+json stored_scenario(json validated, json as_written) {
   validated[kValidatedByKey] = validated_by();
+  validated[kAsWrittenKey] = std::move(as_written);
   return validated;
 }
 
 json job_scenario(const json& stored) {
-  if (stored.is_object() && stored.contains(kValidatedByKey)) {
+  if (!stored.is_object() || !stored.contains(kValidatedByKey)) return validate_scenario(stored);
+  if (stored.at(kValidatedByKey) == validated_by() && validation_is_named()) {
     json s = stored;
-    const bool mine = s[kValidatedByKey] == validated_by();
     s.erase(kValidatedByKey);
-    return mine ? s : validate_scenario(s);
+    s.erase(kAsWrittenKey);
+    return s;
   }
-  return validate_scenario(stored);
+  return validate_scenario(stored.at(kAsWrittenKey));
 }
 
 json load_scenario(const std::filesystem::path& path) {

@@ -23,17 +23,25 @@ using spec::SpecProblem;
 /// expected; a rule that needs a field already found bad is skipped rather than reported twice.
 nlohmann::json validate_scenario(const nlohmann::json& scenario, const std::string& source = "scenario");
 
-/// The key under which a job's stored scenario names the validation it passed: the build and the
-/// scenario schema's SHA-256 (validated_by()).
+/// The keys under which a job's stored scenario names the validation it passed (the build and the
+/// scenario schema's SHA-256, validated_by()) and keeps the point as the sweep wrote it.
 inline constexpr const char* kValidatedByKey = "$validated_by";
+inline constexpr const char* kAsWrittenKey = "$as_written";
 /// This build's validation: "<build version> schema:<first 12 hex of the schema's SHA-256>".
 const std::string& validated_by();
+/// False when validated_by() does not name one build's rules: a build with uncommitted changes
+/// ("-dirty") or outside a git checkout ("+unknown"), which other such builds share. Its marks are
+/// never trusted: its workers validate every job again.
+bool validation_is_named();
 /// A validated scenario as a queue job stores it (sweep expansion at submit): marked with
-/// validated_by(), so that a worker of the same build reads it without validating it again.
-nlohmann::json stored_scenario(nlohmann::json validated);
-/// The validated scenario of a job (what validate_scenario returns, without the mark): the stored
-/// one as it is when this build validated it at submit, else validated now (a job submitted by
-/// another build, or before scenarios were stored validated). Throws as validate_scenario.
+/// validated_by(), so that a worker of the same build reads it without validating it again, and
+/// carrying the point as written, which another build validates with its own rules and defaults.
+nlohmann::json stored_scenario(nlohmann::json validated, nlohmann::json as_written);
+/// The validated scenario of a job (what validate_scenario returns, without the keys above): the
+/// stored one as it is when this build validated it at submit (and validation_is_named()), else
+/// the point as written validated now (a job submitted by another build), or the stored text
+/// itself validated now (unmarked: a job submitted before scenarios were stored validated).
+/// Throws as validate_scenario.
 nlohmann::json job_scenario(const nlohmann::json& stored);
 
 /// How many times validation has run the engine's own checks (each builds an engine System four

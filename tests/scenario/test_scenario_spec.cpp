@@ -335,22 +335,34 @@ TEST(ScenarioSpec, AnAdaptiveStepsCapBelowTheFixedStepIsRefusedAtValidation) {
 }
 
 // A sweep point is validated once, at submit: its jobs store the validated scenario marked with
-// this build's validation, and the worker's job_scenario takes it as it is. A scenario marked by
-// another build (or not marked: jobs of older campaigns) is validated again.
+// this build's validation and the point as written, and the worker's job_scenario takes the
+// validated one as it is. A job marked by another build is validated again from the point as
+// written (that build's own rules and defaults); an unmarked one (older campaigns) is the point.
 TEST(ScenarioSpec, AScenarioThisBuildValidatedAtSubmitIsNotValidatedAgainByTheWorker) {
-  const json validated = validate_scenario(minimal());
-  const json stored = pipeline::stored_scenario(validated);
+  const json written = minimal();
+  const json validated = validate_scenario(written);
+  const json stored = pipeline::stored_scenario(validated, written);
   EXPECT_EQ(stored.at(pipeline::kValidatedByKey), pipeline::validated_by());
-  EXPECT_EQ(pipeline::job_scenario(stored), validated);  // the mark removed, nothing else changed
-  // The mark is trusted: a value broken after submit is not looked at again...
+  EXPECT_EQ(stored.at(pipeline::kAsWrittenKey), written);
+  EXPECT_EQ(pipeline::job_scenario(stored), validated);  // the two keys removed, nothing else changed
+  // The mark is trusted when it names one build's rules: a stored value broken after submit is not
+  // looked at again. A build with uncommitted changes trusts no mark (others share its name).
   json broken = stored;
   broken["dt_s"] = -1;
-  EXPECT_NO_THROW((void)pipeline::job_scenario(broken));
-  // ...unless another build (another schema or other checks) marked it, or nobody did.
+  if (pipeline::validation_is_named())
+    EXPECT_EQ(pipeline::job_scenario(broken).at("dt_s"), -1);
+  else
+    EXPECT_EQ(pipeline::job_scenario(broken), validated);
+  // Another build's mark: the point as written is validated, not the stored defaults.
   broken[pipeline::kValidatedByKey] = "0.0.0+another schema:000000000000";
+  EXPECT_EQ(pipeline::job_scenario(broken), validated);
+  broken[pipeline::kAsWrittenKey]["dt_s"] = -1;
   EXPECT_THROW((void)pipeline::job_scenario(broken), SpecError);
-  broken.erase(pipeline::kValidatedByKey);
-  EXPECT_THROW((void)pipeline::job_scenario(broken), SpecError);
+  // Unmarked: the stored text is the point as written.
+  EXPECT_EQ(pipeline::job_scenario(written), validated);
+  json bad = written;
+  bad["dt_s"] = -1;
+  EXPECT_THROW((void)pipeline::job_scenario(bad), SpecError);
 }
 
 }  // namespace gravsweep

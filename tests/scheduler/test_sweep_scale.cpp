@@ -49,6 +49,7 @@ TEST(SweepScale, EngineChecksRunOncePerDistinctSetupNotPerPoint) {
     const json stored = json::parse(job.scenario_json);
     EXPECT_EQ(stored.at(pipeline::kValidatedByKey), pipeline::validated_by());
     EXPECT_TRUE(stored.contains("at_rest")) << "a default the base does not write";
+    EXPECT_FALSE(stored.at(pipeline::kAsWrittenKey).contains("at_rest")) << "the point as written";
   }
 }
 
