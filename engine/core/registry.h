@@ -10,18 +10,27 @@
 #include <iterator>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "engine/core/error.h"
 
 namespace gravsweep {
 
+/// The names of a table's rows, in table order.
+template <class Rows>
+std::vector<std::string> row_name_list(const Rows& rows) {
+  std::vector<std::string> out;
+  for (const auto& row : rows) out.emplace_back(row.name);
+  return out;
+}
+
 /// The names of a table's rows, in table order, joined by ", ".
 template <class Rows>
 std::string row_names(const Rows& rows) {
   std::string out;
-  for (const auto& row : rows) {
+  for (const auto& name : row_name_list(rows)) {
     if (!out.empty()) out += ", ";
-    out += std::string_view(row.name);
+    out += name;
   }
   return out;
 }

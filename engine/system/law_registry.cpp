@@ -78,13 +78,6 @@ const LawRow& law(std::string_view name) { return find_row(law_rows(), name, "co
 const RollingRow& rolling(std::string_view name) { return find_row(rolling_rows(), name, "rolling model"); }
 
 template <class Rows>
-std::vector<std::string> names_of(const Rows& rows) {
-  std::vector<std::string> out;
-  for (const auto& row : rows) out.emplace_back(row.name);
-  return out;
-}
-
-template <class Rows>
 std::string description_of(const Rows& rows, const std::string& name) {
   const auto* row = find_row_or_null(rows, name);
   return row ? row->description : "";
@@ -92,8 +85,8 @@ std::string description_of(const Rows& rows, const std::string& name) {
 
 }  // namespace
 
-std::vector<std::string> contact_law_names() { return names_of(law_rows()); }
-std::vector<std::string> rolling_model_names() { return names_of(rolling_rows()); }
+std::vector<std::string> contact_law_names() { return row_name_list(law_rows()); }
+std::vector<std::string> rolling_model_names() { return row_name_list(rolling_rows()); }
 std::string contact_law_description(const std::string& n) { return description_of(law_rows(), n); }
 std::string rolling_model_description(const std::string& n) { return description_of(rolling_rows(), n); }
 
@@ -104,9 +97,7 @@ ForceFunction select_force_function(std::string_view law_name, std::string_view 
 }
 
 bool uses_frame_history(std::string_view law_name, std::string_view rolling_name) {
-  const auto* l = find_row_or_null(law_rows(), law_name);
-  const auto* r = find_row_or_null(rolling_rows(), rolling_name);
-  return (l && l->uses_frame_history) || (r && r->uses_frame_history);
+  return law(law_name).uses_frame_history || rolling(rolling_name).uses_frame_history;
 }
 
 void prepare_contact_law(std::string_view law_name, PairTable& pairs) { pairs.for_each(law(law_name).prepare); }

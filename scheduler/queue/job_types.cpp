@@ -68,13 +68,11 @@ const JobKindInfo& kind_info(JobKind k) {
 
 JobKind parse_kind(std::string_view name) {
   KindTable& t = kind_table();
-  std::size_t index = 0;
-  {
-    const std::lock_guard lock(t.mutex);
-    const JobKindInfo& row = find_row(t.rows, name, "job kind");
-    while (&t.rows[index] != &row) ++index;
-  }
-  return registered_kinds().at(index);
+  const std::lock_guard lock(t.mutex);
+  const JobKindInfo& row = find_row(t.rows, name, "job kind");
+  std::size_t index = 0;  // the rows are a deque (stable addresses, not contiguous): walk to the row
+  while (&t.rows[index] != &row) ++index;
+  return JobKind(index);
 }
 
 std::vector<std::string> kind_folders() {

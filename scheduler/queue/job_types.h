@@ -41,6 +41,7 @@ class JobKind {
   std::size_t index_ = 0;
   friend JobKind register_kind(JobKindInfo info);
   friend std::vector<JobKind> registered_kinds();
+  friend JobKind parse_kind(std::string_view name);
 };
 
 /// Adds a kind to the table (before any campaign is opened: its name enters the schema's check of
