@@ -6,6 +6,7 @@
 // Adding a physics term or a kind is one row in its table (see the table's header).
 #pragma once
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <iterator>
 #include <string>
@@ -27,12 +28,7 @@ std::vector<std::string> row_name_list(const Rows& rows) {
 /// The names of a table's rows, in table order, joined by ", ".
 template <class Rows>
 std::string row_names(const Rows& rows) {
-  std::string out;
-  for (const auto& name : row_name_list(rows)) {
-    if (!out.empty()) out += ", ";
-    out += name;
-  }
-  return out;
+  return fmt::format("{}", fmt::join(row_name_list(rows), ", "));
 }
 
 /// The row named `name`, or nullptr.

@@ -48,13 +48,6 @@ struct ExportOptions {
   bool allow_dirty = false;
 };
 
-/// A build from a source tree with uncommitted changes (`git describe --dirty`, build_version.h).
-bool is_dirty_build(const std::string& code_version) {
-  static const std::string kDirty = "-dirty";
-  return code_version.size() >= kDirty.size() &&
-         code_version.compare(code_version.size() - kDirty.size(), kDirty.size(), kDirty) == 0;
-}
-
 /// Drops per code version, refusing (UsageError) a dataset with drops from a dirty build unless
 /// --allow-dirty: a dataset must name the commits that made it.
 std::map<std::string, int> check_provenance(const std::vector<std::string>& versions, const ExportOptions& o) {
@@ -63,7 +56,7 @@ std::map<std::string, int> check_provenance(const std::vector<std::string>& vers
   std::vector<std::string> dirty;
   int n_dirty = 0;
   for (const auto& [v, n] : count)
-    if (is_dirty_build(v)) dirty.push_back(fmt::format("{} ({} drops)", v, n)), n_dirty += n;
+    if (pipeline::is_dirty_build(v)) dirty.push_back(fmt::format("{} ({} drops)", v, n)), n_dirty += n;
   if (!dirty.empty() && !o.allow_dirty)
     throw UsageError(fmt::format(
         "{}: {} of {} drops come from builds with uncommitted changes: {}. A dataset must name the commit that "

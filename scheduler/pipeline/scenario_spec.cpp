@@ -393,10 +393,9 @@ const std::string& validated_by() {
 }
 
 bool validation_is_named() {
-  const std::string_view v = build_version();
-  constexpr std::string_view kDirty = "-dirty", kUnknown = "+unknown";
-  const bool dirty = v.size() >= kDirty.size() && v.substr(v.size() - kDirty.size()) == kDirty;
-  return !dirty && v.find(kUnknown) == std::string_view::npos;
+  static const bool named =
+      !is_dirty_build(build_version()) && std::string_view(build_version()).find("+unknown") == std::string_view::npos;
+  return named;
 }
 
 json stored_scenario(json validated, json as_written) {
