@@ -39,8 +39,9 @@ bool validation_is_named();
 nlohmann::json stored_scenario(nlohmann::json validated, nlohmann::json as_written);
 /// The validated scenario of a job (what validate_scenario returns, without the keys above): the
 /// stored one as it is when this build validated it at submit (and validation_is_named()), else
-/// the point as written validated now (a job submitted by another build), or the stored text
-/// itself validated now (unmarked: a job submitted before scenarios were stored validated).
+/// the point as written validated now (a job submitted by another build; one that stored no point
+/// as written has its validated scenario validated again), or the stored text itself validated
+/// now (unmarked: a job submitted before scenarios were stored validated).
 /// Throws as validate_scenario.
 nlohmann::json job_scenario(const nlohmann::json& stored);
 

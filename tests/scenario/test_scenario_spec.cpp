@@ -358,6 +358,15 @@ TEST(ScenarioSpec, AScenarioThisBuildValidatedAtSubmitIsNotValidatedAgainByTheWo
   EXPECT_EQ(pipeline::job_scenario(broken), validated);
   broken[pipeline::kAsWrittenKey]["dt_s"] = -1;
   EXPECT_THROW((void)pipeline::job_scenario(broken), SpecError);
+  // Another build's mark without a point as written (builds that stored only the mark): the stored
+  // scenario is validated again, without the mark; a bad stored value is a SpecError, not a
+  // missing-key error.
+  json mark_only = stored;
+  mark_only[pipeline::kValidatedByKey] = "0.0.0+another schema:000000000000";
+  mark_only.erase(pipeline::kAsWrittenKey);
+  EXPECT_EQ(pipeline::job_scenario(mark_only), validated);
+  mark_only["dt_s"] = -1;
+  EXPECT_THROW((void)pipeline::job_scenario(mark_only), SpecError);
   // Unmarked: the stored text is the point as written.
   EXPECT_EQ(pipeline::job_scenario(written), validated);
   json bad = written;
