@@ -15,7 +15,8 @@
 # a window ran. 2 threads, no snapshots. Run it on an otherwise idle machine: the CPU model and
 # the load average are printed with the results. AT_REST=loose sets /at_rest's fractions to 1 (a
 # bed whose surface still creeps faster than 1 % of the impact speed is timed instead of refused;
-# said in the header).
+# said in the header). SPEED_BOUND=normal_approach gives this build's adaptive step the bound of
+# the pairs present (/time_step/speed_bound) instead of twice the fastest particle's speed.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 usage="usage: deploy/bench-gravity.sh MAIN_GRAVSWEEP [ROUNDS] [LEVELS]"
@@ -33,7 +34,8 @@ declare -A bed_of=(
   [9.81]=dc58dbbe94582f715e03 [0.1]=efa0c202f64195f5cfd0
   [0.01]=645e11a65ceca9f4ea8a [0.001]=c52dc258847a1e220cd0)
 # The adaptive step of the low-gravity sweep specs, used by this build at every level.
-adaptive='{"steps_per_contact": 20, "dt_max_s": 5e-05}'
+# SPEED_BOUND=normal_approach adds /time_step/speed_bound (said in the header).
+adaptive='{"steps_per_contact": 20, "dt_max_s": 5e-05'"${SPEED_BOUND:+, \"speed_bound\": \"$SPEED_BOUND\"}"'}'
 
 # spec LEVEL KIND OUT: the level's sweep base at FR; KIND main drops /time_step and cuts the drop.
 make_spec() {
@@ -74,7 +76,7 @@ PY
 }
 
 echo "host: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores; load average $(cut -d' ' -f1-3 /proc/loadavg)"
-echo "this: $("$this" --version)  main: $("$main_bin" --version)  Fr = $froude${AT_REST:+  /at_rest $AT_REST}"
+echo "this: $("$this" --version)  main: $("$main_bin" --version)  Fr = $froude${AT_REST:+  /at_rest $AT_REST}  /time_step $adaptive"
 for r in $(seq 1 "$rounds"); do
   for level in $levels; do
     bed="$root/data/gravity_sweep/beds/${bed_of[$level]}.h5"

@@ -12,6 +12,10 @@
 #
 #   deploy/dt-check-sites.sh WORK LEVEL SITES [N] [CAP] [CONTROL_DT]
 #   deploy/dt-check-sites.sh runs/dt-sites 0.01 8 20 5e-5 4.5e-6
+#   SPEED_BOUND=normal_approach deploy/dt-check-sites.sh runs/dt-sites 0.01 16 20 5e-5
+#
+# SPEED_BOUND sets /time_step/speed_bound of the adaptive runs (absent: the scenario's default,
+# twice the fastest particle's speed); their folders are named with it.
 #
 # The bed is prepared by the first run (or taken from WORK/bed_gLEVEL.h5 when it exists). Runs
 # already finished (WORK/<run>/metrics.json) are kept: the script resumes where it stopped.
@@ -23,6 +27,8 @@ sites="${3:?number of sites}"
 n="${4:-20}"
 cap="${5:-5e-5}"
 control="${6:-}"
+bound="${SPEED_BOUND:-}"
+tag="n${n}_cap${cap}${bound:+_$bound}"
 gs="${GRAVSWEEP:-$root/build/scheduler/gravsweep}"
 py=/usr/bin/python3
 [ -x "$gs" ] || { "$root/deploy/install-deps.sh" && "$root/deploy/build.sh"; }
@@ -47,9 +53,9 @@ run() {  # run NAME SPEC
 
 for site in $(seq 1 "$sites"); do
   fixed="$work/fixed_g${g}_s$site.json"
-  fast="$work/fast_g${g}_n${n}_cap${cap}_s$site.json"
+  fast="$work/fast_g${g}_${tag}_s$site.json"
   ctl="$work/control_g${g}_dt${control}_s$site.json"
-  "$py" - "$spec" "$site" "$n" "$cap" "$fixed" "$fast" "$control" "$ctl" <<'PY'
+  "$py" - "$spec" "$site" "$n" "$cap" "$fixed" "$fast" "$control" "$ctl" "$bound" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))
 s.pop("$schema", None)
@@ -60,21 +66,23 @@ if sys.argv[7]:
     c["dt_s"] = float(sys.argv[7])
     json.dump(c, open(sys.argv[8], "w"), indent=1)
 s["time_step"] = {"steps_per_contact": float(sys.argv[3]), "dt_max_s": float(sys.argv[4])}
+if sys.argv[9]:
+    s["time_step"]["speed_bound"] = sys.argv[9]
 json.dump(s, open(sys.argv[6], "w"), indent=1)
 PY
   run "fixed_g${g}_s$site" "$fixed"
-  run "fast_g${g}_n${n}_cap${cap}_s$site" "$fast"
+  run "fast_g${g}_${tag}_s$site" "$fast"
   [ -z "$control" ] || run "control_g${g}_dt${control}_s$site" "$ctl"
 done
 
-echo "dt check over $sites sites at g = $g m/s2, N = $n, cap $cap s; load average $(cut -d' ' -f1-3 /proc/loadavg)"
-"$py" - "$work" "$g" "$sites" "$n" "$control" "$cap" <<'PY'
+echo "dt check over $sites sites at g = $g m/s2, N = $n, cap $cap s${bound:+, speed bound $bound}; load average $(cut -d' ' -f1-3 /proc/loadavg)"
+"$py" - "$work" "$g" "$sites" "$tag" "$control" <<'PY'
 import json, math, sys
-work, g, sites, n, control, cap = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4], sys.argv[5], sys.argv[6]
+work, g, sites, tag, control = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4], sys.argv[5]
 rows, controls = [], []
 for s in range(1, sites + 1):
     f = json.load(open(f"{work}/fixed_g{g}_s{s}/metrics.json"))
-    a = json.load(open(f"{work}/fast_g{g}_n{n}_cap{cap}_s{s}/metrics.json"))
+    a = json.load(open(f"{work}/fast_g{g}_{tag}_s{s}/metrics.json"))
     rows.append((s, f, a))
     if control:
         controls.append((s, f, json.load(open(f"{work}/control_g{g}_dt{control}_s{s}/metrics.json"))))

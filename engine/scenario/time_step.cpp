@@ -18,12 +18,23 @@ constexpr double kWholeStepSlack = 1e-9;
 
 long long choose_step(System& sys, const AdaptiveStep& rule, double fixed_dt_s, double interval_s) {
   if (!rule.on()) throw std::logic_error("choose_step: the adaptive step is off");
-  const double v_rel_m_s = 2 * sys.max_particle_speed_m_s();
+  const double v_rel_m_s = rule.speed_bound == AdaptiveStep::SpeedBound::normal_approach
+                               ? sys.max_approach_speed_m_s(interval_s)
+                               : 2 * sys.max_particle_speed_m_s();
   const double target =
       std::clamp(sys.shortest_contact_time_s(v_rel_m_s) / rule.steps_per_contact, fixed_dt_s, rule.dt_max_s);
   const auto steps = std::max<long long>(1, static_cast<long long>(std::ceil(interval_s / target - kWholeStepSlack)));
   sys.set_dt_s(interval_s / static_cast<double>(steps));
   return steps;
+}
+
+AdaptiveStep::SpeedBound speed_bound_named(std::string_view name) {
+  if (name == "fastest_particle") return AdaptiveStep::SpeedBound::fastest_particle;
+  if (name == "normal_approach") return AdaptiveStep::SpeedBound::normal_approach;
+  throw ConfigError(
+      fmt::format("time_step.speed_bound: unknown value \"{}\" (expected one of: fastest_particle, "
+                  "normal_approach)",
+                  name));
 }
 
 void check_adaptive_step(const AdaptiveStep& rule, double fixed_dt_s, const char* what) {

@@ -4,13 +4,17 @@
 // low-gravity run resolves its contacts with fewer steps.
 #pragma once
 
+#include <string_view>
+
 #include "engine/system/system.h"
 
 namespace gravsweep {
 
 /// Before each interval (of the order of a millisecond: a trace sample, a quench, a settling
-/// check) the step target is the shortest contact time of the pairs present at twice the fastest
-/// particle's speed (a bound of any relative normal speed over so short an interval) divided by
+/// check) the step target is the shortest contact time of the pairs present at the speed bound
+/// (twice the fastest particle's speed, a bound of any relative normal speed over so short an
+/// interval; or the largest normal approach speed of the pairs that can touch within it,
+/// System::max_approach_speed_m_s, which a grain's sideways motion does not raise) divided by
 /// steps_per_contact, clamped between the run's fixed step (the validated one) and dt_max_s; the
 /// interval is then filled with the fewest whole steps no longer than the target (so a step may
 /// come out a little below the fixed one; samples and checks stay on their grid). The step depends only on the state,
@@ -18,10 +22,20 @@ namespace gravsweep {
 /// speed does not see: dt_max_s bounds the step for them (5e-5 s: more than 10 steps per period of a grain under 20
 /// layers of grains at 9.81 m/s2, more at lower gravity, where overlaps scale as (m g)^(2/3)).
 struct AdaptiveStep {
+  /// The relative normal speed at which the contact time is taken.
+  enum class SpeedBound {
+    fastest_particle,  ///< twice the fastest particle's speed (any pair's relative speed)
+    normal_approach,   ///< System::max_approach_speed_m_s: the pairs present, each along its normal
+  };
   double steps_per_contact = 0;  ///< 0: off (the fixed step throughout)
   double dt_max_s = 0;           ///< cap on the step (must be >= the fixed step when on)
+  SpeedBound speed_bound = SpeedBound::fastest_particle;
   [[nodiscard]] bool on() const { return steps_per_contact > 0; }
 };
+
+/// The speed bound named `name` in a scenario (/time_step/speed_bound: "fastest_particle" or
+/// "normal_approach"); anything else is a ConfigError listing both.
+AdaptiveStep::SpeedBound speed_bound_named(std::string_view name);
 
 /// Sets sys's step for the next interval_s by the rule (which must be on) and returns the number
 /// of steps that fill it.

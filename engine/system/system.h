@@ -104,6 +104,14 @@ class System {
   [[nodiscard]] double shortest_contact_time_s(double v_rel_m_s);
   /// Fastest particle speed (walls do not move).
   [[nodiscard]] double max_particle_speed_m_s() const;
+  /// A bound of the relative normal speed (m/s) of every pair that can touch within the next
+  /// interval_s, from the contacts actually present: the largest approach speed -(v_j - v_i) . n
+  /// over the listed pairs (|(v_j - v_i) . n| for a pair that touches), and the speed of each
+  /// particle within reach of a wall. Only listed pairs can touch before the list is rebuilt; when
+  /// a rebuild could come within the interval (the largest displacement since the last build plus
+  /// twice the fastest speed times interval_s reaches half the skin), or no list is built, it is
+  /// twice the fastest particle's speed instead (max_particle_speed_m_s).
+  [[nodiscard]] double max_approach_speed_m_s(double interval_s) const;
   [[nodiscard]] const StepStats& stats() const { return stats_; }
   [[nodiscard]] const PairTable& pair_table() const { return pairs_; }
   [[nodiscard]] const VerletList& neighbor_list() const { return nlist_; }

@@ -519,6 +519,9 @@ ScenarioParams scenario_params(const json& s) {
   if (s.contains("time_step")) {  // dt_max_s >= dt_s: check_size_and_steps
     out.time_step.steps_per_contact = s["/time_step/steps_per_contact"_json_pointer];
     out.time_step.dt_max_s = s["/time_step/dt_max_s"_json_pointer];
+    // Optional and without a default, so that the job ids of existing sweeps stay.
+    out.time_step.speed_bound =
+        speed_bound_named(s["/time_step"_json_pointer].value("speed_bound", "fastest_particle"));
   }
   out.at_rest.surface_speed_fraction = s["/at_rest/surface_speed_fraction"_json_pointer];
   out.at_rest.rms_speed_fraction = s["/at_rest/rms_speed_fraction"_json_pointer];

@@ -165,7 +165,9 @@ TEST(Reproduction, EquationFourAtLowGravityFollowsTheFittedF0) {
   for (const auto& row : csv_rows("results_part2_chrono_lowg.csv")) {
     const double vc = std::stod(row.at("vc_m_s")), tstop = std::stod(row.at("tstop_s"));
     EXPECT_LT(eq4_s(vc, kTable3F0_N, kTable3InvD1_1_m), 0.15 * tstop) << "Table 3's f0 under-predicts, vc " << vc;
-    if (vc >= 0.2) EXPECT_GT(eq4_s(vc, f0_N, inv_d1_1_m), 1.3 * tstop) << "the traces' f0 over-predicts, vc " << vc;
+    if (vc >= 0.2) {
+      EXPECT_GT(eq4_s(vc, f0_N, inv_d1_1_m), 1.3 * tstop) << "the traces' f0 over-predicts, vc " << vc;
+    }
   }
 }
 

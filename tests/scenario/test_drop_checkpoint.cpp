@@ -137,6 +137,25 @@ TEST_F(DropCheckpoint, AtTheAdaptiveStepTheResumedTraceIsTheUninterruptedOne) {
   EXPECT_NO_FATAL_FAILURE(expect_same_trace(dir_->path / "adaptive_reference.h5", dir_->path / "adaptive_resumed.h5"));
 }
 
+// The same with the normal-approach bound (/time_step/speed_bound): the bound reads the neighbour
+// list and its positions at the last build, both in the checkpoint, so the resumed drop takes the
+// same steps.
+TEST_F(DropCheckpoint, AtTheNormalApproachStepTheResumedTraceIsTheUninterruptedOne) {
+  scenario_["time_step"] = {{"steps_per_contact", 10}, {"dt_max_s", 4e-5}, {"speed_bound", "normal_approach"}};
+  json uninterrupted;
+  ASSERT_TRUE(attempt(dir_->path / "approach_reference.h5", 2.0, &uninterrupted));
+  const json fixed = json::parse(results::read_trace(reference()).metrics_json);
+  EXPECT_LT(uninterrupted["steps"].get<long>(), fixed["steps"].get<long>() * 3 / 4)
+      << "the adaptive step never grew past the fixed step: this test would not test it";
+  ASSERT_NO_FATAL_FAILURE(interrupted_once(0.04));
+  EXPECT_FALSE(attempt(dir_->path / "never.h5", 0.12));
+  json m;
+  ASSERT_TRUE(attempt(dir_->path / "approach_resumed.h5", 2.0, &m));
+  EXPECT_TRUE(warnings_.empty()) << warnings_.front();
+  EXPECT_EQ(m["checkpoint_resumes"], 2);
+  EXPECT_NO_FATAL_FAILURE(expect_same_trace(dir_->path / "approach_reference.h5", dir_->path / "approach_resumed.h5"));
+}
+
 // The file holds the drop exactly: every array and counter read back equals what was written.
 TEST_F(DropCheckpoint, FileRoundTripIsExact) {
   ASSERT_NO_FATAL_FAILURE(interrupted_once());

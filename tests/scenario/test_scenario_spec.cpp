@@ -334,6 +334,23 @@ TEST(ScenarioSpec, AnAdaptiveStepsCapBelowTheFixedStepIsRefusedAtValidation) {
   EXPECT_NO_THROW(validate_scenario(s));
 }
 
+// /time_step/speed_bound is optional and has no default: absent, the validated scenario holds none
+// (so the job ids of existing sweeps stay) and the drop takes twice the fastest particle's speed;
+// named, the drop takes that bound; an unknown name is refused at its pointer.
+TEST(ScenarioSpec, TheAdaptiveStepsSpeedBoundIsOptionalAndNamed) {
+  json s = minimal();
+  s["time_step"] = {{"steps_per_contact", 20}, {"dt_max_s", 5e-5}};
+  const json plain = validate_scenario(s);
+  EXPECT_FALSE(plain["time_step"].contains("speed_bound")) << plain["time_step"];
+  EXPECT_EQ(pipeline::scenario_params(plain).time_step.speed_bound, AdaptiveStep::SpeedBound::fastest_particle);
+  s["time_step"]["speed_bound"] = "normal_approach";
+  EXPECT_EQ(pipeline::scenario_params(validate_scenario(s)).time_step.speed_bound,
+            AdaptiveStep::SpeedBound::normal_approach);
+  s["time_step"]["speed_bound"] = "fastest";
+  const std::string msg = refused_at(s, "/time_step/speed_bound");
+  EXPECT_NE(msg.find("normal_approach"), std::string::npos) << msg;
+}
+
 // A sweep point is validated once, at submit: its jobs store the validated scenario marked with
 // this build's validation and the point as written, and the worker's job_scenario takes the
 // validated one as it is. A job marked by another build is validated again from the point as
