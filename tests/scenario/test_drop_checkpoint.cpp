@@ -76,6 +76,10 @@ class DropCheckpoint : public ::testing::Test {
     ASSERT_TRUE(fs::exists(ckpt_));
     ASSERT_FALSE(fs::exists(dir_->path / "never.h5"));
   }
+  /// The drop at the adaptive step `time_step` (/time_step), uninterrupted and interrupted twice,
+  /// its traces NAME_reference.h5 and NAME_resumed.h5 compared value for value; the step must
+  /// really grow (fewer steps than the fixed step), or the test would not test it.
+  void resumes_as_uninterrupted(const json& time_step, const std::string& name);
 };
 test::TempDir* DropCheckpoint::dir_ = nullptr;
 
@@ -95,6 +99,23 @@ void expect_same_trace(const fs::path& a_path, const fs::path& b_path) {
   const json ma = json::parse(a.metrics_json), mb = json::parse(b.metrics_json);
   for (const char* k : {"zstop_m", "tstop_s", "vc_m_s", "apeak_m_s2", "steps", "first_contact_s", "rest_time_s"})
     EXPECT_EQ(ma.at(k), mb.at(k)) << k;
+}
+
+void DropCheckpoint::resumes_as_uninterrupted(const json& time_step, const std::string& name) {
+  scenario_["time_step"] = time_step;
+  const fs::path reference_trace = dir_->path / (name + "_reference.h5"), resumed = dir_->path / (name + "_resumed.h5");
+  json uninterrupted;
+  ASSERT_TRUE(attempt(reference_trace, 2.0, &uninterrupted));
+  const json fixed = json::parse(results::read_trace(reference()).metrics_json);
+  EXPECT_LT(uninterrupted["steps"].get<long>(), fixed["steps"].get<long>() * 3 / 4)
+      << "the adaptive step never grew past the fixed step: this test would not test it";
+  ASSERT_NO_FATAL_FAILURE(interrupted_once(0.04));
+  EXPECT_FALSE(attempt(dir_->path / "never.h5", 0.12));
+  json m;
+  ASSERT_TRUE(attempt(resumed, 2.0, &m));
+  EXPECT_TRUE(warnings_.empty()) << warnings_.front();
+  EXPECT_EQ(m["checkpoint_resumes"], 2);
+  EXPECT_NO_FATAL_FAILURE(expect_same_trace(reference_trace, resumed));
 }
 
 // Three interruptions (stop requests at 3 %, 8 % and 13 % of the time cap: 9, 24 and 39 ms, during
@@ -122,38 +143,15 @@ TEST_F(DropCheckpoint, ResumedThreeTimesTheTraceIsTheUninterruptedOne) {
 // again before each sample interval from the state, so a drop resumed at a sample continues with
 // the step an uninterrupted one takes there. The step must really grow: fewer steps than fixed.
 TEST_F(DropCheckpoint, AtTheAdaptiveStepTheResumedTraceIsTheUninterruptedOne) {
-  scenario_["time_step"] = {{"steps_per_contact", 10}, {"dt_max_s", 4e-5}};
-  json uninterrupted;
-  ASSERT_TRUE(attempt(dir_->path / "adaptive_reference.h5", 2.0, &uninterrupted));
-  const json fixed = json::parse(results::read_trace(reference()).metrics_json);
-  EXPECT_LT(uninterrupted["steps"].get<long>(), fixed["steps"].get<long>() * 3 / 4)
-      << "the adaptive step never grew past the fixed step: this test would not test it";
-  ASSERT_NO_FATAL_FAILURE(interrupted_once(0.04));
-  EXPECT_FALSE(attempt(dir_->path / "never.h5", 0.12));
-  json m;
-  ASSERT_TRUE(attempt(dir_->path / "adaptive_resumed.h5", 2.0, &m));
-  EXPECT_TRUE(warnings_.empty()) << warnings_.front();
-  EXPECT_EQ(m["checkpoint_resumes"], 2);
-  EXPECT_NO_FATAL_FAILURE(expect_same_trace(dir_->path / "adaptive_reference.h5", dir_->path / "adaptive_resumed.h5"));
+  resumes_as_uninterrupted({{"steps_per_contact", 10}, {"dt_max_s", 4e-5}}, "adaptive");
 }
 
 // The same with the normal-approach bound (/time_step/speed_bound): the bound reads the neighbour
 // list and its positions at the last build, both in the checkpoint, so the resumed drop takes the
 // same steps.
 TEST_F(DropCheckpoint, AtTheNormalApproachStepTheResumedTraceIsTheUninterruptedOne) {
-  scenario_["time_step"] = {{"steps_per_contact", 10}, {"dt_max_s", 4e-5}, {"speed_bound", "normal_approach"}};
-  json uninterrupted;
-  ASSERT_TRUE(attempt(dir_->path / "approach_reference.h5", 2.0, &uninterrupted));
-  const json fixed = json::parse(results::read_trace(reference()).metrics_json);
-  EXPECT_LT(uninterrupted["steps"].get<long>(), fixed["steps"].get<long>() * 3 / 4)
-      << "the adaptive step never grew past the fixed step: this test would not test it";
-  ASSERT_NO_FATAL_FAILURE(interrupted_once(0.04));
-  EXPECT_FALSE(attempt(dir_->path / "never.h5", 0.12));
-  json m;
-  ASSERT_TRUE(attempt(dir_->path / "approach_resumed.h5", 2.0, &m));
-  EXPECT_TRUE(warnings_.empty()) << warnings_.front();
-  EXPECT_EQ(m["checkpoint_resumes"], 2);
-  EXPECT_NO_FATAL_FAILURE(expect_same_trace(dir_->path / "approach_reference.h5", dir_->path / "approach_resumed.h5"));
+  resumes_as_uninterrupted({{"steps_per_contact", 10}, {"dt_max_s", 4e-5}, {"speed_bound", "normal_approach"}},
+                           "approach");
 }
 
 // The file holds the drop exactly: every array and counter read back equals what was written.
