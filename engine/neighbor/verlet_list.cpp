@@ -263,16 +263,16 @@ void VerletList::extend(std::size_t n_total) {
   position_at_build_.resize(n_total, Vec3::Constant(std::numeric_limits<double>::quiet_NaN()));
 }
 
-bool VerletList::needs_rebuild(const Particles& p) const {
+bool VerletList::needs_rebuild(const Particles& p) const { return max_displacement2_m2(p) > 0.25 * skin_m_ * skin_m_; }
+
+double VerletList::max_displacement2_m2(const Particles& p) const {
   const std::size_t n = p.size();
-  if (position_at_build_.size() != n || offset.size() != n + 1) return true;
-  const double limit2 = 0.25 * skin_m_ * skin_m_;
-  int rebuild = 0;
-#pragma omp parallel for schedule(static) reduction(| : rebuild)
-  for (std::size_t i = 0; i < n; ++i) {
-    if ((p.position_m[i] - position_at_build_[i]).squaredNorm() > limit2) rebuild = 1;
-  }
-  return rebuild != 0;
+  if (position_at_build_.size() != n || offset.size() != n + 1) return kInf;
+  double moved2_m2 = 0;  // a NaN displacement is not a maximum (as a comparison with it is false)
+#pragma omp parallel for schedule(static) reduction(max : moved2_m2)
+  for (std::size_t i = 0; i < n; ++i)
+    moved2_m2 = std::max(moved2_m2, (p.position_m[i] - position_at_build_[i]).squaredNorm());
+  return moved2_m2;
 }
 
 void VerletList::build(const Particles& p, double skin_m, int threads) {

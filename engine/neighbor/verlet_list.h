@@ -44,6 +44,9 @@ class VerletList {
 
   /// True when some particle moved more than skin/2 since the last build (or nothing is built).
   [[nodiscard]] bool needs_rebuild(const Particles& p) const;
+  /// The square of the largest displacement of a particle since the last build (m^2); infinite
+  /// when nothing is built for these particles. needs_rebuild() is this beyond (skin/2)^2.
+  [[nodiscard]] double max_displacement2_m2(const Particles& p) const;
 
   [[nodiscard]] std::size_t pairs() const { return neighbor.size(); }
   [[nodiscard]] long long builds() const { return builds_; }

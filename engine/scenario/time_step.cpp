@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "engine/core/error.h"
+#include "engine/core/registry.h"
 
 namespace gravsweep {
 
@@ -28,13 +29,20 @@ long long choose_step(System& sys, const AdaptiveStep& rule, double fixed_dt_s, 
   return steps;
 }
 
+namespace {
+struct SpeedBoundRow {
+  const char* name;
+  AdaptiveStep::SpeedBound bound;
+};
+/// The speed bounds by name (/time_step/speed_bound).
+constexpr SpeedBoundRow kSpeedBoundRows[] = {
+    {"fastest_particle", AdaptiveStep::SpeedBound::fastest_particle},
+    {"normal_approach", AdaptiveStep::SpeedBound::normal_approach},
+};
+}  // namespace
+
 AdaptiveStep::SpeedBound speed_bound_named(std::string_view name) {
-  if (name == "fastest_particle") return AdaptiveStep::SpeedBound::fastest_particle;
-  if (name == "normal_approach") return AdaptiveStep::SpeedBound::normal_approach;
-  throw ConfigError(
-      fmt::format("time_step.speed_bound: unknown value \"{}\" (expected one of: fastest_particle, "
-                  "normal_approach)",
-                  name));
+  return find_row(kSpeedBoundRows, name, "time step speed bound").bound;
 }
 
 void check_adaptive_step(const AdaptiveStep& rule, double fixed_dt_s, const char* what) {

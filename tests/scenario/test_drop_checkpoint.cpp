@@ -76,10 +76,14 @@ class DropCheckpoint : public ::testing::Test {
     ASSERT_TRUE(fs::exists(ckpt_));
     ASSERT_FALSE(fs::exists(dir_->path / "never.h5"));
   }
-  /// The drop at the adaptive step `time_step` (/time_step), uninterrupted and interrupted twice,
-  /// its traces NAME_reference.h5 and NAME_resumed.h5 compared value for value; the step must
-  /// really grow (fewer steps than the fixed step), or the test would not test it.
-  void resumes_as_uninterrupted(const json& time_step, const std::string& name);
+  /// The drop at the adaptive step `time_step` (/time_step), run uninterrupted (NAME_reference.h5)
+  /// and interrupted twice then resumed (NAME_resumed.h5); the test compares them.
+  struct AdaptiveRuns {
+    long uninterrupted_steps = 0, fixed_steps = 0;  ///< fixed: the same drop at the fixed step
+    json resumed;                                   ///< the resumed drop's metrics
+    fs::path reference, resumed_trace;
+  };
+  AdaptiveRuns run_adaptive_interrupted(const json& time_step, const std::string& name);
 };
 test::TempDir* DropCheckpoint::dir_ = nullptr;
 
@@ -101,21 +105,20 @@ void expect_same_trace(const fs::path& a_path, const fs::path& b_path) {
     EXPECT_EQ(ma.at(k), mb.at(k)) << k;
 }
 
-void DropCheckpoint::resumes_as_uninterrupted(const json& time_step, const std::string& name) {
+DropCheckpoint::AdaptiveRuns DropCheckpoint::run_adaptive_interrupted(const json& time_step, const std::string& name) {
   scenario_["time_step"] = time_step;
-  const fs::path reference_trace = dir_->path / (name + "_reference.h5"), resumed = dir_->path / (name + "_resumed.h5");
+  AdaptiveRuns r;
+  r.reference = dir_->path / (name + "_reference.h5");
+  r.resumed_trace = dir_->path / (name + "_resumed.h5");
   json uninterrupted;
-  ASSERT_TRUE(attempt(reference_trace, 2.0, &uninterrupted));
-  const json fixed = json::parse(results::read_trace(reference()).metrics_json);
-  EXPECT_LT(uninterrupted["steps"].get<long>(), fixed["steps"].get<long>() * 3 / 4)
-      << "the adaptive step never grew past the fixed step: this test would not test it";
-  ASSERT_NO_FATAL_FAILURE(interrupted_once(0.04));
+  EXPECT_TRUE(attempt(r.reference, 2.0, &uninterrupted));
+  r.uninterrupted_steps = uninterrupted.value("steps", 0L);
+  r.fixed_steps = json::parse(results::read_trace(reference()).metrics_json)["steps"].get<long>();
+  interrupted_once(0.04);
   EXPECT_FALSE(attempt(dir_->path / "never.h5", 0.12));
-  json m;
-  ASSERT_TRUE(attempt(resumed, 2.0, &m));
+  EXPECT_TRUE(attempt(r.resumed_trace, 2.0, &r.resumed));
   EXPECT_TRUE(warnings_.empty()) << warnings_.front();
-  EXPECT_EQ(m["checkpoint_resumes"], 2);
-  EXPECT_NO_FATAL_FAILURE(expect_same_trace(reference_trace, resumed));
+  return r;
 }
 
 // Three interruptions (stop requests at 3 %, 8 % and 13 % of the time cap: 9, 24 and 39 ms, during
@@ -143,15 +146,23 @@ TEST_F(DropCheckpoint, ResumedThreeTimesTheTraceIsTheUninterruptedOne) {
 // again before each sample interval from the state, so a drop resumed at a sample continues with
 // the step an uninterrupted one takes there. The step must really grow: fewer steps than fixed.
 TEST_F(DropCheckpoint, AtTheAdaptiveStepTheResumedTraceIsTheUninterruptedOne) {
-  resumes_as_uninterrupted({{"steps_per_contact", 10}, {"dt_max_s", 4e-5}}, "adaptive");
+  const AdaptiveRuns r = run_adaptive_interrupted({{"steps_per_contact", 10}, {"dt_max_s", 4e-5}}, "adaptive");
+  EXPECT_LT(r.uninterrupted_steps, r.fixed_steps * 3 / 4)
+      << "the adaptive step never grew past the fixed step: this test would not test it";
+  EXPECT_EQ(r.resumed["checkpoint_resumes"], 2);
+  EXPECT_NO_FATAL_FAILURE(expect_same_trace(r.reference, r.resumed_trace));
 }
 
 // The same with the normal-approach bound (/time_step/speed_bound): the bound reads the neighbour
 // list and its positions at the last build, both in the checkpoint, so the resumed drop takes the
 // same steps.
 TEST_F(DropCheckpoint, AtTheNormalApproachStepTheResumedTraceIsTheUninterruptedOne) {
-  resumes_as_uninterrupted({{"steps_per_contact", 10}, {"dt_max_s", 4e-5}, {"speed_bound", "normal_approach"}},
-                           "approach");
+  const AdaptiveRuns r = run_adaptive_interrupted(
+      {{"steps_per_contact", 10}, {"dt_max_s", 4e-5}, {"speed_bound", "normal_approach"}}, "approach");
+  EXPECT_LT(r.uninterrupted_steps, r.fixed_steps * 3 / 4)
+      << "the adaptive step never grew past the fixed step: this test would not test it";
+  EXPECT_EQ(r.resumed["checkpoint_resumes"], 2);
+  EXPECT_NO_FATAL_FAILURE(expect_same_trace(r.reference, r.resumed_trace));
 }
 
 // The file holds the drop exactly: every array and counter read back equals what was written.
