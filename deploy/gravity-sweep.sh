@@ -8,18 +8,22 @@
 #   deploy/gravity-sweep.sh export   finished levels -> data/gravity_sweep/ (measurement format, 2 kHz)
 #
 # Environment: GRAVSWEEP_CAMPAIGN (default runs/gravity_sweep/sweep.db), GRAVSWEEP_BIN (default
-# build/scheduler/gravsweep), WORKERS (1), THREADS (2).
+# build/scheduler/gravsweep), WORKERS (1), THREADS (2), SPECS (the folder of level specs, default
+# examples/gravity_sweep; examples/gravity_sweep/extend holds the design's extensions: Fr 2-3 at
+# 9.81 m/s2 with their dt check, a second bed and a deeper, wider bed at 0.01 m/s2; run them in a
+# campaign of their own).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 gs="${GRAVSWEEP_BIN:-$root/build/scheduler/gravsweep}"
 db="${GRAVSWEEP_CAMPAIGN:-$root/runs/gravity_sweep/sweep.db}"
 data="$root/data/gravity_sweep"
+specs="${SPECS:-$root/examples/gravity_sweep}"
 [ -x "$gs" ] || { "$root/deploy/install-deps.sh" && "$root/deploy/build.sh"; }
 
 case "${1:-}" in
   run)
     mkdir -p "$(dirname "$db")" "$data/beds"
-    for spec in "$root"/examples/gravity_sweep/g*.json; do "$gs" submit "$spec" --db "$db"; done
+    for spec in "$specs"/g*.json; do "$gs" submit "$spec" --db "$db"; done
     "$gs" resume --db "$db"
     # Beds are kept in data/gravity_sweep/beds/ (commit them: a fresh machine skips their preparation).
     exec nice -n 10 "$gs" work --db "$db" --workers "${WORKERS:-1}" --threads "${THREADS:-2}" --lease 300 \
@@ -30,7 +34,7 @@ case "${1:-}" in
     ;;
   export)
     # One measurement campaign per level with finished drops, and one result table of all levels.
-    for spec in "$root"/examples/gravity_sweep/g*.json; do
+    for spec in "$specs"/g*.json; do
       sweep=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["sweep"])' "$spec")
       dir="$data/${sweep#gravity_sweep_}"
       rm -rf "$dir.tmp"
