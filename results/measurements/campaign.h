@@ -45,6 +45,18 @@ struct Campaign {
 /// source, the fit window, a clipped record (mark_clipping). Throws std::invalid_argument with the reason.
 void process_trial(MeasuredTrial& t);
 
+/// Processing a verb imposes on every trial it reads (Trial::time_scale, Trial::end_rule; empty:
+/// each trial's own), for a sensitivity of a result to the processing.
+struct ProcessingChoice {
+  std::string time_scale, end_rule;
+  [[nodiscard]] bool any() const { return !time_scale.empty() || !end_rule.empty(); }
+};
+/// Gives the trial the choice (the fields it names).
+void apply_choice(Trial& t, const ProcessingChoice& p);
+/// Gives every trial the choice and processes it again (from its raw trace); a trial that cannot
+/// be processed so moves to the issues as unmeasurable, with the reason.
+void reprocess_campaign(Campaign& c, const ProcessingChoice& p);
+
 /// A saturated accelerometer's flat top: the longest run of consecutive raw samples at the
 /// record's largest value (within kClipRelTolerance of it, as a sensor at full scale writes one
 /// value), [begin, end), when it is at least kClipMinSamples long and above rest. A real peak with
@@ -75,7 +87,7 @@ std::string clip_summary(const MeasuredTrial& t);
 /// Reads and processes a lab campaign folder. Throws std::runtime_error only when trials.csv itself
 /// cannot be read or lacks a required column; row- and trace-level problems become issues.
 /// `cutoff_hz` is the filter of trials whose row does not set filter_cutoff_hz.
-Campaign load_campaign(const std::string& directory, double cutoff_hz = 500.0);
+Campaign load_campaign(const std::string& directory, double cutoff_hz = 500.0, const ProcessingChoice& processing = {});
 
 /// A DEM trace (trace.h5) and what names it.
 struct DemTraceRef {
@@ -90,7 +102,8 @@ MeasuredTrial read_dem_trial(const DemTraceRef& ref);
 MeasuredTrial dem_trial_of(const TraceData& trace, const DemTraceRef& ref);
 /// Reads and processes DEM traces; unreadable or unmeasurable ones (no contact before the time
 /// cap, a rebound) become issues naming the trace, the job and the reason.
-Campaign load_dem_campaign(const std::string& label, const std::vector<DemTraceRef>& refs);
+Campaign load_dem_campaign(const std::string& label, const std::vector<DemTraceRef>& refs,
+                           const ProcessingChoice& processing = {});
 
 /// Stores the campaign in the database (tables trials and trial_metrics; samples stored once per
 /// content: traces + trace_samples for the raw record, processed_traces + processed_samples for

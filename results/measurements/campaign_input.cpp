@@ -75,14 +75,16 @@ void filter_trials(const std::string& path, CampaignInput& in, const std::vector
   in.filtered_out = before - trials.size();
 }
 
-CampaignInput load_trial_input(const std::string& path, const std::vector<std::string>& where, double cutoff_hz) {
+CampaignInput load_trial_input(const std::string& path, const std::vector<std::string>& where, double cutoff_hz,
+                               const ProcessingChoice& processing) {
   CampaignInput in;
   if (fs::is_directory(path)) {
     in.kind = kLabFolderKind;
-    in.campaign = load_campaign(path, cutoff_hz);
+    in.campaign = load_campaign(path, cutoff_hz, processing);
   } else if (fs::is_regular_file(path)) {
     in.kind = kImportedFileKind;
     in.campaign = read_imported_file(path);
+    if (processing.any()) reprocess_campaign(in.campaign, processing);
   } else {
     throw std::runtime_error(fmt::format("{}: no such file or folder: {}", path, kExpectedInput));
   }

@@ -45,13 +45,15 @@ MeasuredTrial dem_trial_of(const TraceData& d, const DemTraceRef& ref) {
   return t;
 }
 
-Campaign load_dem_campaign(const std::string& label, const std::vector<DemTraceRef>& refs) {
+Campaign load_dem_campaign(const std::string& label, const std::vector<DemTraceRef>& refs,
+                           const ProcessingChoice& processing) {
   Campaign c;
   c.directory = label;
   for (const auto& r : refs) {
     const std::string who = r.job_id.empty() ? "" : fmt::format(" (drop job {})", r.job_id);
     try {
       MeasuredTrial t = read_dem_trial(r);
+      apply_choice(t.info, processing);
       process_trial(t);
       if (t.processed.metrics.rebound)
         throw std::invalid_argument("not measurable: rebound (" + t.processed.metrics.note + ")");

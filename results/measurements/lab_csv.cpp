@@ -254,7 +254,7 @@ MeasuredTrial read_row(const fs::path& dir, const std::map<std::string, int>& co
 
 }  // namespace
 
-Campaign load_campaign(const std::string& directory, double cutoff_hz) {
+Campaign load_campaign(const std::string& directory, double cutoff_hz, const ProcessingChoice& processing) {
   Campaign c;
   c.directory = directory;
   const fs::path dir(directory);
@@ -306,6 +306,7 @@ Campaign load_campaign(const std::string& directory, double cutoff_hz) {
       if (!ids.insert(t.info.trial_id).second)
         throw ParseError{{"trials.csv", ln, col.at("trial_id") + 1,
                           fmt::format("column 'trial_id': '{}' appears twice", t.info.trial_id)}};
+      apply_choice(t.info, processing);
       try {
         process_trial(t);
       } catch (const TraceError& e) {

@@ -26,6 +26,8 @@ const std::vector<TrialField>& trial_fields() {
       {"filter_cutoff_hz", nullptr, "Hz", false, &Trial::filter_cutoff_hz, nullptr},
       {"end_threshold_g", nullptr, "1", false, &Trial::end_threshold_g, nullptr},
       {"end_speed_fraction", nullptr, "1", false, &Trial::end_speed_fraction, nullptr},
+      {"time_scale", nullptr, "", false, nullptr, &Trial::time_scale},
+      {"end_rule", nullptr, "", false, nullptr, &Trial::end_rule},
       {"clipped_at_m_s2", nullptr, "m/s2", false, &Trial::clipped_at_m_s2, nullptr},
       {"clipped_samples", nullptr, "1", false, &Trial::clipped_samples, nullptr},
       {"clip_depth_error_m", nullptr, "m", false, &Trial::clip_depth_error_m, nullptr},
@@ -120,10 +122,28 @@ void from_json(const nlohmann::json& j, Trial& t) {
     t.attributes = j.at("attributes").get<std::map<std::string, std::string>>();
 }
 
+double froude_time_factor(double gravity_m_s2, double projectile_diameter_m) {
+  if (!(gravity_m_s2 > 0) || !(projectile_diameter_m > 0)) return 1.0;
+  const double f =
+      std::sqrt((gravity_m_s2 / projectile_diameter_m) / (kPaperGravity_m_s2 / kPaperProjectileDiameter_m));
+  return std::abs(f - 1.0) < 1e-12 ? 1.0 : f;  // the paper's drop exactly as the paper processes it
+}
+
+TimeScale time_scale_for(const Trial& t) {
+  if (!t.time_scale.empty()) return time_scale_of(t.time_scale);
+  return t.source == TraceSource::dem ? TimeScale::froude : TimeScale::fixed;
+}
+
 MetricOptions metric_options(const Trial& t) {
   MetricOptions o;
   o.gravity_m_s2 = t.gravity_m_s2;
   o.cutoff_hz = t.filter_cutoff_hz;
+  o.end_rule = end_rule_of(t.end_rule);
+  if (time_scale_for(t) == TimeScale::froude) {
+    const double f = froude_time_factor(t.gravity_m_s2, t.projectile_diameter_m);
+    o.cutoff_hz *= f;
+    o.end_hold_s /= f;
+  }
   o.end_threshold_g = t.end_threshold_g;
   o.end_speed_fraction = t.end_speed_fraction;
   o.impact_speed_m_s = t.impact_speed_m_s;

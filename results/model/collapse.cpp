@@ -9,6 +9,7 @@
 #include <map>
 
 #include "results/measurements/trial.h"
+#include "results/model/stats.h"
 
 namespace gravsweep::results {
 
@@ -77,6 +78,69 @@ double overlap_rms(const LevelCurve& a, const LevelCurve& b, double& weight) {
   return s2 / kGrid;
 }
 
+/// The design's Froude number of each point: clusters of ln Fr closer than kSameFroudeLn, over
+/// all levels (repeats differ by their measured impact speeds).
+std::vector<int> froude_groups(const std::vector<Point>& pts) {
+  std::vector<std::size_t> order(pts.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return pts[a].x < pts[b].x; });
+  std::vector<int> group(pts.size(), 0);
+  int g = -1;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    if (k == 0 || pts[order[k]].x - pts[order[k - 1]].x > kSameFroudeLn) ++g;
+    group[order[k]] = g;
+  }
+  return group;
+}
+
+/// The nested analysis of variance of CollapseRow (level within Froude number, repeats within cell).
+void level_effect(const std::vector<Point>& pts, CollapseRow& r) {
+  const std::vector<int> group = froude_groups(pts);
+  // cells[(group, level)] -> the points' y
+  std::map<std::pair<int, double>, std::vector<double>> cells;
+  for (std::size_t i = 0; i < pts.size(); ++i) cells[{group[i], pts[i].level_m_s2}].push_back(pts[i].y);
+  std::map<int, int> levels_at;
+  for (const auto& [key, ys] : cells) ++levels_at[key.first];
+  double ss_within = 0, ss_between = 0, n_sum = 0;
+  int df_within = 0, df_between = 0, n_cells = 0;
+  std::map<int, std::pair<double, double>> group_sum;  // group -> (sum y, n), shared Froude numbers only
+  for (const auto& [key, ys] : cells) {
+    double mean = 0;
+    for (double y : ys) mean += y;
+    mean /= static_cast<double>(ys.size());
+    for (double y : ys) ss_within += (y - mean) * (y - mean);
+    df_within += static_cast<int>(ys.size()) - 1;
+    if (levels_at[key.first] < 2) continue;
+    group_sum[key.first].first += mean * static_cast<double>(ys.size());
+    group_sum[key.first].second += static_cast<double>(ys.size());
+  }
+  for (const auto& [key, ys] : cells) {
+    if (levels_at[key.first] < 2) continue;
+    double mean = 0;
+    for (double y : ys) mean += y;
+    mean /= static_cast<double>(ys.size());
+    const double g_mean = group_sum[key.first].first / group_sum[key.first].second;
+    ss_between += static_cast<double>(ys.size()) * (mean - g_mean) * (mean - g_mean);
+    n_sum += static_cast<double>(ys.size());
+    ++n_cells;
+  }
+  for (const auto& [g, n] : levels_at)
+    if (n >= 2) df_between += n - 1;
+  r.cells = n_cells;
+  r.level_df = df_between;
+  r.repeat_df = df_within;
+  if (df_between < 1 || df_within < 1) {
+    r.level_scatter_pct = r.repeat_scatter_pct = r.level_f = r.level_p = kNaN;
+    return;
+  }
+  const double ms_between = ss_between / df_between, ms_within = ss_within / df_within;
+  const double n_per_cell = n_sum / n_cells;
+  r.repeat_scatter_pct = pct(std::sqrt(ms_within));
+  r.level_scatter_pct = pct(std::sqrt(std::max(0.0, (ms_between - ms_within) / n_per_cell)));
+  r.level_f = ms_within > 0 ? ms_between / ms_within : kNaN;
+  r.level_p = f_upper_p(r.level_f, df_between, df_within);
+}
+
 CollapseRow collapse_of(const std::string& metric, const std::vector<Point>& pts) {
   CollapseRow r;
   r.metric = metric;
@@ -86,6 +150,7 @@ CollapseRow collapse_of(const std::string& metric, const std::vector<Point>& pts
   r.levels = static_cast<int>(by_level.size());
   if (pts.size() < 3) {
     r.common_scatter_pct = r.within_scatter_pct = r.between_levels_pct = r.collapse_ratio = kNaN;
+    r.level_scatter_pct = r.repeat_scatter_pct = r.level_f = r.level_p = kNaN;
     return r;
   }
   const Eigen::VectorXd common = poly_fit(pts, std::min(kCollapseDegree, distinct_x(pts) - 1));
@@ -120,6 +185,7 @@ CollapseRow collapse_of(const std::string& metric, const std::vector<Point>& pts
   r.within_scatter_pct = pct(s_within);
   r.between_levels_pct = pairs > 0 ? pct(std::sqrt(between / pairs)) : kNaN;
   r.collapse_ratio = s_within > 0 ? s_common / s_within : kNaN;
+  level_effect(pts, r);
   return r;
 }
 

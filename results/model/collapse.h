@@ -34,8 +34,19 @@ struct CollapseRow {
   /// common / within scatter (in ln units): 1 for a perfect collapse, larger when the levels
   /// lie apart.
   double collapse_ratio = 0;
+  /// The level effect at equal Fr, by a nested analysis of variance of ln(metric) over the cells
+  /// (Froude number of the design, level): repeats within a cell give the repeat variance, the cells'
+  /// means about their Froude number's mean the level variance. Only Froude numbers run at two or
+  /// more levels count. NaN where there are no such cells or no repeats.
+  int cells = 0;                    ///< (Fr, level) cells at Froude numbers shared by two or more levels
+  double level_scatter_pct = 0;     ///< the level's variance component, exp(sigma_L) - 1
+  double repeat_scatter_pct = 0;    ///< the repeats' scatter within a cell, exp(sigma_r) - 1
+  double level_f = 0, level_p = 0;  ///< F = MS_levels / MS_repeats and its upper-tail p
+  int level_df = 0, repeat_df = 0;  ///< their degrees of freedom
 };
 inline constexpr int kCollapseDegree = 2;
+/// Below this p the levels differ at equal Fr: the metric does not collapse.
+inline constexpr double kLevelEffectP = 0.01;
 std::vector<CollapseRow> collapse(const Campaign& c);
 
 }  // namespace gravsweep::results

@@ -122,6 +122,60 @@ std::pair<double, double> prediction_sd_pct(const FittedModel& law, const Trial&
           100 * std::sqrt(std::max(0.0, dt.dot(law.cov * dt))) / p.tstop_s};
 }
 
+/// Impact Froude numbers closer than this in ln Fr (5 %) are one speed of the design.
+constexpr double kSameFroudeLn = 0.05;
+
+/// The held-out drops grouped by the design's Froude number, with their signed mean errors.
+std::vector<LevelOutFroude> by_froude(const std::vector<LevelOutTrial>& per_trial) {
+  std::vector<const LevelOutTrial*> sorted;
+  for (const auto& t : per_trial)
+    if (std::isfinite(t.impact_froude)) sorted.push_back(&t);
+  std::sort(sorted.begin(), sorted.end(),
+            [](const LevelOutTrial* a, const LevelOutTrial* b) { return a->impact_froude < b->impact_froude; });
+  std::vector<LevelOutFroude> out;
+  std::vector<std::vector<const LevelOutTrial*>> groups;
+  for (std::size_t k = 0; k < sorted.size(); ++k) {
+    if (k == 0 || std::log(sorted[k]->impact_froude / sorted[k - 1]->impact_froude) > kSameFroudeLn)
+      groups.emplace_back();
+    groups.back().push_back(sorted[k]);
+  }
+  for (const auto& grp : groups) {
+    LevelOutFroude f;
+    f.drops = static_cast<int>(grp.size());
+    double fr = 0, z = 0, t = 0;
+    int nz = 0, nt = 0;
+    for (const auto* p : grp) {
+      fr += p->impact_froude;
+      if (std::isfinite(p->zstop_err_pct)) {
+        z += p->zstop_err_pct, ++nz;
+        f.zstop_min_err_pct =
+            std::isfinite(f.zstop_min_err_pct) ? std::min(f.zstop_min_err_pct, p->zstop_err_pct) : p->zstop_err_pct;
+        f.zstop_max_err_pct =
+            std::isfinite(f.zstop_max_err_pct) ? std::max(f.zstop_max_err_pct, p->zstop_err_pct) : p->zstop_err_pct;
+      }
+      if (std::isfinite(p->tstop_err_pct)) t += p->tstop_err_pct, ++nt;
+    }
+    f.froude = fr / static_cast<double>(grp.size());
+    if (nz) f.zstop_mean_err_pct = z / nz;
+    if (nt) f.tstop_mean_err_pct = t / nt;
+    f.misses = std::abs(f.zstop_mean_err_pct) > kLevelOutZstopTargetPct ||
+               std::abs(f.tstop_mean_err_pct) > kLevelOutTstopTargetPct;
+    out.push_back(f);
+  }
+  return out;
+}
+
+/// "; but Fr 10 misses (zstop -22.1 %, tstop +3.0 % over 2 drops)" for every Froude number whose
+/// signed mean error is beyond a target; "" when none is.
+std::string froude_misses(const LevelOutRow& r) {
+  std::string s;
+  for (const auto& f : r.by_froude)
+    if (f.misses)
+      s += fmt::format("{}Fr {:.2g} (zstop {:+.1f} %, tstop {:+.1f} % over {} drops)", s.empty() ? "" : ", ", f.froude,
+                       f.zstop_mean_err_pct, f.tstop_mean_err_pct, f.drops);
+  return s.empty() ? s : "; beyond a target at " + s;
+}
+
 std::string verdict_of(const LevelOutRow& r) {
   const double z = r.zstop_median_abs_err_pct, t = r.tstop_median_abs_err_pct;
   const std::string range = r.fitted_g_m_s2.size() == 1
@@ -135,11 +189,13 @@ std::string verdict_of(const LevelOutRow& r) {
   if (!(t <= kLevelOutTstopTargetPct))
     misses.push_back(miss_words(r, "tstop", &LevelOutTrial::tstop_err_pct, t, kLevelOutTstopTargetPct));
   if (misses.empty())
-    return where + fmt::format("within the targets (zstop <= {:g} %, tstop <= {:g} %)", kLevelOutZstopTargetPct,
-                               kLevelOutTstopTargetPct);
+    return where +
+           fmt::format("within the targets (zstop <= {:g} %, tstop <= {:g} %)", kLevelOutZstopTargetPct,
+                       kLevelOutTstopTargetPct) +
+           froude_misses(r);
   std::string v = where + "misses the targets: " + misses.front();
   if (misses.size() > 1) v += "; " + misses.back();
-  return v + cause_words(r);
+  return v + cause_words(r) + froude_misses(r);
 }
 
 /// The held-out level g: the law fitted on every other level, each trial at g predicted.
@@ -178,6 +234,7 @@ LevelOutRow hold_out(const ModelSpec& spec, const Campaign& c, double g_m_s2, co
   r.tstop_all_levels_median_abs_err_pct = median_abs(t_all);
   r.zstop_law_sd_pct = median_abs(z_sd);
   r.tstop_law_sd_pct = median_abs(t_sd);
+  r.by_froude = by_froude(r.per_trial);
   r.verdict = verdict_of(r);
   return r;
 }

@@ -57,6 +57,13 @@ FittedModel bed_scattered(const FittedModel& truth_model, const ModelSpec& truth
   return m;
 }
 
+/// How much longer the drop's own times are at gravity g than at 9.81 m/s2 with D = 10 cm
+/// (SynthOptions::froude_times; 1 without).
+double time_factor(const SynthOptions& o, double g_m_s2) {
+  if (!o.froude_times) return 1.0;
+  return std::sqrt((kPaperGravity_m_s2 / kPaperProjectileDiameter_m) / (g_m_s2 / o.diameter_m));
+}
+
 /// The helpers below draw from the campaign's one generator and one normal distribution (which
 /// keeps the second value of each pair it makes), so a seed gives the same campaign as ever.
 
@@ -73,7 +80,8 @@ struct SynthDrop {
 SynthDrop integrate_drop(const FittedModel& m, TermContext c, const SynthOptions& o, double t_first_s,
                          std::mt19937_64& rng, std::normal_distribution<double>& n01) {
   const double g = c.g_m_s2, fs_hz = o.sample_rate_hz, dt = 1.0 / (fs_hz * kSubstepsPerSample);
-  const double ou_a = std::exp(-dt / o.force_fluct_tau_s), ou_b = o.force_fluct * std::sqrt(1 - ou_a * ou_a);
+  const double tf = time_factor(o, g);
+  const double ou_a = std::exp(-dt / (o.force_fluct_tau_s * tf)), ou_b = o.force_fluct * std::sqrt(1 - ou_a * ou_a);
   auto accel_down = [&](double zz, double vv, double tt, double fl) {
     c.z_m = std::max(zz, 0.0);
     c.v_m_s = vv;
@@ -85,7 +93,7 @@ SynthDrop integrate_drop(const FittedModel& m, TermContext c, const SynthOptions
   };
   SynthDrop d;
   double z = 0, v = c.vc_m_s, tc = 0, ou = 0, t_next = t_first_s;
-  while (tc < kMaxCollision_s) {
+  while (tc < kMaxCollision_s * tf) {
     while (tc + dt <= t_next + 1e-15) {  // advance to the next sample
       const double k1v = accel_down(z, v, tc, ou), k1z = v;
       const double k2v = accel_down(z + 0.5 * dt * k1z, v + 0.5 * dt * k1v, tc + 0.5 * dt, ou),
@@ -120,10 +128,13 @@ void write_trace(const std::filesystem::path& path, int first, const std::vector
   std::ofstream tr(path);
   tr << "t_s,accel_m_s2\n";
   const int motion = static_cast<int>(a_up.size());
-  const int total = first + motion + static_cast<int>(std::lround(o.rest_tail_s * o.sample_rate_hz));
+  const int total =
+      first + motion + static_cast<int>(std::lround(o.rest_tail_s * time_factor(o, g) * o.sample_rate_hz));
+  const double chatter_m_s2 = o.contact_chatter_g * g * std::sqrt(time_factor(o, g));
   for (int i = 0; i < total; ++i) {
     double a = i < first ? -g : i < first + motion ? a_up[static_cast<std::size_t>(i - first)] : 0.0;
     a += bias_m_s2 + o.sensor_noise_g * g_sensor * n01(rng);
+    if (chatter_m_s2 > 0 && i >= first) a += chatter_m_s2 * n01(rng);
     if (o.sensor_range_m_s2 > 0) a = std::clamp(a, -o.sensor_range_m_s2, o.sensor_range_m_s2);
     tr << fmt::format("{:.6f},{:.5g}\n", i / o.sample_rate_hz, a);
   }
@@ -150,7 +161,12 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
   truth_csv << "trial_id,zstop_m,tstop_s,t_contact_s\n";
   int id = 0;
   for (double g : o.gravity_m_s2) {
-    for (double v0 : o.impact_speed_m_s) {
+    std::vector<double> speeds = o.impact_speed_m_s;
+    if (!o.froude.empty()) {
+      speeds.clear();
+      for (double fr : o.froude) speeds.push_back(fr * std::sqrt(g * o.diameter_m));
+    }
+    for (double v0 : speeds) {
       for (int rep = 0; rep < o.repeats; ++rep) {
         ++id;
         const double H = o.fill_height_m[static_cast<std::size_t>(id - 1) % o.fill_height_m.size()];
@@ -166,13 +182,15 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
         c.vc_m_s = v0;
         const double g_sensor = o.noise_scales_with_g ? g : kStandardGravity_m_s2;
         const double bias = o.sensor_bias_g * g_sensor * n01(rng);
-        const double t_free = 0.01 + 0.02 * std::uniform_real_distribution<double>(0, 1)(rng);
+        const double t_free = (0.01 + 0.02 * std::uniform_real_distribution<double>(0, 1)(rng)) * time_factor(o, g);
         const int first = static_cast<int>(std::ceil(t_free * o.sample_rate_hz));  // first sample after contact
         const SynthDrop drop = integrate_drop(m, c, o, first / o.sample_rate_hz - t_free, rng, n01);
         const std::string name = fmt::format("S{:03d}", id), rel = fmt::format("traces/{}.csv", name);
         write_trace(fs::path(dir) / rel, first, drop.a_up_m_s2, g, bias, g_sensor, o, rng, n01);
         const double v_rep = v0 * (1.0 + o.speed_spread * n01(rng));
-        csv << fmt::format("{},{},{},{:.4f},{},{},{},{},{},{}\n", name, rel, g, v_rep, H, o.mass_kg, o.diameter_m,
+        // (Speeds by Froude number reach mm/s at low gravity: all their digits.)
+        const std::string v_text = o.froude.empty() ? fmt::format("{:.4f}", v_rep) : fmt::format("{:.6g}", v_rep);
+        csv << fmt::format("{},{},{},{},{},{},{},{},{},{}\n", name, rel, g, v_text, H, o.mass_kg, o.diameter_m,
                            o.grain_diameter_m, o.bulk_density_kg_m3, o.sample_rate_hz);
         truth_csv << fmt::format("{},{:.9g},{:.9g},{:.9g}\n", name, drop.zstop_m, drop.tstop_s, t_free);
       }

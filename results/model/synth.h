@@ -37,6 +37,21 @@ struct SynthOptions {
   double speed_spread = 0.005;    ///< relative scatter of the reported impact speed
   double contact_ramp_m = 1e-3;   ///< force ramps in over the first millimetre
   unsigned seed = 1;
+  /// Non-empty: the speeds by Froude number, v = Fr sqrt(g D) at each level, in place of
+  /// impact_speed_m_s (the design of a gravity sweep).
+  std::vector<double> froude;
+  /// true: the drop's own times scale as sqrt(D / g) from their values at 9.81 m/s2 and D = 10 cm
+  /// (the free fall before contact, the force fluctuation's correlation time, the rest after it
+  /// and the longest collision), as in a Froude-scaled drop, where every time is a multiple of
+  /// sqrt(D / g); the sensor's sample rate stays. false: fixed in seconds at every level.
+  bool froude_times = false;
+  /// RMS, in g, of the grain contacts' chatter on the record from contact on (a zero-mean white
+  /// acceleration per sample, on top of the motion): at 9.81 m/s2 and D = 10 cm this value, and
+  /// with froude_times sqrt(T / T_1g) times it (T = sqrt(D / g)), so that the chatter is the same
+  /// white noise in the drop's own units at every level, band-limited by the grains' contact
+  /// frequency (the sample rate here), which does not scale with g: a projectile resting on a bed
+  /// at 0.001 m/s2 reads 0.1-0.6 g of contacts through a 500 Hz filter (a DEM drop). 0: none.
+  double contact_chatter_g = 0;
 };
 
 /// The model with its terms' typical values (times each term's scale) at the given levels.

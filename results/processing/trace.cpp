@@ -102,6 +102,36 @@ void validate(const Trace& tr) {
 
 const char* to_string(TraceSource s) { return s == TraceSource::dem ? "dem" : "lab"; }
 
+const char* to_string(TimeScale s) { return s == TimeScale::fixed ? "fixed" : "froude"; }
+
+TimeScale time_scale_of(const std::string& s) {
+  if (s == "froude") return TimeScale::froude;
+  if (s == "fixed") return TimeScale::fixed;
+  throw std::invalid_argument(
+      fmt::format("time scale '{}': expected 'froude' (the drop's sqrt(D/g)) or 'fixed' "
+                  "(the paper's hertz and seconds at every gravity)",
+                  s));
+}
+
+const char* to_string(EndRule r) {
+  switch (r) {
+    case EndRule::paper:
+      return "paper";
+    case EndRule::depth:
+      return "depth";
+    case EndRule::speed:
+      break;
+  }
+  return "speed";
+}
+
+EndRule end_rule_of(const std::string& s) {
+  if (s == "speed" || s.empty()) return EndRule::speed;
+  if (s == "paper") return EndRule::paper;
+  if (s == "depth") return EndRule::depth;
+  throw std::invalid_argument(fmt::format("end rule '{}': expected 'speed', 'paper' or 'depth'", s));
+}
+
 TraceSource trace_source_of(const std::string& s) {
   if (s == "lab") return TraceSource::lab;
   if (s == "dem") return TraceSource::dem;
@@ -163,9 +193,12 @@ PassResult collision_pass(const Trace& trace, const MetricOptions& o, const std:
   std::vector<double> v_pass, z_pass;
   EndCriteria ec;
   ec.end_level_m_s2 = o.end_threshold_g * g;
-  ec.hold = end_hold_samples(fs);
+  ec.hold = end_hold_samples(fs, o.end_hold_s);
+  const bool paper_rule = o.end_rule == EndRule::paper;
   double vc_pass = 0;
-  if (!trace.velocity_down_m_s.empty() && !trace.depth_m.empty()) {
+  if (paper_rule) {
+    // The paper's rule: the acceleration alone.
+  } else if (!trace.velocity_down_m_s.empty() && !trace.depth_m.empty()) {
     ec.speed = &trace.velocity_down_m_s;
     vc_pass = interp_at(t, trace.velocity_down_m_s, r.start.t_start_s);
   } else if (o.impact_speed_m_s) {
@@ -184,7 +217,11 @@ PassResult collision_pass(const Trace& trace, const MetricOptions& o, const std:
     // record's coasting follows, and no projectile coasts this slowly for long at 0.1 g.
     ec.end_level_m_s2 = end_level(o.end_threshold_g, g, record_noise(af, ff_end));
     const double v_tol_m_s = g * static_cast<double>(w) / fs;
-    const std::optional<std::size_t> jb = last_exceedance_end(a, ipk, ec.end_level_m_s2, ec.hold);
+    // Nothing but rest follows the last exceedance, so no dip inside the collision can pass for
+    // it: the rest needs the paper's hold, not the drop-scaled one (at 0.1 m/s2 a lab record's
+    // tail after a 6 g stop rings above 0.1 g for 70 ms through a 50 Hz filter).
+    const std::size_t rest_hold = std::min(ec.hold, end_hold_samples(fs, kPaperEndHold_s));
+    const std::optional<std::size_t> jb = last_exceedance_end(a, ipk, ec.end_level_m_s2, rest_hold);
     if (jb && v_pass[*jb] <= ec.v_end_m_s + v_tol_m_s) j = jb;
   }
   if (!j) j = end_sample(a, ipk, ec);
@@ -194,9 +231,11 @@ PassResult collision_pass(const Trace& trace, const MetricOptions& o, const std:
                                   ? fmt::format(" (raised to {:.3g} m/s2, {} sigma of the record's noise)",
                                                 ec.end_level_m_s2, kEndNoiseSigmas)
                                   : "";
+    const std::string speed =
+        ec.speed ? fmt::format(" with the speed below {} of the collision speed", o.end_speed_fraction) : "";
     throw TraceError(fmt::format("trace shorter than the collision: after the peak at t = {:.4f} s the acceleration "
-                                 "never stays below {} g{} with the speed below {} of the collision speed",
-                                 t[ipk], o.end_threshold_g, level, o.end_speed_fraction),
+                                 "never stays below {} g{} for {:.3g} s{}",
+                                 t[ipk], o.end_threshold_g, level, o.end_hold_s, speed),
                      n - 1);
   }
   r.end = end_edge(t, a, *j, r.start.i_start, w, ec.end_level_m_s2);
@@ -250,12 +289,18 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
   out.bias_m_s2 = bias;
   out.accel_up_m_s2 = a;
   m.tstop_s = m.t_end_s - m.t_start_s;
+  m.cutoff_hz = o.cutoff_hz;
+  m.end_hold_s = o.end_hold_s;
 
   // Velocity and depth: the trace's own when present (DEM), else integrated from the impact speed.
   if (own_kinematics) {
     out.velocity_down_m_s = trace.velocity_down_m_s;
     out.depth_m = trace.depth_m;
     m.vc_m_s = interp_at(t, out.velocity_down_m_s, m.t_start_s);
+    // One depth reference for DEM drops and lab records: the collision start (the paper's
+    // processing integrates its records' depth from there). The surface's is kept beside it.
+    m.start_depth_m = interp_at(t, trace.depth_m, m.t_start_s);
+    for (double& z : out.depth_m) z -= m.start_depth_m;
   } else {
     if (!o.impact_speed_m_s)
       throw std::invalid_argument(
@@ -270,8 +315,16 @@ ProcessedTrace process_trace(const Trace& trace, const MetricOptions& o) {
   m.apeak_m_s2 = peak_acceleration(a, out.velocity_down_m_s, i_start, i_end, pass.start.step, pass.end.step, w,
                                    m.vc_m_s - out.rest_speed_offset_m_s, g);
   const std::size_t i_last_depth = own_kinematics ? n - 1 : i_end;  // trace_steps.h, rebound_of
-  const Rebound rb = rebound_of(out.velocity_down_m_s, out.depth_m, i_start, i_end, i_last_depth, m.vc_m_s, o);
+  MetricOptions from_start = o;  // the floor's depth below the collision start, for the rebound flag
+  if (from_start.fill_height_m) *from_start.fill_height_m -= m.start_depth_m;
+  const Rebound rb = rebound_of(out.velocity_down_m_s, out.depth_m, i_start, i_end, i_last_depth, m.vc_m_s, from_start);
   m.zstop_m = rb.max_depth_m;  // Sect. 2.3: the maximum penetration depth
+  m.zstop_surface_m = m.zstop_m + m.start_depth_m;
+  if (o.end_rule == EndRule::depth) {
+    const DepthEnd de = depth_end(t, out.depth_m, i_start, i_last_depth, kEndDepthFraction);
+    m.t_end_s = de.t_end_s;
+    m.tstop_s = m.t_end_s - m.t_start_s;
+  }
   m.depth_at_end_m = interp_at(t, out.depth_m, m.t_end_s);
   m.final_depth_m = out.depth_m.back();
   m.rebound = rb.rebound;

@@ -1,7 +1,8 @@
 // A projectile trace and the paper's processing of it (Sunday et al. 2021 Sect. 2.3). The same
 // code processes DEM traces (results of `gravsweep run`) and laboratory accelerometer records.
 //
-// Conventions: depth z positive DOWN, zero at the bed surface; velocity positive down;
+// Conventions: depth z positive DOWN (a DEM trace's from the bed's mean surface, a processed
+// trace's from the collision start, as the paper's processing of its records); velocity positive down;
 // acceleration as the accelerometer format (docs/formats/measurements.md section 3.2): the
 // projectile's vertical kinematic acceleration, positive UP, so free fall reads -g and rest
 // reads 0. (Equivalently accel_up = -dv_down/dt.)
@@ -33,10 +34,46 @@ struct Trace {
   std::optional<double> contact_start_s;
 };
 
+/// The paper's processing (Sunday et al. 2021 Sect. 2.3) as it stands for its lab drops at 1 g:
+/// a 500 Hz low-pass and an end held for 2 ms, for a D = 10 cm projectile at 9.81 m/s2.
+inline constexpr double kPaperCutoff_hz = 500.0;
+inline constexpr double kPaperEndHold_s = 0.002;
+inline constexpr double kPaperGravity_m_s2 = 9.81;
+inline constexpr double kPaperProjectileDiameter_m = 0.1;
+
+/// The time scale the processing's times are set in.
+/// froude: the drop's own time sqrt(D / g): the cut-off is kPaperCutoff_hz sqrt((g / D) / (9.81 /
+///   0.1 m)) (50.5 sqrt(g / D)) and the hold kPaperEndHold_s over the same factor, so a drop at any
+///   gravity is filtered with the same bandwidth in units of sqrt(g / D) as the paper's 1 g drop
+///   (at 0.01 m/s2 a 500 Hz filter is 31 times wider in those units, and a projectile at rest read
+///   0.1-0.6 g of grain contacts through it). At g = 9.81 m/s2 and D = 10 cm it is the paper's.
+/// fixed: the paper's hertz and seconds at every gravity (the processing before the time scale).
+/// Which one a trial gets: time_scale_for (results/measurements/trial.h).
+enum class TimeScale { froude, fixed };
+const char* to_string(TimeScale s);
+/// Throws std::invalid_argument naming the expected values.
+TimeScale time_scale_of(const std::string& s);
+
+/// Which rule ends the collision (MetricOptions::end_rule).
+/// paper: the acceleration below end_threshold_g g, held for the hold time (Sect. 2.3).
+/// speed: the paper's, with the projectile's speed below end_speed_fraction vc too (a lull between
+///   force-chain bursts does not end it); lab records searched back from the rest at the record's end.
+/// depth: where the depth first reaches kEndDepthFraction of the collision's maximum depth (the
+///   speed rule still places the rest that a lab record's bias and integration need). Independent
+///   of the filter and of a sensor's noise, and in the drop's own scales by construction.
+enum class EndRule { paper, speed, depth };
+const char* to_string(EndRule r);
+/// Throws std::invalid_argument naming the expected values.
+EndRule end_rule_of(const std::string& s);
+/// The depth rule's fraction of the maximum depth.
+inline constexpr double kEndDepthFraction = 0.99;
+
 struct MetricOptions {
   double gravity_m_s2 = 9.81;
-  double cutoff_hz = 500.0;  ///< 2nd-order Butterworth low-pass (paper: 500 Hz)
+  double cutoff_hz = kPaperCutoff_hz;  ///< 2nd-order Butterworth low-pass (paper: 500 Hz at 1 g)
   int filter_order = 2;
+  double end_hold_s = kPaperEndHold_s;  ///< the end level must hold this long (paper: 2 ms at 1 g)
+  EndRule end_rule = EndRule::speed;
   double end_threshold_g = 0.1;  ///< collision ends when |a| < 0.1 g (paper)
   /// ... and the projectile has lost this much of its collision speed: its downward speed is below
   /// end_speed_fraction * vc. A DEM projectile is stopped by bursts of force chains with lulls of
@@ -60,17 +97,22 @@ struct MetricOptions {
 
 /// The paper's metrics of one collision.
 struct Metrics {
-  double vc_m_s = 0;          ///< collision velocity (speed at collision start)
-  double apeak_m_s2 = 0;      ///< peak (upward) acceleration of the filtered trace
-  double zstop_m = 0;         ///< penetration depth: the maximum depth of the collision (Sect. 2.3)
-  double depth_at_end_m = 0;  ///< depth at the collision end (below zstop_m after a rebound)
-  double final_depth_m = 0;   ///< depth at the last sample of the record
-  double tstop_s = 0;         ///< collision duration (end - start)
-  double t_start_s = 0;       ///< collision start: no longer in free fall
-  double t_end_s = 0;         ///< collision end: acceleration below end_threshold_g after the peak,
-                              ///< with the speed below end_speed_fraction * vc
-  bool rebound = false;       ///< rose back by more than 10 % of zstop after it (trace_steps::rebound_of)
-  std::string note;           ///< why a metric could not be found, if so
+  double vc_m_s = 0;      ///< collision velocity (speed at collision start)
+  double apeak_m_s2 = 0;  ///< peak (upward) acceleration of the filtered trace
+  double zstop_m = 0;     ///< penetration depth: the maximum depth of the collision, from its start (Sect. 2.3)
+  /// Depth of the collision start below the bed's mean surface (DEM: the projectile's lowest point
+  /// at first contact, negative above the surface; lab: 0, the depth is integrated from there).
+  double start_depth_m = 0;
+  double zstop_surface_m = 0;  ///< the maximum depth below the bed's mean surface: zstop_m + start_depth_m
+  double depth_at_end_m = 0;   ///< depth at the collision end (below zstop_m after a rebound)
+  double final_depth_m = 0;    ///< depth at the last sample of the record
+  double tstop_s = 0;          ///< collision duration (end - start)
+  double cutoff_hz = 0;        ///< the low-pass cut-off applied (MetricOptions, after the time scale)
+  double end_hold_s = 0;       ///< the end's hold applied
+  double t_start_s = 0;        ///< collision start: no longer in free fall
+  double t_end_s = 0;          ///< collision end (MetricOptions::end_rule)
+  bool rebound = false;        ///< rose back by more than 10 % of zstop after it (trace_steps::rebound_of)
+  std::string note;            ///< why a metric could not be found, if so
 };
 
 /// A processed trace: the filtered, bias-corrected acceleration, the velocity and depth (the
@@ -80,7 +122,7 @@ struct ProcessedTrace {
   std::vector<double> t_s;
   std::vector<double> accel_up_m_s2;      ///< filtered, bias removed
   std::vector<double> velocity_down_m_s;  ///< positive down
-  std::vector<double> depth_m;            ///< positive down, 0 at first contact (integrated case)
+  std::vector<double> depth_m;            ///< positive down, 0 at the collision start
   double sample_rate_hz = 0;
   double bias_m_s2 = 0;               ///< removed sensor bias
   std::size_t free_fall_samples = 0;  ///< samples used for the bias from free fall

@@ -169,8 +169,21 @@ CollisionStart free_fall_start(const std::vector<double>& t, const std::vector<d
   return {j, t_onset, step};
 }
 
-std::size_t end_hold_samples(double fs_hz) {
-  return std::max<std::size_t>(3, static_cast<std::size_t>(std::ceil(0.002 * fs_hz)));
+std::size_t end_hold_samples(double fs_hz, double hold_s) {
+  return std::max<std::size_t>(3, static_cast<std::size_t>(std::ceil(hold_s * fs_hz)));
+}
+
+DepthEnd depth_end(const std::vector<double>& t, const std::vector<double>& z, std::size_t i_start, std::size_t i_last,
+                   double fraction) {
+  const std::size_t last = std::min(i_last, z.size() - 1);
+  std::size_t i_max = i_start;
+  for (std::size_t k = i_start; k <= last; ++k)
+    if (z[k] > z[i_max]) i_max = k;
+  const double level = fraction * z[i_max];
+  std::size_t k = i_start;
+  while (k < i_max && z[k + 1] < level) ++k;
+  if (k >= i_max) return {i_max, t[i_max]};
+  return {k + 1, crossing_time(t, z, k, level)};
 }
 
 std::optional<std::size_t> end_sample(const std::vector<double>& a, std::size_t ipk, const EndCriteria& c) {

@@ -89,8 +89,16 @@ struct EndCriteria {
   const std::vector<double>* speed = nullptr;  ///< downward speed per sample, when known
   std::size_t hold = 3;                        ///< samples the acceleration must stay below the level
 };
-/// Samples to hold the end level: 2 ms, at least 3 samples.
-std::size_t end_hold_samples(double fs_hz);
+/// Samples to hold the end level: hold_s (MetricOptions::end_hold_s), at least 3 samples.
+std::size_t end_hold_samples(double fs_hz, double hold_s);
+/// The depth rule's end (EndRule::depth): the time at which z first reaches `fraction` of its
+/// maximum over [i_start, i_last] after t_start_s (interpolated), with the sample after it.
+struct DepthEnd {
+  std::size_t i_end = 0;
+  double t_end_s = 0;
+};
+DepthEnd depth_end(const std::vector<double>& t, const std::vector<double>& z, std::size_t i_start, std::size_t i_last,
+                   double fraction);
 /// The first sample at or after the peak where the acceleration stays below the end level for
 /// `hold` samples with the speed below v_end; nullopt when there is none.
 std::optional<std::size_t> end_sample(const std::vector<double>& a, std::size_t ipk, const EndCriteria& c);

@@ -29,7 +29,7 @@ std::optional<db::Database> open_queue_database(const std::string& path) {
 
 /// Every finished drop of a campaign database (filtered on its results table) as a DEM trial.
 CampaignInput load_queue_campaign(const std::string& path, db::Database& db, const std::vector<std::string>& where,
-                                  const std::string& files) {
+                                  const std::string& files, const results::ProcessingChoice& processing) {
   CampaignInput in;
   in.kind = "campaign database (submit/work)";
   queue::ResultsQuery q;
@@ -55,7 +55,7 @@ CampaignInput load_queue_campaign(const std::string& path, db::Database& db, con
       in.note += fmt::format("{}{} drop jobs {}", in.note.empty() ? "" : ", ", st.get_int(1), st.get_text(0));
     if (!in.note.empty()) in.note += " (not finished: not trials yet; `gravsweep work` runs them)";
   }
-  in.campaign = results::load_dem_campaign(path, refs);
+  in.campaign = results::load_dem_campaign(path, refs, processing);
   results::refuse_unphysical(path, in);
   return in;
 }
@@ -63,14 +63,14 @@ CampaignInput load_queue_campaign(const std::string& path, db::Database& db, con
 }  // namespace
 
 CampaignInput load_campaign_input(const std::string& path, const std::vector<std::string>& where, double cutoff_hz,
-                                  const std::string& files) {
+                                  const std::string& files, const results::ProcessingChoice& processing) {
   try {
     if (db::is_postgres_url(path)) {
       db::Database db = queue::open_campaign(path, queue::OpenMode::read, files);  // refuses a non-campaign
-      return load_queue_campaign(path, db, where, files);
+      return load_queue_campaign(path, db, where, files, processing);
     }
-    if (auto db = open_queue_database(path)) return load_queue_campaign(path, *db, where, files);
-    return results::load_trial_input(path, where, cutoff_hz);
+    if (auto db = open_queue_database(path)) return load_queue_campaign(path, *db, where, files, processing);
+    return results::load_trial_input(path, where, cutoff_hz, processing);
   } catch (const UsageError&) {
     throw;
   } catch (const db::DbError& e) {
@@ -81,10 +81,11 @@ CampaignInput load_campaign_input(const std::string& path, const std::vector<std
 }
 
 CampaignInput load_campaign_inputs(const std::vector<std::string>& paths, const std::vector<std::string>& where,
-                                   double cutoff_hz, const std::string& files) {
+                                   double cutoff_hz, const std::string& files,
+                                   const results::ProcessingChoice& processing) {
   std::vector<std::pair<std::string, CampaignInput>> inputs;
   for (const auto& p : paths) {
-    inputs.emplace_back(p, load_campaign_input(p, where, cutoff_hz, files));
+    inputs.emplace_back(p, load_campaign_input(p, where, cutoff_hz, files, processing));
     describe_input(p, inputs.back().second);
   }
   try {

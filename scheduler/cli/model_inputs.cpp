@@ -31,11 +31,12 @@ CLI::App* add_model_inputs(CLI::App* sub, ModelInputs& o) {
   sub->add_option("--where", o.where, kWhereHelp);
   add_input_files_option(sub, o.files);
   add_format_option(sub, o.format);
+  add_processing_options(sub, o.processing);
   return sub;
 }
 
 results::Campaign load_model_campaign(const ModelInputs& o, std::size_t min_trials) {
-  auto in = load_campaign_inputs(o.inputs, o.where, kModelFilterHz, o.files);
+  auto in = load_campaign_inputs(o.inputs, o.where, kModelFilterHz, o.files, o.processing);
   if (in.campaign.trials.size() < min_trials)
     throw UsageError(fmt::format("{}: only {} usable trials; at least {} are needed", fmt::join(o.inputs, " + "),
                                  in.campaign.trials.size(), min_trials));

@@ -14,10 +14,11 @@ namespace gravsweep::cli {
 
 /// The inputs and output format of a `model` sub-verb.
 struct ModelInputs {
-  std::vector<std::string> inputs;  ///< databases, imported SQLite files or lab folders, read as one
-  std::vector<std::string> where;   ///< `gravsweep results` filters, all must hold
-  std::string files;                ///< files root of a postgresql:// input
-  std::string format = "table";     ///< table, csv or json
+  std::vector<std::string> inputs;       ///< databases, imported SQLite files or lab folders, read as one
+  std::vector<std::string> where;        ///< `gravsweep results` filters, all must hold
+  std::string files;                     ///< files root of a postgresql:// input
+  std::string format = "table";          ///< table, csv or json
+  results::ProcessingChoice processing;  ///< --time-scale, --end-rule (empty: each trial's own)
 };
 
 /// Adds the positional inputs, --where, --files and --format to `sub`; returns `sub`.

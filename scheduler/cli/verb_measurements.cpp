@@ -29,6 +29,7 @@ struct ImportOptions {
   double cutoff_hz = 500.0;
   std::string files;  ///< files root of a postgresql:// input
   bool keep_going = false;
+  results::ProcessingChoice processing;
 };
 
 /// `measurements import`: read, check, store, print the table of metrics.
@@ -37,7 +38,7 @@ void run_import(const ImportOptions& o) {
   std::error_code ec;
   if (fs::exists(o.db) && fs::equivalent(o.db, o.dir, ec))
     throw UsageError(fmt::format("--db '{}': the campaign read; another file expected", o.db));
-  auto in = load_campaign_input(o.dir, o.where, o.cutoff_hz, o.files);
+  auto in = load_campaign_input(o.dir, o.where, o.cutoff_hz, o.files, o.processing);
   describe_input(o.dir, in);
   const results::Campaign& c = in.campaign;
   std::size_t bad = 0;
@@ -103,7 +104,11 @@ void setup_import(CLI::App* sub) {
   imp->add_option("--where", o->where, "filter the trials, grammar of `gravsweep results` (e.g. 'gravity_m_s2<1')");
   imp->add_flag("--keep-going", o->keep_going, "store the good trials even when some are bad input (exit code 4)");
   imp->add_option("--db", o->db, "SQLite file to store into (created if missing)")->capture_default_str();
-  imp->add_option("--cutoff", o->cutoff_hz, "low-pass cut-off, Hz")->capture_default_str();
+  imp->add_option("--cutoff", o->cutoff_hz,
+                  "low-pass cut-off of a trial without filter_cutoff_hz, Hz: the cut-off at the paper's drop (1 g, "
+                  "D = 10 cm), scaled by sqrt(g/D) for the trial's own drop under the froude time scale")
+      ->capture_default_str();
+  add_processing_options(imp, o->processing);
   add_input_files_option(imp, o->files);
   add_format_option(imp, o->format);
   imp->callback([o]() { run_import(*o); });

@@ -30,7 +30,20 @@ constexpr const char* kLawHelp =
 struct LawOptions {
   ModelInputs in;
   std::string law = "scaled_base";
+  bool per_froude = false;  ///< lolo: the table by held-out level and Froude number instead
 };
+
+/// Signed mean errors by held-out level and Froude number (results::LevelOutFroude).
+results::Table froude_table(const std::vector<results::LevelOutRow>& rows) {
+  results::Table t({"held_out_g_m_s2", "impact_fr", "drops", "zstop_mean_err_pct", "zstop_min_err_pct",
+                    "zstop_max_err_pct", "tstop_mean_err_pct", "beyond_target"});
+  for (const auto& r : rows)
+    for (const auto& f : r.by_froude)
+      t.add({num(r.g_m_s2), num(f.froude, 3), std::to_string(f.drops), num(f.zstop_mean_err_pct, 3),
+             num(f.zstop_min_err_pct, 3), num(f.zstop_max_err_pct, 3), num(f.tstop_mean_err_pct, 3),
+             f.misses ? "yes" : "no"});
+  return t;
+}
 
 /// The fitted constants of a law, "phi=1.59 inv_d1_1_m=24.8".
 std::string constants(const results::FittedModel& m) {
@@ -67,12 +80,20 @@ void run_lolo(const LawOptions& o) {
            num(r.zstop_all_levels_median_abs_err_pct, 3), num(r.tstop_all_levels_median_abs_err_pct, 3),
            num(r.zstop_law_sd_pct, 2), num(r.tstop_law_sd_pct, 2), constants(r.law), r.verdict});
   }
+  if (o.per_froude) {
+    froude_table(rows).print(o.in.format);
+    return;
+  }
   if (o.in.format == "table")
     fmt::print(
         "Leave one gravity level out: {} fitted on the other levels, each drop of the held-out level predicted "
         "(median |error| over its drops; targets zstop {:g} %, tstop {:g} % inside the fitted range):\n",
         spec.name(), results::kLevelOutZstopTargetPct, results::kLevelOutTstopTargetPct);
   t.print(o.in.format);
+  if (o.in.format == "table") {
+    fmt::print("\nBy Froude number (signed mean error, predicted - measured, over the drops of each Fr):\n");
+    froude_table(rows).print(o.in.format);
+  }
 }
 
 /// The summary under the regime table: the law's crossover at the surface, the median along the
@@ -142,11 +163,16 @@ void setup_model_lolo(CLI::App& model) {
       "propagated from the covariance of the law's constants, median over the drops; the fit's noise),\n"
       "or by more (its gravity scaling misses); outside the range it is an extrapolation. A law with a\n"
       "parameter per level (base) is refused: a held-out level has none. The fit takes each trial's\n"
-      "residuals in units of its own RMS force, so that the Froude 10 drops do not outweigh the rest.\n\n"
+      "residuals in units of its own RMS force, so that the Froude 10 drops do not outweigh the rest.\n"
+      "A median hides a Froude number the law misses: the verdict names every Froude number whose\n"
+      "signed mean error is beyond a target, and the second table (--per-froude: that table alone, for\n"
+      "csv and json) gives the signed errors by held-out level and Froude number.\n\n"
       "Examples:\n"
       "  gravsweep model lolo data/gravity_sweep/g9.81 data/gravity_sweep/g1.62\n"
       "  gravsweep model lolo runs/gravity_sweep/sweep.db --law scaled_base+cohesion --format csv");
   add_law_inputs(lolo, *o)->callback([o]() { run_lolo(*o); });
+  lolo->add_flag("--per-froude", o->per_froude,
+                 "print the signed mean errors by held-out level and Froude number instead of the table by level");
 
   auto orm = std::make_shared<LawOptions>();
   auto* regimes = model.add_subcommand(

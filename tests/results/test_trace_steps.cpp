@@ -38,8 +38,8 @@ TEST(TraceSteps, FilterIsTheButterworthOrSaysWhyNot) {
 TEST(TraceSteps, EdgeWidthAndHoldFollowTheRates) {
   EXPECT_EQ(edge_width(1400, 500), 4u);  // 1 + ceil(2.8)
   EXPECT_EQ(edge_width(10000, 500), 21u);
-  EXPECT_EQ(end_hold_samples(1400), 3u);  // 2 ms is 2.8 samples: at least 3
-  EXPECT_EQ(end_hold_samples(10000), 20u);
+  EXPECT_EQ(end_hold_samples(1400, 0.002), 3u);  // 2 ms is 2.8 samples: at least 3
+  EXPECT_EQ(end_hold_samples(10000, 0.002), 20u);
 }
 
 TEST(TraceSteps, ContactPeakIsTheMaximumAndFreeFallOnlyNeverMakesContact) {
