@@ -100,4 +100,57 @@ std::vector<RegimeTrial> regime_map(const FittedModel& law, const Campaign& c) {
   return out;
 }
 
+namespace {
+
+/// ln Fr where the (ln Fr, dynamic share %) polyline first crosses 50 % upwards; NaN when it does not.
+double crossing_of(const std::vector<std::pair<double, double>>& pts) {
+  for (std::size_t k = 1; k < pts.size(); ++k) {
+    const auto [x0, y0] = pts[k - 1];
+    const auto [x1, y1] = pts[k];
+    if (y0 < 50 && y1 >= 50) return std::exp(x0 + (x1 - x0) * (50 - y0) / (y1 - y0));
+  }
+  return NAN;
+}
+
+}  // namespace
+
+double whole_collision_crossover(const std::vector<RegimeTrial>& map, CrossoverShare share) {
+  constexpr double kSameFroudeLn = 0.05;
+  std::vector<std::pair<double, double>> drops;  // (ln Fr, dynamic share %)
+  for (const auto& r : map) {
+    const double qs = share == CrossoverShare::impulse ? r.quasi_static_impulse_pct : r.quasi_static_work_pct;
+    if (std::isfinite(r.impact_froude) && r.impact_froude > 0 && std::isfinite(qs))
+      drops.emplace_back(std::log(r.impact_froude), 100 - qs);
+  }
+  std::sort(drops.begin(), drops.end());
+  std::vector<std::pair<double, double>> mean;
+  for (std::size_t k = 0; k < drops.size();) {
+    std::size_t e = k + 1;
+    while (e < drops.size() && drops[e].first - drops[e - 1].first <= kSameFroudeLn) ++e;
+    double x = 0, y = 0;
+    for (std::size_t j = k; j < e; ++j) x += drops[j].first, y += drops[j].second;
+    const double n = static_cast<double>(e - k);
+    mean.emplace_back(x / n, y / n);
+    k = e;
+  }
+  return crossing_of(mean);
+}
+
+CrossoverEstimate whole_collision_crossover(const FittedModel& law, const Campaign& c, CrossoverShare share) {
+  CrossoverEstimate e;
+  e.froude = whole_collision_crossover(regime_map(law, c), share);
+  const Eigen::Index n = law.coef.size();
+  Eigen::VectorXd d(n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    FittedModel up = law, down = law;
+    const double h = 0.01 * std::max(std::abs(law.coef(j)), 1e-12);
+    up.coef(j) += h, down.coef(j) -= h;
+    d(j) =
+        (whole_collision_crossover(regime_map(up, c), share) - whole_collision_crossover(regime_map(down, c), share)) /
+        (2 * h);
+  }
+  if (d.allFinite()) e.sd = std::sqrt(std::max(0.0, d.dot(law.cov * d)));
+  return e;
+}
+
 }  // namespace gravsweep::results

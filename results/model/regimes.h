@@ -48,4 +48,18 @@ struct RegimeTrial {
 };
 std::vector<RegimeTrial> regime_map(const FittedModel& law, const Campaign& c);
 
+/// The impact Froude number at which the dynamic part carries half of a whole collision, by one
+/// definition (its share of the impulse, or of the work): the drops grouped by the design's Froude
+/// number (within 5 % in ln Fr), the groups' mean shares interpolated linearly in ln Fr to 50 %.
+/// NaN where the shares never cross 50 %.
+enum class CrossoverShare { impulse, work };
+double whole_collision_crossover(const std::vector<RegimeTrial>& map, CrossoverShare share);
+/// The same for the law fitted on the campaign, with its standard deviation propagated from the
+/// cluster-robust covariance of the law's constants (central differences of 1 % of each constant,
+/// delta method, as leave_level_out's prediction_sd).
+struct CrossoverEstimate {
+  double froude = NAN, sd = NAN;
+};
+CrossoverEstimate whole_collision_crossover(const FittedModel& law, const Campaign& c, CrossoverShare share);
+
 }  // namespace gravsweep::results

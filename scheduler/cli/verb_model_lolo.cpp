@@ -98,7 +98,8 @@ void run_lolo(const LawOptions& o) {
 
 /// The summary under the regime table: the law's crossover at the surface, the median along the
 /// drops, and paper II's.
-std::string crossover_summary(const results::FittedModel& law, const std::vector<results::RegimeTrial>& map) {
+std::string crossover_summary(const results::FittedModel& law, const results::Campaign& c,
+                              const std::vector<results::RegimeTrial>& map) {
   std::vector<double> surface, along;
   for (const auto& r : map) {
     surface.push_back(r.surface_crossover_froude);
@@ -108,11 +109,17 @@ std::string crossover_summary(const results::FittedModel& law, const std::vector
   const std::string law_fr = num(*lo, 3) == num(*hi, 3) ? num(*lo, 3) : num(*lo, 3) + "-" + num(*hi, 3);
   const std::size_t crossing =
       static_cast<std::size_t>(std::count_if(along.begin(), along.end(), [](double x) { return std::isfinite(x); }));
+  const auto range = [&](results::CrossoverShare s) {
+    const auto e = results::whole_collision_crossover(law, c, s);
+    return fmt::format("Fr {} +- {}", num(e.froude, 3), num(e.sd, 2));
+  };
   return fmt::format(
       "Crossover (inertial drag = quasi-static resistance): Fr {} by the law at the surface ({}); along the {} "
-      "drops that start in the inertial regime, median Fr {}; {} start quasi-static; paper II: Fr ~ {:g}",
+      "drops that start in the inertial regime, median Fr {}; {} start quasi-static. Over whole collisions the drag "
+      "does half the work at {} and carries half the impulse at {} (SD from the law's covariance); paper II: Fr ~ "
+      "{:g}",
       law_fr, constants(law), crossing, num(results::median_abs(along), 3), map.size() - crossing,
-      results::kPaperIICrossoverFroude);
+      range(results::CrossoverShare::work), range(results::CrossoverShare::impulse), results::kPaperIICrossoverFroude);
 }
 
 void run_regimes(const LawOptions& o) {
@@ -134,9 +141,9 @@ void run_regimes(const LawOptions& o) {
                law.spec.name(), law.trials_used);
   t.print(o.in.format);
   if (o.in.format == "table")
-    fmt::print("\n{}\n", crossover_summary(law, map));
+    fmt::print("\n{}\n", crossover_summary(law, c, map));
   else
-    std::fprintf(stderr, "%s\n", crossover_summary(law, map).c_str());
+    std::fprintf(stderr, "%s\n", crossover_summary(law, c, map).c_str());
 }
 
 CLI::App* add_law_inputs(CLI::App* sub, LawOptions& o) {

@@ -52,72 +52,90 @@ std::string sweep_levels() {
 }  // namespace
 
 // The gravity sweep's committed levels (data/gravity_sweep/, GRAVITY.md), recomputed from the
-// traces. Two levels (9.81, 1.62 m/s2): the Froude-scaled duration falls on one curve (ratio 1.03),
-// the scaled depth lies 5-10 % lower at 1.62 m/s2 below Fr 1 (ratio 1.39). All five levels (50
-// drops, four decades of g): the depth collapses (ratio 1.00, the levels 4.9 % apart at equal Fr),
-// the duration less well (1.55: the levels 17.7 % apart against 12.2 % within).
-TEST(GravitySweep, TheCommittedLevelsCollapseInDepthAndLessInDuration) {
-  const auto collapse = [](const std::string& folders, const char* trials) {
-    const auto r = gravsweep::testing::run_gravsweep("model collapse" + folders + " --format csv", false);
-    EXPECT_EQ(r.code, 0) << r.out;
-    std::map<std::string, std::vector<std::string>> rows;
-    std::istringstream in(r.out);
-    gravsweep::results::CsvReader csv(in);
-    std::vector<std::string> cells;
-    int line = 0;
-    while (csv.next(cells, line))
-      if (cells.size() == 7) rows[cells[0]] = cells;
-    EXPECT_EQ(rows.count("zstop_over_D"), 1u) << r.out;
-    EXPECT_EQ(rows.count("tstop_sqrt_g_over_D"), 1u) << r.out;
-    EXPECT_EQ(rows["zstop_over_D"][2], trials);
-    return rows;
+// traces, and the level effect at equal Fr (nested ANOVA over the 25 cells of Froude number and
+// level, two repeats each). Processed in each drop's own scales (the default of DEM drops) all
+// three scaled metrics collapse: the levels differ by no more than the repeats (p >= 0.01). In the
+// paper's fixed hertz and seconds the duration and the peak "did not collapse": that was the
+// 500 Hz filter, ten to a hundred times wider in units of sqrt(g/D) below 1 g.
+TEST(GravitySweep, TheCommittedLevelsCollapseInAllThreeMetricsInTheirOwnScales) {
+  std::string out;
+  auto by_metric = [&](const std::string& extra) {
+    std::map<std::string, std::map<std::string, std::string>> m;
+    for (const auto& r : csv_rows("model collapse" + sweep_levels() + extra, out)) m[r.at("metric")] = r;
+    std::printf("%s", out.c_str());
+    return m;
   };
-  auto two = collapse(level_folder("g9.81") + level_folder("g1.62"), "14");
-  EXPECT_NEAR(std::stod(two["tstop_sqrt_g_over_D"].at(6)), 1.03, 0.05);
-  EXPECT_NEAR(std::stod(two["zstop_over_D"].at(6)), 1.39, 0.05);
-  EXPECT_LT(std::stod(two["zstop_over_D"].at(5)), 15.0);  // the levels lie within 15 % at equal Fr
-  auto five = collapse(sweep_levels(), "50");
-  EXPECT_EQ(five["zstop_over_D"].at(1), "5");
-  EXPECT_NEAR(std::stod(five["zstop_over_D"].at(6)), 1.00, 0.05);
-  EXPECT_NEAR(std::stod(five["zstop_over_D"].at(5)), 4.9, 0.5);
-  EXPECT_NEAR(std::stod(five["tstop_sqrt_g_over_D"].at(6)), 1.55, 0.05);
+  auto own = by_metric("");
+  ASSERT_EQ(own.size(), 3u) << out;
+  for (const auto& [metric, r] : own) {
+    SCOPED_TRACE(metric);
+    EXPECT_EQ(r.at("trials"), "50");
+    EXPECT_EQ(r.at("cells"), "25");
+    EXPECT_GE(std::stod(r.at("level_p")), 0.01);
+    EXPECT_EQ(r.at("verdict").rfind("collapses", 0), 0u) << r.at("verdict");
+  }
+  EXPECT_NEAR(std::stod(own["zstop_over_D"].at("level_p")), 0.033, 0.005);
+  EXPECT_NEAR(std::stod(own["tstop_sqrt_g_over_D"].at("level_p")), 0.14, 0.02);
+  EXPECT_NEAR(std::stod(own["tstop_sqrt_g_over_D"].at("repeat_scatter_pct")), 3.7, 0.3);
+  EXPECT_NEAR(std::stod(own["tstop_sqrt_g_over_D"].at("collapse_ratio")), 1.01, 0.05);
+  EXPECT_NEAR(std::stod(own["apeak_over_g"].at("level_p")), 0.59, 0.05);
+  auto fixed = by_metric(" --time-scale fixed");
+  ASSERT_EQ(fixed.size(), 3u) << out;
+  EXPECT_LT(std::stod(fixed["tstop_sqrt_g_over_D"].at("level_p")), 0.01);
+  EXPECT_NEAR(std::stod(fixed["tstop_sqrt_g_over_D"].at("collapse_ratio")), 1.55, 0.05);
+  EXPECT_LT(std::stod(fixed["apeak_over_g"].at("level_p")), 1e-9);
+  EXPECT_GT(std::stod(fixed["apeak_over_g"].at("level_scatter_pct")), 100);
+  // The depth does not depend on the filter: the same under both.
+  EXPECT_EQ(fixed["zstop_over_D"].at("level_p"), own["zstop_over_D"].at("level_p"));
 }
 
 // Leave one level out on the five committed levels (GRAVITY.md, "One gravity-scaled law"): phi m g
-// + kappa g z + m v^2/d1 fitted on four levels predicts the fifth within the targets (zstop
-// 10 %, tstop 15 %) at 1.62 and 0.1 m/s2 and misses zstop at 0.01 m/s2 by 13 %, the verdict naming
-// both regimes; the numbers are the ones GRAVITY.md states (within 1 point). Without the depth
-// term (phi m g + m v^2/d1) every level is missed by more than 30 % in zstop.
-TEST(GravitySweep, OneDepthFrictionLawPredictsEachHeldOutLevelFromTheOtherFour) {
+// + kappa g z + m v^2/d1 fitted on four levels predicts the fifth's duration within 2-9 % at every
+// level, and misses its depth by 12-20 % at every level as much as when the level is in the fit:
+// the form misses, not the gravity scaling. The signed errors by Froude number show how: too
+// shallow at Fr 0.2 at every level, too deep at Fr 1-2. Without the depth term every level is
+// missed by more than 30 % in zstop.
+TEST(GravitySweep, OneDepthFrictionLawPredictsEachHeldOutLevelAsWellAsWithTheLevelInTheFit) {
   std::string out;
-  const auto rows = csv_rows("model lolo" + sweep_levels() + " --law scaled_base+gravity_depth_friction", out);
+  const std::string law = " --law scaled_base+gravity_depth_friction";
+  const auto rows = csv_rows("model lolo" + sweep_levels() + law, out);
   std::printf("%s", out.c_str());
   ASSERT_EQ(rows.size(), 5u) << out;
-  const std::map<std::string, std::pair<double, double>> stated{
-      {"9.81", {6.5, 3.2}}, {"1.62", {4.6, 6.0}}, {"0.1", {6.5, 5.6}}, {"0.01", {13.0, 5.8}}, {"0.001", {12.4, 25.9}}};
+  const std::map<std::string, std::pair<double, double>> stated{{"9.81", {19.0, 8.3}},
+                                                                {"1.62", {18.5, 2.3}},
+                                                                {"0.1", {12.0, 5.4}},
+                                                                {"0.01", {19.5, 3.8}},
+                                                                {"0.001", {18.3, 8.6}}};
   for (const auto& r : rows) {
     const std::string g = r.at("held_out_g_m_s2");
     SCOPED_TRACE(g);
     ASSERT_EQ(stated.count(g), 1u);
     EXPECT_NEAR(std::stod(r.at("zstop_median_err_pct")), stated.at(g).first, 1.0);
     EXPECT_NEAR(std::stod(r.at("tstop_median_err_pct")), stated.at(g).second, 1.0);
-    const bool outer = g == "9.81" || g == "0.001";
-    EXPECT_EQ(r.at("range"), outer ? "outside" : "inside");
-    if (g == "1.62" || g == "0.1") EXPECT_EQ(r.at("verdict").rfind("within the targets", 0), 0u) << r.at("verdict");
-    if (g == "0.01") {
-      EXPECT_EQ(r.at("verdict").rfind("misses the targets: zstop", 0), 0u) << r.at("verdict");
-      EXPECT_NE(r.at("verdict").find("both regimes miss"), std::string::npos) << r.at("verdict");
-    }
+    EXPECT_NEAR(std::stod(r.at("zstop_all_levels_err_pct")), std::stod(r.at("zstop_median_err_pct")), 2.0);
+    EXPECT_EQ(r.at("range"), g == "9.81" || g == "0.001" ? "outside" : "inside");
+    EXPECT_NE(r.at("verdict").find("the form of the law misses this level even with it in the fit"), std::string::npos)
+        << r.at("verdict");
+    EXPECT_NE(r.at("verdict").find("beyond a target at Fr 0.2 (zstop -"), std::string::npos) << r.at("verdict");
+  }
+  const auto by_froude = csv_rows("model lolo" + sweep_levels() + law + " --per-froude", out);
+  ASSERT_EQ(by_froude.size(), 25u) << out;
+  for (const auto& r : by_froude) {
+    const double fr = std::stod(r.at("impact_fr")), z = std::stod(r.at("zstop_mean_err_pct"));
+    if (fr < 0.3) EXPECT_LT(z, -10) << r.at("held_out_g_m_s2");
+    if (fr > 0.8 && fr < 3) EXPECT_GT(z, 10) << r.at("held_out_g_m_s2") << " Fr " << fr;
   }
   const auto plain = csv_rows("model lolo" + sweep_levels(), out);
   ASSERT_EQ(plain.size(), 5u) << out;
   for (const auto& r : plain) EXPECT_GT(std::stod(r.at("zstop_median_err_pct")), 30.0) << r.at("held_out_g_m_s2");
 }
 
-// The regime map of the depth-friction law fitted on all five levels: one crossover at the surface
-// for every level, Fr 0.51 (GRAVITY.md), a third of paper II's 1.5; a drop that starts above it
+// The regime map of the depth-friction law fitted on all five levels, and the crossover by three
+// definitions: the drag equals the quasi-static resistance at the surface at Fr 0.69 at every
+// level, does half the work of a whole collision at Fr 1.44 and carries half its impulse at Fr
+// 2.63: paper II's ~1.5 is the energy definition. A drop that starts above the surface crossover
 // crosses it on its way down, one that starts below is quasi-static from the impact on.
-TEST(GravitySweep, TheRegimeMapOfTheFiveLevelsCrossesAtFroude051) {
+TEST(GravitySweep, TheCrossoverOfTheFiveLevelsByThreeDefinitions) {
   std::string out;
   const auto rows = csv_rows("model regimes" + sweep_levels() + " --law scaled_base+gravity_depth_friction", out);
   std::printf("%s", out.c_str());
@@ -125,22 +143,25 @@ TEST(GravitySweep, TheRegimeMapOfTheFiveLevelsCrossesAtFroude051) {
   for (const auto& r : rows) {
     SCOPED_TRACE(r.at("trial_id"));
     const double crossover = std::stod(r.at("law_crossover_fr"));
-    EXPECT_NEAR(crossover, 0.511, 0.005);
+    EXPECT_NEAR(crossover, 0.693, 0.005);
     EXPECT_EQ(r.at("paper_ii_fr"), "1.5");
     EXPECT_EQ(r.at("crossover_fr") != "-", std::stod(r.at("impact_fr")) > crossover) << r.at("impact_fr");
   }
+  const auto table = gravsweep::testing::run_gravsweep(
+      "model regimes" + sweep_levels() + " --law scaled_base+gravity_depth_friction", false);
+  EXPECT_NE(table.out.find("the drag does half the work at Fr 1.44 +- 0.038 and carries half the impulse at Fr 2.63"),
+            std::string::npos)
+      << table.out;
 }
 
-// `model rank --scaled` on the five levels names the depth friction that follows g, and reports
-// the best generated form (a drag concentrated within two grain diameters of the surface) as
-// tried but not named: it fits the traces better held out but lengthens the predicted durations.
+// `model rank --scaled` on the five levels names the depth friction that follows g (held-out
+// trace error down 25 %, better on 46 of 50 drops); no generated form is significant.
 TEST(GravitySweep, TheScaledRankOnTheFiveLevelsNamesTheDepthFrictionThatFollowsGravity) {
   const auto r = gravsweep::testing::run_gravsweep("model rank" + sweep_levels() + " --scaled", false);
   ASSERT_EQ(r.code, 0) << r.out;
   std::printf("%s", r.out.c_str());
   EXPECT_NE(r.out.find("Verdict: missing effect: gravity_depth_friction ("), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("the best generated form, c * v^2*exp(-z/0.02):shared"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find(": not named"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("better on 46 of 50 trials"), std::string::npos) << r.out;
 }
 
 // At 0.001 m/s2 and Fr 10, processed in the paper's fixed hertz and seconds, the collision "ended"
@@ -167,4 +188,5 @@ TEST(GravitySweep, AtOneThousandthGTheFroudeTenCollisionEndsAtItsMaximumDepth) {
   const auto own = fraction_at_end("froude");
   ASSERT_EQ(own.size(), 2u);
   for (double f : own) EXPECT_GE(f, 0.97);
+  std::printf("depth at the end / zstop: fixed %.3f %.3f, own scales %.3f %.3f\n", fixed[0], fixed[1], own[0], own[1]);
 }
