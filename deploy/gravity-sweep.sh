@@ -6,6 +6,8 @@
 #   deploy/gravity-sweep.sh run      submit examples/gravity_sweep/*.json and run the workers
 #   deploy/gravity-sweep.sh status   progress with ETA
 #   deploy/gravity-sweep.sh export   finished levels -> data/gravity_sweep/ (measurement format, 2 kHz)
+#   deploy/gravity-sweep.sh table    data/gravity_sweep/results.csv: every committed folder's drops in one
+#                                    table (the union of their columns, a column `folder` first)
 #
 # Environment: GRAVSWEEP_CAMPAIGN (default runs/gravity_sweep/sweep.db), GRAVSWEEP_BIN (default
 # build/scheduler/gravsweep), WORKERS (1), THREADS (2), SPECS (the folder of level specs, default
@@ -45,12 +47,36 @@ case "${1:-}" in
         echo "export: $sweep: nothing exported (see above)"; rm -rf "$dir.tmp"
       fi
     done
-    "$gs" results --db "$db" --where 'sweep~gravity_sweep_' --where "kind=drop" --all --format csv \
-      --out "$data/results.csv"
+    "$0" table
     du -sh "$data"
     ;;
+  table)
+    # The committed folders' result rows in one table; a drop in two folders is refused.
+    /usr/bin/python3 - "$data" <<'PY'
+import csv, glob, os, sys
+data = sys.argv[1]
+rows, cols, seen = [], ["folder"], {}
+for path in sorted(glob.glob(os.path.join(data, "g*", "results.csv"))):
+    folder = os.path.basename(os.path.dirname(path))
+    with open(path, newline="") as f:
+        reader = csv.DictReader(f)
+        for name in reader.fieldnames:
+            if name not in cols:
+                cols.append(name)
+        for r in reader:
+            if r["job_id"] in seen:
+                sys.exit(f"{path}: drop {r['job_id']} is also in {seen[r['job_id']]}")
+            seen[r["job_id"]] = folder
+            rows.append(dict(r, folder=folder))
+with open(os.path.join(data, "results.csv"), "w", newline="") as f:
+    w = csv.DictWriter(f, fieldnames=cols, restval="")
+    w.writeheader()
+    w.writerows(rows)
+print(f"{len(rows)} drops from {len(set(seen.values()))} folders -> {os.path.join(data, 'results.csv')}")
+PY
+    ;;
   *)
-    sed -n '2,12p' "$0"
+    sed -n '2,14p' "$0"
     exit 2
     ;;
 esac
