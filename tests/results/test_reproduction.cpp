@@ -501,9 +501,8 @@ std::pair<int, int> fast_grains(const gravsweep::results::BedData& b, double spe
 TEST(Reproduction, ThePkdgravBedIsOrderedWithItsFastGrainsAtTheFloor) {
   namespace fs = std::filesystem;
   const fs::path beds = fs::path(GRAVSWEEP_SOURCE_DIR) / "data/reproduction/beds";
-  const auto pkd = gravsweep::results::read_bed(beds / "ef2d61bc91083ece4a6c.h5");  // part 5, 9,333 grains
-  const auto chrono =
-      gravsweep::results::read_bed(beds / "516d5e9739ddeb48fb02.h5");  // 10 cm Chrono bed (parts 1, 1b, 3)
+  const auto pkd = gravsweep::results::read_bed(beds / "ef2d61bc91083ece4a6c.h5");     // part 5, 9,333 grains
+  const auto chrono = gravsweep::results::read_bed(beds / "bc8dcb3a1b26b1148049.h5");  // Chrono bed, 12 cm (part 3)
   const double phi_pkd = core_packing_fraction(pkd), phi_chrono = core_packing_fraction(chrono);
   const auto [fast_pkd, floor_pkd] = fast_grains(pkd, 1e-2);
   const auto [fast_chrono, floor_chrono] = fast_grains(chrono, 1e-3);
