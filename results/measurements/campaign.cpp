@@ -41,10 +41,10 @@ void process_trial(MeasuredTrial& t) {
     o.cutoff_hz = t.info.filter_cutoff_hz;
     o.end_hold_s = kPaperEndHold_s;
     t.processed = process_trace(t.raw, o);
-    t.processed.metrics.note += fmt::format("{}processed in the paper's fixed scales ({:g} Hz, {:g} s hold): the "
-                                            "record is too short for its drop-scaled filter ({})",
-                                            t.processed.metrics.note.empty() ? "" : "; ", o.cutoff_hz,
-                                            o.end_hold_s, e.what());
+    t.processed.metrics.note += fmt::format(
+        "{}processed in the paper's fixed scales ({:g} Hz, {:g} s hold): the "
+        "record is too short for its drop-scaled filter ({})",
+        t.processed.metrics.note.empty() ? "" : "; ", o.cutoff_hz, o.end_hold_s, e.what());
   }
   // Fit window: inside the collision, two filter edge widths clear of contact and stop.
   const auto& p = t.processed;

@@ -30,8 +30,8 @@ inline constexpr const char* kImportedFileKind = "imported SQLite file";
 /// `path` and what was expected (no such path, an empty file, a file of neither kind, a bad --where).
 /// `processing`: the choice given to every trial (ProcessingChoice; an imported file's trials are
 /// processed again from their stored raw traces).
-CampaignInput load_trial_input(const std::string& path, const std::vector<std::string>& where,
-                               double cutoff_hz = 500.0, const ProcessingChoice& processing = {});
+CampaignInput load_trial_input(const std::string& path, const std::vector<std::string>& where, double cutoff_hz = 500.0,
+                               const ProcessingChoice& processing = {});
 
 /// A trial as the row --where sees: its fields (with the read-only aliases), its attributes and its
 /// numeric metrics (not the processing note: a trial may have a "note" attribute).
