@@ -66,6 +66,27 @@ std::map<std::string, int> check_provenance(const std::vector<std::string>& vers
   return count;
 }
 
+/// The beds of the drops to export, by bed job (one read each), and their count per code version,
+/// refusing (UsageError) a bed from a dirty build unless --allow-dirty, as check_provenance refuses
+/// a drop: a drop of a clean build on a bed of uncommitted code is not reproducible either.
+using BedsByJob = std::map<std::string, std::optional<results::BedData>>;
+std::map<std::string, int> check_bed_provenance(const BedsByJob& beds, const ExportOptions& o) {
+  std::map<std::string, int> count;
+  std::vector<std::string> dirty;
+  for (const auto& [job, bed] : beds) {
+    const std::string v = bed ? bed->code_version : std::string("unknown (bed file not found)");
+    ++count[v];
+    if (pipeline::is_dirty_build(v)) dirty.push_back(fmt::format("{} ({})", job, v));
+  }
+  if (!dirty.empty() && !o.allow_dirty)
+    throw UsageError(
+        fmt::format("{}: {} of {} beds come from builds with uncommitted changes: {}. A dataset must name the commit "
+                    "that made its beds too: prepare them again with a build of a clean commit, or give --allow-dirty "
+                    "(recorded in {}/provenance.json)",
+                    o.db, dirty.size(), beds.size(), fmt::join(dirty, ", "), o.out));
+  return count;
+}
+
 /// Columns of trials.csv after the trial record's own (results::trial_fields()): the DEM
 /// provenance that the record does not carry.
 const std::vector<std::string> kDemColumns = {"source", "contact_start_s", "sweep",           "scenario_file",
@@ -170,6 +191,13 @@ void run_export(const ExportOptions& o) {
   for (const auto& r : t.rows)
     if (exported(r)) versions.push_back(r[c_version].is_string() ? r[c_version].get<std::string>() : "unknown");
   const auto by_version = check_provenance(versions, o);
+  BedsByJob beds;
+  for (const auto& r : t.rows) {
+    const std::string bed_job = r[c_bed].is_string() ? r[c_bed].get<std::string>() : std::string();
+    if (!exported(r) || beds.count(bed_job)) continue;
+    beds[bed_job] = bed_of(db, paths, results::read_trace(paths.abs(r[c_trace].get<std::string>())), bed_job);
+  }
+  const auto beds_by_version = check_bed_provenance(beds, o);
   const fs::path out(o.out);
   fs::create_directories(out / "traces");
   fs::create_directories(out / "scenarios");
@@ -179,7 +207,7 @@ void run_export(const ExportOptions& o) {
     const std::string job = r[c_job].get<std::string>();
     const fs::path trace_path = paths.abs(r[c_trace].get<std::string>());
     const results::TraceData td = results::read_trace(trace_path);
-    const auto bed = bed_of(db, paths, td, r[c_bed].is_string() ? r[c_bed].get<std::string>() : std::string());
+    const auto& bed = beds.at(r[c_bed].is_string() ? r[c_bed].get<std::string>() : std::string());
     const double rate = write_trace_csv(out / "traces" / (job + ".csv"), td, o.rate_hz);
     write_text_file(out / "scenarios" / (job + ".json"), json::parse(td.scenario_json).dump(2) + "\n");
     trials.add(trial_row(job, r[c_sweep].get<std::string>(), trace_path, td, bed, rate));
@@ -189,6 +217,7 @@ void run_export(const ExportOptions& o) {
   }
   write_text_file(out / "provenance.json", json{{"exported_by", pipeline::build_version()},
                                                 {"drops_by_code_version", by_version},
+                                                {"beds_by_code_version", beds_by_version},
                                                 {"allow_dirty", o.allow_dirty},
                                                 {"sweep", o.sweep},
                                                 {"where", o.where}}
@@ -217,8 +246,8 @@ void setup_export(CLI::App& app) {
       "at 0.4 x the new rate), OUT/scenarios/<job>.json (the scenario of each drop) and OUT/results.csv\n"
       "(the campaign's results table, metrics from the full-rate traces). The folder is what `gravsweep\n"
       "measurements import` and `gravsweep model ...` read. OUT/provenance.json gives the code version of\n"
-      "every drop; drops from a build with uncommitted changes (a code version ending in -dirty) are\n"
-      "refused (exit 2) unless --allow-dirty, which provenance.json records.\n\n"
+      "every drop; drops, or beds, from a build with uncommitted changes (a code version ending in\n"
+      "-dirty) are refused (exit 2) unless --allow-dirty, which provenance.json records.\n\n"
       "Example:\n"
       "  gravsweep export --db paper.db --out data/reproduction --sweep part1_chrono_1g");
   add_campaign_options(sub, o->db, &o->files);

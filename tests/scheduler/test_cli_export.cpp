@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "db/database.h"
+#include "results/io/bed_file.h"
 #include "scheduler/pipeline/impact_runners.h"
 #include "scheduler_test_helpers.h"
 
@@ -25,6 +26,23 @@ std::vector<std::string> lines_of(const std::filesystem::path& p) {
     out.push_back(l);
   }
   return out;
+}
+
+/// Gives every bed file of the campaign's files root this code version (as a build of another
+/// commit would have written it); returns how many.
+int stamp_beds(const std::filesystem::path& files_root, const std::string& version) {
+  int n = 0;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(files_root)) {
+    if (e.path().extension() != ".h5" || e.path().parent_path().filename() == "traces") continue;
+    try {
+      auto bed = results::read_bed(e.path());
+      bed.code_version = version;
+      results::write_bed(e.path(), bed);
+      ++n;
+    } catch (const std::exception&) {  // not a bed file
+    }
+  }
+  return n;
 }
 
 std::string read_text(const std::filesystem::path& p) {
@@ -46,14 +64,17 @@ TEST(CliExport, FinishedDropsBecomeAMeasurementCampaign) {
   ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
   auto r = run_cli({"work", "--db", "c.db", "--workers", "2", "--threads", "1", "--quiet"}, d.path);
   ASSERT_EQ(r.code, 0) << r.err;
-  {  // the drops as a clean commit's build made them (this test's own build may be dirty)
+  {  // the drops and their bed as a clean commit's build made them (this test's own build may be dirty)
     db::Database db((d.path / "c.db").string());
     db.exec("UPDATE results SET code_version='0.1.0+0123456789ab'");
   }
+  ASSERT_EQ(stamp_beds(d.path / "c.files", "0.1.0+0123456789ab"), 1);
   r = run_cli({"export", "--db", "c.db", "--out", "ds", "--rate-hz", "2000"}, d.path);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(json::parse(read_text(d.path / "ds" / "provenance.json"))["drops_by_code_version"],
             (json{{"0.1.0+0123456789ab", 2}}));
+  EXPECT_EQ(json::parse(read_text(d.path / "ds" / "provenance.json"))["beds_by_code_version"],
+            (json{{"0.1.0+0123456789ab", 1}}));
   EXPECT_NE(r.out.find("2 drops exported"), std::string::npos) << r.out;
   const auto trials = lines_of(d.path / "ds" / "trials.csv");
   ASSERT_EQ(trials.size(), 3u);
@@ -74,6 +95,13 @@ TEST(CliExport, FinishedDropsBecomeAMeasurementCampaign) {
   // The folder is a measurement campaign that the import reads.
   r = run_cli({"measurements", "import", "ds", "--db", "ds.db"}, d.path);
   EXPECT_EQ(r.code, 0) << r.err << r.out;
+  // Clean drops on a bed from a build with uncommitted changes: refused as a dirty drop is,
+  // naming the bed, and nothing is written.
+  ASSERT_EQ(stamp_beds(d.path / "c.files", "0.1.0+0123456789ab-dirty"), 1);
+  r = run_cli({"export", "--db", "c.db", "--out", "dirty_bed"}, d.path);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("1 of 1 beds come from builds with uncommitted changes"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(d.path / "dirty_bed"));
   // A drop from a build with uncommitted changes: refused, naming it, and nothing is written;
   // exported with --allow-dirty, which provenance.json records.
   {
