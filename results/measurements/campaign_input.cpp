@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cstdio>
+#include <cmath>
 #include <filesystem>
 #include <set>
 #include <stdexcept>
@@ -43,6 +44,9 @@ nlohmann::json where_row(const MeasuredTrial& t) {
   const nlohmann::json m = t.processed.metrics;
   for (const auto& f : metric_fields())
     if (!f.text) j[f.key] = m[f.key];
+  // The impact Froude number vc / sqrt(g D), for a gravity sweep's subsets ('impact_froude<=1').
+  const double gD = t.info.gravity_m_s2 * t.info.projectile_diameter_m;
+  if (gD > 0) j["impact_froude"] = t.processed.metrics.vc_m_s / std::sqrt(gD);
   return j;
 }
 

@@ -33,8 +33,9 @@ inline constexpr const char* kImportedFileKind = "imported SQLite file";
 CampaignInput load_trial_input(const std::string& path, const std::vector<std::string>& where, double cutoff_hz = 500.0,
                                const ProcessingChoice& processing = {});
 
-/// A trial as the row --where sees: its fields (with the read-only aliases), its attributes and its
-/// numeric metrics (not the processing note: a trial may have a "note" attribute).
+/// A trial as the row --where sees: its fields (with the read-only aliases), its attributes, its
+/// numeric metrics (not the processing note: a trial may have a "note" attribute) and its impact
+/// Froude number `impact_froude` = vc / sqrt(g D).
 nlohmann::json where_row(const MeasuredTrial& t);
 
 /// Keeps the trials whose where_row matches every expression and counts the others in

@@ -22,7 +22,8 @@ constexpr const char* kInputsHelp =
     "every finished drop is a trial), SQLite file from `measurements import`, or lab campaign folder; several are "
     "read as one campaign (e.g. one exported dataset per gravity level)";
 constexpr const char* kWhereHelp =
-    "filter the trials, grammar of `gravsweep results` (e.g. 'gravity_m_s2<1'); repeatable";
+    "filter the trials, grammar of `gravsweep results` (e.g. 'gravity_m_s2<1'; a trial of a folder or an imported "
+    "file also has impact_froude = vc / sqrt(g D): 'impact_froude<=1'); repeatable";
 
 }  // namespace
 

@@ -13,6 +13,7 @@
 
 #include "results/io/csv.h"
 #include "results/measurements/campaign.h"
+#include "tests/common/temp_dir.h"
 #include "results_helpers.h"
 
 namespace {
@@ -189,4 +190,29 @@ TEST(GravitySweep, AtOneThousandthGTheFroudeTenCollisionEndsAtItsMaximumDepth) {
   ASSERT_EQ(own.size(), 2u);
   for (double f : own) EXPECT_GE(f, 0.97);
   std::printf("depth at the end / zstop: fixed %.3f %.3f, own scales %.3f %.3f\n", fixed[0], fixed[1], own[0], own[1]);
+}
+
+// The law's constants depend on the Froude range it is fitted on (GRAVITY.md): on Fr <= 1 alone
+// and on Fr >= 2 alone phi is 0.61 and 1.93, many standard errors apart (`--where
+// 'impact_froude...'`, a trial's vc / sqrt(g D)).
+TEST(GravitySweep, TheLawsConstantsDependOnTheFroudeRangeItIsFittedOn) {
+  const gravsweep::test::TempDir tmp;
+  auto phi = [&](const char* where, double& se) {
+    std::string out;
+    const auto rows = csv_rows("model fit" + sweep_levels() + " --model scaled_base+gravity_depth_friction --where '" +
+                                   where + "' --plot '" + (tmp.path / "error_falls.png").string() + "'",
+                               out);
+    for (const auto& r : rows)
+      if (r.count("parameter") && r.at("parameter") == "scaled_base.phi") {
+        se = std::stod(r.at("std_error"));
+        return std::stod(r.at("value"));
+      }
+    ADD_FAILURE() << out;
+    return 0.0;
+  };
+  double se_low = 0, se_high = 0;
+  const double low = phi("impact_froude<=1.1", se_low), high = phi("impact_froude>=1.5", se_high);
+  EXPECT_NEAR(low, 0.605, 0.01);
+  EXPECT_NEAR(high, 1.93, 0.02);
+  EXPECT_GT(high - low, 5 * std::hypot(se_low, se_high));
 }
