@@ -35,6 +35,17 @@ void add_container_walls(System& sys, const ContainerSpec& c, double height_m, s
   sys.mutable_config().domain = Domain{Vec3(-R, -R, -0.05 * R), Vec3(R, R, height_m + 10 * R)};
 }
 
+void add_lid(System& sys, const ContainerSpec& c, double height_m, std::uint8_t wall_material) {
+  sys.walls.push_back(
+      Wall::disk(kLidWallName, Vec3(0, 0, height_m), -Vec3::UnitZ(), 0.5 * c.diameter_m, wall_material));
+  sys.invalidate();
+}
+
+void remove_lid(System& sys) {
+  const auto n = std::erase_if(sys.walls, [](const Wall& w) { return w.name == kLidWallName; });
+  if (n > 0) sys.invalidate();
+}
+
 std::size_t place_grains(System& sys, const BedSpec& spec) {
   const auto& g = spec.grains;
   const double R_c = 0.5 * spec.container.diameter_m;
@@ -301,12 +312,14 @@ BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progr
   const double wall_h =
       spec.container.wall_height_m > 0 ? spec.container.wall_height_m : std::max(top, spec.fill_height_m) + 0.1;
   add_container_walls(sys, spec.container, wall_h, spec.wall_material);
+  if (spec.lid) add_lid(sys, spec.container, wall_h, spec.wall_material);
   sys.invalidate();
   if (progress) progress(BedPhase::fill, 1.0, fmt::format("{} grains", rep.grains_placed));
   // Settle under gravity.
   const double t0 = sys.time_s();
   rep.settle_end = settle(sys, spec.settle, 0.0, progress, BedPhase::settle, &rep.rms_speed_m_s, &rep.max_speed_m_s);
   rep.settle_time_s = sys.time_s() - t0;
+  remove_lid(sys);
   // Flatten: delete grains whose centre lies above the fill height.
   std::vector<bool> remove(sys.particles.size(), false);
   for (std::size_t i = 0; i < sys.particles.size(); ++i)

@@ -466,6 +466,7 @@ BedSpec bed_spec_of(const json& s, double settle_g, double gravity_m_s2) {
   }
   // Optional and without a default (0 = none), so that the bed keys of existing beds stay.
   b.surface_relax_s = bj.value("surface_relax_s", 0.0);
+  b.lid = bj.value("lid", false);  // optional, no default: the bed keys of open beds stay
   if (bj.contains("time_step")) {  // dt_max_s >= dt_s: check_size_and_steps
     b.time_step.steps_per_contact = bj["/time_step/steps_per_contact"_json_pointer];
     b.time_step.dt_max_s = bj["/time_step/dt_max_s"_json_pointer];

@@ -141,6 +141,12 @@ TEST_F(ImpactPipeline, BedReuseEqualsPreparingTheBedAgain) {
   json other = test::tiny_scenario();
   other["bed"]["seed"] = 8;
   EXPECT_NE(pipeline::bed_key(other), pipeline::bed_key(test::tiny_scenario()));
+  // A lid during the pour is another bed; without the key the bed key is as before it existed.
+  json lidded = test::tiny_scenario();
+  lidded["bed"]["lid"] = true;
+  EXPECT_NE(pipeline::bed_key(lidded), pipeline::bed_key(test::tiny_scenario()));
+  EXPECT_FALSE(pipeline::bed_key(test::tiny_scenario()).at("bed").contains("lid"));
+  EXPECT_TRUE(pipeline::bed_key(lidded).at("bed").at("lid").get<bool>());
 }
 
 TEST_F(ImpactPipeline, DropsOfOtherSpeedsShareTheBedButNotOtherGravity) {
