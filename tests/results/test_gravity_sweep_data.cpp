@@ -3,9 +3,11 @@
 // GRAVITY.md states, so that a change to processing or fitting that moves them fails here.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
@@ -215,4 +217,41 @@ TEST(GravitySweep, TheLawsConstantsDependOnTheFroudeRangeItIsFittedOn) {
   EXPECT_NEAR(low, 0.605, 0.01);
   EXPECT_NEAR(high, 1.93, 0.02);
   EXPECT_GT(high - low, 5 * std::hypot(se_low, se_high));
+}
+
+// Fr 2 and 3 at 9.81 m/s2 (g9.81_fast/): with them every level reaches above Fr 1, and the drops
+// at Fr >= 2 of all five levels collapse (no level effect, p >= 0.01, in all three metrics). Their
+// step: the same drops at 2.5 us on the same sites move zstop by under 0.5 %
+// (dt_check_9.81_fast.csv).
+TEST(GravitySweep, AboveFroudeOneTheFiveLevelsCollapseAndTheStepHoldsAtThreeMetresPerSecond) {
+  std::string out;
+  const auto rows =
+      csv_rows("model collapse" + sweep_levels() + level_folder("g9.81_fast") + " --where 'impact_froude>=1.5'", out);
+  std::printf("%s", out.c_str());
+  ASSERT_EQ(rows.size(), 3u) << out;
+  for (const auto& r : rows) {
+    SCOPED_TRACE(r.at("metric"));
+    EXPECT_EQ(r.at("levels"), "5");
+    EXPECT_EQ(r.at("trials"), "24");
+    EXPECT_GE(std::stod(r.at("level_p")), 0.01);
+  }
+  std::ifstream in(std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "data" / "gravity_sweep" / "dt_check_9.81_fast.csv");
+  ASSERT_TRUE(in.good());
+  gravsweep::results::CsvReader csv(in);
+  std::vector<std::string> header, cells;
+  int line = 0;
+  ASSERT_TRUE(csv.next(header, line));
+  auto col = [&](const char* name) {
+    return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  std::map<std::pair<std::string, std::string>, std::map<std::string, double>> by_site;  // (speed, seed) -> dt -> zstop
+  while (csv.next(cells, line))
+    by_site[{cells.at(col("impact_speed_m_s")), cells.at(col("projectile_seed"))}][cells.at(col("dt_s"))] =
+        std::stod(cells.at(col("zstop_m")));
+  ASSERT_EQ(by_site.size(), 4u);
+  for (const auto& [site, z] : by_site) {
+    ASSERT_EQ(z.size(), 2u);
+    const double fine = z.begin()->second, coarse = z.rbegin()->second;  // "2.5e-06" sorts before "5e-06"
+    EXPECT_NEAR(coarse / fine, 1.0, 0.005) << site.first << " m/s, seed " << site.second;
+  }
 }
