@@ -19,8 +19,8 @@ const char* file_kind(Schema which) {
 }
 
 nlohmann::json read_spec_file(const std::filesystem::path& path, Schema which) {
-  auto fail = [&](std::string source, std::string found, std::string expected) {
-    std::vector<SpecProblem> problems{{"", std::move(found), std::move(expected)}};
+  auto fail = [&](std::string source, std::string found, std::string expected, std::string pointer = {}) {
+    std::vector<SpecProblem> problems{{std::move(pointer), std::move(found), std::move(expected)}};
     if (which == Schema::sweep) throw SpecError::sweep_spec(std::move(source), std::move(problems));
     throw SpecError(std::move(source), std::move(problems));
   };
@@ -29,7 +29,8 @@ nlohmann::json read_spec_file(const std::filesystem::path& path, Schema which) {
   if (!text) fail(path.string(), why, fmt::format("a readable {}", file_kind(which)));
   nlohmann::json doc;
   if (const auto err = parse_json_text(*text, doc))
-    fail(fmt::format("{}:{}:{}", path.string(), err->line, err->column), err->what, "valid JSON");
+    fail(fmt::format("{}:{}:{}", path.string(), err->line, err->column), err->what,
+         err->pointer.empty() ? "valid JSON" : "valid JSON, each key once in an object", err->pointer);
   return doc;
 }
 

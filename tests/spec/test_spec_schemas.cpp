@@ -11,6 +11,7 @@
 #include "tests/common/temp_dir.h"
 #include "results/model/model.h"
 #include "scheduler/sweep/spec.h"
+#include "spec/json_text.h"
 #include "spec/schemas.h"
 
 using namespace gravsweep;
@@ -128,6 +129,32 @@ TEST(SpecSchemas, AModelFileIsCheckedByItsSchemaEveryProblemWithItsPointer) {
     FAIL() << "a length of 0 accepted";
   } catch (const spec::SpecError& e) {
     EXPECT_EQ(e.pointer(), "/terms/0/name") << e.what();
+  }
+}
+
+// A key given twice in one object is refused at its second occurrence, with its JSON pointer and
+// line: a parser keeps one of the two silently (nlohmann's the last), so a sweep with "sweep" twice
+// ran under the second name.
+TEST(SpecSchemas, AKeyGivenTwiceInOneObjectIsRefusedWithItsPointer) {
+  nlohmann::json doc;
+  const auto err = spec::parse_json_text(
+      "{\"a\": 1, \"b\": {\"c\": [{\"x\": 1}, {\"y\": 1,\n \"x\": 2, \"y\": 3}]}, \"x\": 4}", doc);
+  ASSERT_TRUE(err.has_value());
+  EXPECT_EQ(err->pointer, "/b/c/1/y");
+  EXPECT_EQ(err->line, 2u);
+  EXPECT_EQ(err->column, 10u);
+  EXPECT_NE(err->what.find("\"y\" given twice"), std::string::npos) << err->what;
+  EXPECT_FALSE(spec::parse_json_text("{\"a\": {\"x\": 1}, \"b\": {\"x\": 2}, \"c\": [{\"x\": 1}, {\"x\": 2}]}", doc))
+      << "the same key in different objects is fine";
+  test::TempDir d;
+  const fs::path f = d.path / "sweep.json";
+  std::ofstream(f) << "{\"sweep\": \"first\",\n \"base\": {},\n \"sweep\": \"second\"}\n";
+  try {
+    spec::read_spec_file(f, spec::Schema::sweep);
+    FAIL() << "a duplicate key accepted";
+  } catch (const spec::SpecError& e) {
+    EXPECT_EQ(e.pointer(), "/sweep") << e.what();
+    EXPECT_NE(std::string(e.what()).find(f.string() + ":3:2"), std::string::npos) << e.what();
   }
 }
 
