@@ -60,15 +60,17 @@ struct PhysicalRange {
   const char* what;
 };
 
-// Wide on purpose: a wrong unit (g in kg, mm in m) or a corrupt number (1e308) is refused, no
-// real drop is (milligravity asteroid surfaces to 100 g centrifuges, grains to boulders).
+// Wide on purpose: a wrong unit (g in kg, mm in m) or a corrupt number (1e308, 1e-300) is refused,
+// no real drop is (the weakest gravity of a small rubble pile to 100 g centrifuges, grains of dust
+// to boulders). The lower bounds keep every accepted input's fit finite: a mass of 1e-300 kg made
+// the fit's forces underflow and its held-out errors NaN.
 constexpr PhysicalRange kPhysicalRanges[] = {
-    {"gravity_m_s2", 0, 1000, false, "a gravity"},
-    {"impact_speed_m_s", 0, 1000, false, "an impact speed"},
-    {"fill_height_m", 0, 100, false, "a bed depth"},
-    {"projectile_mass_kg", 0, 1000, false, "a projectile mass"},
-    {"projectile_diameter_m", 0, 10, false, "a projectile diameter"},
-    {"grain_diameter_m", 0, 1, false, "a grain diameter"},
+    {"gravity_m_s2", 1e-6, 1000, true, "a gravity"},
+    {"impact_speed_m_s", 1e-6, 1000, true, "an impact speed"},
+    {"fill_height_m", 1e-4, 100, true, "a bed depth"},
+    {"projectile_mass_kg", 1e-6, 1000, true, "a projectile mass"},
+    {"projectile_diameter_m", 1e-4, 10, true, "a projectile diameter"},
+    {"grain_diameter_m", 1e-6, 1, true, "a grain diameter"},
     {"bulk_density_kg_m3", 0, 25000, true, "a bulk density (0: not measured)"},
     {"sample_rate_hz", 0, 1e9, false, "a sample rate"},
     {"drop_height_m", 0, 1000, true, "a drop height"},
