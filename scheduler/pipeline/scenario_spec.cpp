@@ -411,8 +411,9 @@ json job_scenario(const json& stored) {
   json s = stored;
   s.erase(kValidatedByKey);
   s.erase(kAsWrittenKey);  // no-op when absent
-  // Trusted: as validated. Marked by a build that stored no point as written: validated again.
-  return trusted ? s : validate_scenario(s);
+  // Trusted or marked by a build that stored no point as written: the stored scenario, checked
+  // again (validating a validated scenario returns it unchanged).
+  return validate_scenario(s);
 }
 
 json load_scenario(const std::filesystem::path& path) {

@@ -34,15 +34,17 @@ const std::string& validated_by();
 /// never trusted: its workers validate every job again.
 bool validation_is_named();
 /// A validated scenario as a queue job stores it (sweep expansion at submit): marked with
-/// validated_by(), so that a worker of the same build reads it without validating it again, and
+/// validated_by(), which tells a worker of the same build that the stored defaults are its own, and
 /// carrying the point as written, which another build validates with its own rules and defaults.
 nlohmann::json stored_scenario(nlohmann::json validated, nlohmann::json as_written);
 /// The validated scenario of a job (what validate_scenario returns, without the keys above): the
-/// stored one as it is when this build validated it at submit (and validation_is_named()), else
-/// the point as written validated now (a job submitted by another build; one that stored no point
-/// as written has its validated scenario validated again), or the stored text itself validated
-/// now (unmarked: a job submitted before scenarios were stored validated).
-/// Throws as validate_scenario.
+/// stored one, checked again, when this build validated it at submit (and validation_is_named()),
+/// else the point as written validated now (a job submitted by another build; one that stored no
+/// point as written has its validated scenario validated again), or the stored text itself
+/// validated now (unmarked: a job submitted before scenarios were stored validated). The
+/// database is a trust boundary (on PostgreSQL many users write to it): a mark never skips the
+/// checks that bound a job's resources and types; they take milliseconds, a job minutes.
+/// Throws as validate_scenario (a SpecError naming the field's JSON pointer: a permanent failure).
 nlohmann::json job_scenario(const nlohmann::json& stored);
 
 /// How many times validation has run the engine's own checks (each builds an engine System four

@@ -351,25 +351,43 @@ TEST(ScenarioSpec, TheAdaptiveStepsSpeedBoundIsOptionalAndNamed) {
   EXPECT_NE(msg.find("normal_approach"), std::string::npos) << msg;
 }
 
-// A sweep point is validated once, at submit: its jobs store the validated scenario marked with
-// this build's validation and the point as written, and the worker's job_scenario takes the
-// validated one as it is. A job marked by another build is validated again from the point as
+// A sweep point is validated at submit: its jobs store the validated scenario marked with this
+// build's validation and the point as written, and the worker's job_scenario checks the validated
+// one again (unchanged by it). A job marked by another build is validated again from the point as
 // written (that build's own rules and defaults); an unmarked one (older campaigns) is the point.
-TEST(ScenarioSpec, AScenarioThisBuildValidatedAtSubmitIsNotValidatedAgainByTheWorker) {
+TEST(ScenarioSpec, AScenarioValidatedAtSubmitIsCheckedAgainByTheWorker) {
   const json written = minimal();
   const json validated = validate_scenario(written);
   const json stored = pipeline::stored_scenario(validated, written);
   EXPECT_EQ(stored.at(pipeline::kValidatedByKey), pipeline::validated_by());
   EXPECT_EQ(stored.at(pipeline::kAsWrittenKey), written);
   EXPECT_EQ(pipeline::job_scenario(stored), validated);  // the two keys removed, nothing else changed
-  // The mark is trusted when it names one build's rules: a stored value broken after submit is not
-  // looked at again. A build with uncommitted changes trusts no mark (others share its name).
+  // A stored value broken after submit (the database is a trust boundary) is refused whatever the
+  // mark says, naming its field: a permanent failure, not a retry. A string where a number
+  // belongs, likewise (it failed with the JSON library's message, naming no field, retried three
+  // times). A build with uncommitted changes trusts no mark (others share its name) and validates
+  // the point as written, which is intact.
   json broken = stored;
   broken["dt_s"] = -1;
-  if (pipeline::validation_is_named())
-    EXPECT_EQ(pipeline::job_scenario(broken).at("dt_s"), -1);
-  else
+  json typo = stored;
+  typo["gravity_m_s2"] = "NaN";
+  if (pipeline::validation_is_named()) {
+    try {
+      (void)pipeline::job_scenario(broken);
+      ADD_FAILURE() << "a broken stored value passed the mark";
+    } catch (const SpecError& e) {
+      EXPECT_EQ(e.pointer(), "/dt_s") << e.what();
+    }
+    try {
+      (void)pipeline::job_scenario(typo);
+      ADD_FAILURE() << "a string gravity passed the mark";
+    } catch (const SpecError& e) {
+      EXPECT_EQ(e.pointer(), "/gravity_m_s2") << e.what();
+    }
+  } else {
     EXPECT_EQ(pipeline::job_scenario(broken), validated);
+    EXPECT_EQ(pipeline::job_scenario(typo), validated);
+  }
   // Another build's mark: the point as written is validated, not the stored defaults.
   broken[pipeline::kValidatedByKey] = "0.0.0+another schema:000000000000";
   EXPECT_EQ(pipeline::job_scenario(broken), validated);
