@@ -3,6 +3,8 @@
 #include <fcntl.h>
 #include <sys/statvfs.h>
 #include <fmt/format.h>
+
+#include <new>
 #include <unistd.h>
 
 #include <algorithm>
@@ -439,6 +441,11 @@ class Worker {
     } catch (const NumericalFailure& e) {
       a.error = fmt::format("numerical failure at step {}, particle {}: {}", e.step(), e.particle(), e.what());
       a.exit_code = kExitNumerical;
+      a.permanent = true;
+    } catch (const std::bad_alloc&) {
+      // A retry asks for the same memory: the job's sizes exceed this machine.
+      a.error = "out of memory: the job asked for more memory than this machine gives it (a retry would ask again)";
+      a.exit_code = kExitFailure;
       a.permanent = true;
     } catch (const std::exception& e) {
       a.error = e.what();

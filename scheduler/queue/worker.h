@@ -40,8 +40,8 @@ struct RunOutput {
   nlohmann::json report = nlohmann::json::object();
 };
 
-/// Runs one job; throws on failure (gravsweep::ConfigError and NumericalFailure are permanent:
-/// the job goes dead at once; anything else is retried with backoff).
+/// Runs one job; throws on failure (gravsweep::ConfigError, NumericalFailure and std::bad_alloc
+/// are permanent: the job goes dead at once; anything else is retried with backoff).
 using Runner = std::function<RunOutput(const RunContext&)>;
 using RunnerTable = std::map<JobKind, Runner>;
 

@@ -7,7 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "db/database.h"
 #include "scheduler/pipeline/impact_runners.h"
+#include "scheduler/pipeline/scenario_spec.h"
 #include "scheduler_test_helpers.h"
 
 using namespace gravsweep;
@@ -195,4 +197,35 @@ TEST(BadSpecs, AnUnreadableBaseIsOneProblemNotAlsoEveryAxisPointer) {
   EXPECT_NE(r.err.find("(1 problem)"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("'/tmp' is a folder, not a file"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("/axes/0/pointer"), std::string::npos) << r.err;
+}
+
+// The database is a trust boundary: a bed job whose stored scenario was edited after submit (a
+// 1000 m container, with this build's validation mark kept) is refused at once, naming the field,
+// before anything is allocated: one attempt, dead, not three attempts of several GB each.
+TEST(BadSpecs, ATamperedStoredScenarioIsRefusedAtOnceNamingItsField) {
+  TempDir d;
+  json doc = {{"sweep", "tamper"}, {"base", json::parse(tiny_base())}};
+  write_text(d.path / "spec.json", doc.dump());
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
+  {
+    db::Database db((d.path / "c.db").string());
+    db::Statement q(db, "SELECT job_id, scenario_json FROM jobs WHERE kind = 'bed'");
+    ASSERT_TRUE(q.step());
+    const std::string job = q.get_text(0);
+    json s = json::parse(q.get_text(1));
+    s["container"]["diameter_m"] = 1000.0;    // the validated scenario, and the point as written (a
+    if (s.contains(pipeline::kAsWrittenKey))  // build with uncommitted changes trusts no mark)
+      s[pipeline::kAsWrittenKey]["container"]["diameter_m"] = 1000.0;
+    db::Statement u(db, "UPDATE jobs SET scenario_json = ? WHERE job_id = ?");
+    u.bind(1, s.dump());
+    u.bind(2, job);
+    u.step();
+  }
+  const auto r = run_cli({"work", "--db", "c.db", "--workers", "1", "--quiet"}, d.path);
+  db::Database db((d.path / "c.db").string());
+  db::Statement q(db, "SELECT state, attempts, last_error FROM jobs WHERE kind = 'bed'");
+  ASSERT_TRUE(q.step());
+  EXPECT_EQ(q.get_text(0), "dead") << r.err;
+  EXPECT_EQ(q.get_int(1), 1) << "refused at its first attempt, not retried";
+  EXPECT_NE(q.get_text(2).find("/container/diameter_m"), std::string::npos) << q.get_text(2);
 }
