@@ -39,7 +39,9 @@ double clock_s(db::Database& db);
 void ensure_schema(db::Database& db);
 
 /// Where a campaign keeps its files, {beds,traces,noop,tmp,quarantine}/ under the files root:
-/// `files_root` when given, else <db dir>/<db stem>.files/ beside an SQLite file. A PostgreSQL
+/// `files_root` when given, else <db dir>/<db stem>.files/ beside an SQLite file (the file itself:
+/// a symbolic link to it is followed, so that a verb given the link never makes a second
+/// <link stem>.files/ that claims the campaign). A PostgreSQL
 /// campaign needs it given (ConfigError otherwise): the folder every worker node mounts at the
 /// same path.
 struct CampaignPaths {

@@ -193,7 +193,10 @@ CampaignPaths::CampaignPaths(const fs::path& db_path, const fs::path& files_root
         fmt::format("--files: a PostgreSQL campaign ({}) needs its files root given, the folder every "
                     "worker node mounts at the same path (e.g. --files /shared/campaign)",
                     db_path.string()));
-  const fs::path abs = fs::absolute(db_path);
+  // The database file itself, through any symbolic link to it (weakly: it may not exist yet).
+  std::error_code ec;
+  fs::path abs = fs::weakly_canonical(fs::absolute(db_path), ec);
+  if (ec) abs = fs::absolute(db_path);
   root = abs.parent_path() / (abs.stem().string() + ".files");
 }
 

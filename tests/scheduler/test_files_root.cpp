@@ -119,6 +119,20 @@ TEST(FilesRoot, SubmitWritesTheMarkerNamingTheCampaign) {
   EXPECT_EQ(marker_id(d.path / "c.files"), id);
 }
 
+// A database reached through a symbolic link keeps its own files root: resume through the link
+// made a <link>.files/ holding a marker with the real campaign's id, which a later work would
+// have taken as the campaign's own.
+TEST(FilesRoot, AVerbGivenASymlinkToTheDatabaseUsesTheDatabasesOwnFolder) {
+  TempDir d;
+  ASSERT_NO_FATAL_FAILURE(finished_campaign(d.path, 2));
+  std::filesystem::create_symlink("c.db", d.path / "link.db");
+  const auto r = run_cli({"resume", "--db", "link.db"}, d.path);
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(d.path / "link.files")) << "a second files root was made for the link";
+  db::Database db((d.path / "c.db").string());
+  EXPECT_EQ(marker_id(d.path / "c.files"), sql_text(db, "SELECT value FROM queue_meta WHERE key='campaign_id'"));
+}
+
 TEST(FilesRoot, AnotherCampaignsFolderIsRefusedBeforeAnythingMoves) {
   TempDir d;
   ASSERT_NO_FATAL_FAILURE(finished_campaign(d.path, 3, "other"));
