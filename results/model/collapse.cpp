@@ -9,6 +9,7 @@
 #include <map>
 
 #include "results/measurements/trial.h"
+#include "results/model/froude.h"
 #include "results/model/stats.h"
 
 namespace gravsweep::results {
@@ -40,19 +41,18 @@ double poly_at(const Eigen::VectorXd& c, double x) {
   return y;
 }
 
-/// Froude numbers closer than this in ln Fr (5 %) are one speed of the design: repeats of one
-/// point differ by their measured impact speeds, and a curve must not bend between them.
-constexpr double kSameFroudeLn = 0.05;
-
-/// Distinct Froude numbers among the points (clusters closer than kSameFroudeLn in ln Fr).
-int distinct_x(const std::vector<Point>& pts) {
+/// The design's Froude number of each point (froude_groups): repeats of one point differ by their
+/// measured impact speeds, and a curve must not bend between them.
+std::vector<int> froude_groups_of(const std::vector<Point>& pts) {
   std::vector<double> x;
   for (const auto& p : pts) x.push_back(p.x);
-  std::sort(x.begin(), x.end());
-  int n = 0;
-  for (std::size_t i = 0; i < x.size(); ++i)
-    if (i == 0 || x[i] - x[i - 1] > kSameFroudeLn) ++n;
-  return n;
+  return froude_groups(x);
+}
+
+/// Distinct Froude numbers of the design among the points.
+int distinct_x(const std::vector<Point>& pts) {
+  const std::vector<int> g = froude_groups_of(pts);
+  return g.empty() ? 0 : *std::max_element(g.begin(), g.end()) + 1;
 }
 
 double pct(double ln_scatter) { return 100 * (std::exp(ln_scatter) - 1); }
@@ -78,24 +78,9 @@ double overlap_rms(const LevelCurve& a, const LevelCurve& b, double& weight) {
   return s2 / kGrid;
 }
 
-/// The design's Froude number of each point: clusters of ln Fr closer than kSameFroudeLn, over
-/// all levels (repeats differ by their measured impact speeds).
-std::vector<int> froude_groups(const std::vector<Point>& pts) {
-  std::vector<std::size_t> order(pts.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return pts[a].x < pts[b].x; });
-  std::vector<int> group(pts.size(), 0);
-  int g = -1;
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    if (k == 0 || pts[order[k]].x - pts[order[k - 1]].x > kSameFroudeLn) ++g;
-    group[order[k]] = g;
-  }
-  return group;
-}
-
 /// The nested analysis of variance of CollapseRow (level within Froude number, repeats within cell).
 void level_effect(const std::vector<Point>& pts, CollapseRow& r) {
-  const std::vector<int> group = froude_groups(pts);
+  const std::vector<int> group = froude_groups_of(pts);  // over all levels
   // cells[(group, level)] -> the points' y
   std::map<std::pair<int, double>, std::vector<double>> cells;
   for (std::size_t i = 0; i < pts.size(); ++i) cells[{group[i], pts[i].level_m_s2}].push_back(pts[i].y);

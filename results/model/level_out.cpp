@@ -8,6 +8,7 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "results/model/froude.h"
 #include "results/model/model_internal.h"
 #include "results/model/regimes.h"
 
@@ -122,23 +123,21 @@ std::pair<double, double> prediction_sd_pct(const FittedModel& law, const Trial&
           100 * std::sqrt(std::max(0.0, dt.dot(law.cov * dt))) / p.tstop_s};
 }
 
-/// Impact Froude numbers closer than this in ln Fr (5 %) are one speed of the design.
-constexpr double kSameFroudeLn = 0.05;
-
-/// The held-out drops grouped by the design's Froude number, with their signed mean errors.
+/// The held-out drops grouped by the design's Froude number (froude_groups), with their signed
+/// mean errors.
 std::vector<LevelOutFroude> by_froude(const std::vector<LevelOutTrial>& per_trial) {
-  std::vector<const LevelOutTrial*> sorted;
+  std::vector<const LevelOutTrial*> drops;
+  std::vector<double> ln_fr;
   for (const auto& t : per_trial)
-    if (std::isfinite(t.impact_froude)) sorted.push_back(&t);
-  std::sort(sorted.begin(), sorted.end(),
-            [](const LevelOutTrial* a, const LevelOutTrial* b) { return a->impact_froude < b->impact_froude; });
+    if (std::isfinite(t.impact_froude) && t.impact_froude > 0) {
+      drops.push_back(&t);
+      ln_fr.push_back(std::log(t.impact_froude));
+    }
+  const std::vector<int> group = froude_groups(ln_fr);
+  const int n_groups = group.empty() ? 0 : *std::max_element(group.begin(), group.end()) + 1;
+  std::vector<std::vector<const LevelOutTrial*>> groups(static_cast<std::size_t>(n_groups));
+  for (std::size_t k = 0; k < drops.size(); ++k) groups[static_cast<std::size_t>(group[k])].push_back(drops[k]);
   std::vector<LevelOutFroude> out;
-  std::vector<std::vector<const LevelOutTrial*>> groups;
-  for (std::size_t k = 0; k < sorted.size(); ++k) {
-    if (k == 0 || std::log(sorted[k]->impact_froude / sorted[k - 1]->impact_froude) > kSameFroudeLn)
-      groups.emplace_back();
-    groups.back().push_back(sorted[k]);
-  }
   for (const auto& grp : groups) {
     LevelOutFroude f;
     f.drops = static_cast<int>(grp.size());

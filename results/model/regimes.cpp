@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "results/model/froude.h"
 #include "results/model/model_internal.h"
 
 namespace gravsweep::results {
@@ -115,24 +116,26 @@ double crossing_of(const std::vector<std::pair<double, double>>& pts) {
 }  // namespace
 
 double whole_collision_crossover(const std::vector<RegimeTrial>& map, CrossoverShare share) {
-  constexpr double kSameFroudeLn = 0.05;
-  std::vector<std::pair<double, double>> drops;  // (ln Fr, dynamic share %)
+  std::vector<double> ln_fr, dynamic_pct;
   for (const auto& r : map) {
     const double qs = share == CrossoverShare::impulse ? r.quasi_static_impulse_pct : r.quasi_static_work_pct;
-    if (std::isfinite(r.impact_froude) && r.impact_froude > 0 && std::isfinite(qs))
-      drops.emplace_back(std::log(r.impact_froude), 100 - qs);
+    if (std::isfinite(r.impact_froude) && r.impact_froude > 0 && std::isfinite(qs)) {
+      ln_fr.push_back(std::log(r.impact_froude));
+      dynamic_pct.push_back(100 - qs);
+    }
   }
-  std::sort(drops.begin(), drops.end());
-  std::vector<std::pair<double, double>> mean;
-  for (std::size_t k = 0; k < drops.size();) {
-    std::size_t e = k + 1;
-    while (e < drops.size() && drops[e].first - drops[e - 1].first <= kSameFroudeLn) ++e;
-    double x = 0, y = 0;
-    for (std::size_t j = k; j < e; ++j) x += drops[j].first, y += drops[j].second;
-    const double n = static_cast<double>(e - k);
-    mean.emplace_back(x / n, y / n);
-    k = e;
+  // The design's Froude numbers (froude_groups, numbered from the smallest): mean ln Fr and share.
+  const std::vector<int> group = froude_groups(ln_fr);
+  const int n_groups = group.empty() ? 0 : *std::max_element(group.begin(), group.end()) + 1;
+  std::vector<std::pair<double, double>> mean(static_cast<std::size_t>(n_groups), {0.0, 0.0});
+  std::vector<double> count(static_cast<std::size_t>(n_groups), 0.0);
+  for (std::size_t k = 0; k < group.size(); ++k) {
+    const auto g = static_cast<std::size_t>(group[k]);
+    mean[g].first += ln_fr[k];
+    mean[g].second += dynamic_pct[k];
+    count[g] += 1;
   }
+  for (std::size_t g = 0; g < mean.size(); ++g) mean[g] = {mean[g].first / count[g], mean[g].second / count[g]};
   return crossing_of(mean);
 }
 
