@@ -317,7 +317,9 @@ BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progr
   if (progress) progress(BedPhase::fill, 1.0, fmt::format("{} grains", rep.grains_placed));
   // Settle under gravity.
   const double t0 = sys.time_s();
-  rep.settle_end = settle(sys, spec.settle, 0.0, progress, BedPhase::settle, &rep.rms_speed_m_s, &rep.max_speed_m_s);
+  const AdaptiveStep pour_step = spec.pour_time_step ? spec.time_step : AdaptiveStep{};
+  rep.settle_end =
+      settle(sys, spec.settle, 0.0, progress, BedPhase::settle, &rep.rms_speed_m_s, &rep.max_speed_m_s, pour_step);
   rep.settle_time_s = sys.time_s() - t0;
   remove_lid(sys);
   // Flatten: delete grains whose centre lies above the fill height.
@@ -336,7 +338,7 @@ BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progr
   }
   const bool quenched = spec.quench_interval_s > 0 && spec.quench_time_s > 0;
   // The adaptive step (when on) applies at the drop's gravity only: after a ramp.
-  const AdaptiveStep relax_step = spec.relax_gravity_m_s2 ? spec.time_step : AdaptiveStep{};
+  const AdaptiveStep relax_step = spec.relax_gravity_m_s2 || spec.pour_time_step ? spec.time_step : AdaptiveStep{};
   if (spec.relax_gravity_m_s2)
     ramp_gravity(sys, *spec.relax_gravity_m_s2, spec.gravity_ramp_s, spec.settle.check_interval_s, progress, quenched);
   if (quenched) {

@@ -109,6 +109,11 @@ struct BedSpec {
   /// far (0.3 m from 0.08 m/s at 0.01 m/s2) and may leave the domain (measured: at 0.01 m/s2 a
   /// grain left it after 5.75 s); the lid sends it back. Off: an open container, as the paper's.
   bool lid = false;
+  /// With time_step on: the pour and its settling run at the adaptive step too, and so does the
+  /// relaxation of a bed poured at the drop's gravity (no ramp). Poured at 0.01 m/s2, grains fall
+  /// and settle for tens of seconds at mm/s to cm/s: millions of fixed 5 us steps. Off: the pour
+  /// keeps dt_s, as every earlier bed.
+  bool pour_time_step = false;
 };
 
 /// Phase of bed preparation, for progress reporting.

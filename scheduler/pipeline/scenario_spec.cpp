@@ -471,6 +471,7 @@ BedSpec bed_spec_of(const json& s, double settle_g, double gravity_m_s2) {
   if (bj.contains("time_step")) {  // dt_max_s >= dt_s: check_size_and_steps
     b.time_step.steps_per_contact = bj["/time_step/steps_per_contact"_json_pointer];
     b.time_step.dt_max_s = bj["/time_step/dt_max_s"_json_pointer];
+    b.pour_time_step = bj.at("time_step").value("pour", false);  // optional, no default: bed keys stay
   }
   return b;
 }

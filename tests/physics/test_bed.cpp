@@ -353,3 +353,44 @@ TEST(Bed, ALidKeepsGrainsThrownUpAtLowGravityInTheContainer) {
   EXPECT_EQ(s.walls.size(), 2u);
   EXPECT_EQ(s.walls.back().name, "side");
 }
+
+namespace {
+
+/// A 10 cm cup (3 cm fill, ~300 Table 1 grains) poured, settled and relaxed at 0.1 m/s2 under a
+/// lid, with the adaptive step in the pour (BedSpec::pour_time_step) or at dt_s throughout.
+LowGCup poured_at_low_g(bool adaptive_pour) {
+  SystemConfig cfg = chrono_table1_config(0.09);
+  cfg.dt_s = 1e-5;
+  cfg.threads = 1;
+  cfg.gravity_m_s2 = Vec3(0, 0, -0.1);
+  System s(cfg);
+  BedSpec spec;
+  spec.container.diameter_m = 0.10;
+  spec.fill_height_m = 0.03;
+  spec.seed = 5;
+  spec.lid = true;
+  spec.settle.max_time_s = 2.0;
+  spec.settle.rms_speed_m_s = 1e-4;
+  spec.settle.max_speed_m_s = 2e-3;
+  spec.relax_time_s = 0.2;
+  spec.time_step = AdaptiveStep{20, 2e-4};
+  spec.pour_time_step = adaptive_pour;
+  const BedReport rep = prepare_bed(s, spec);
+  const BedRestState r = bed_rest_state(s, rep.surface_height_m, spec.grains.diameter_m);
+  std::printf("poured at 0.1 m/s2, adaptive pour %d: %zu grains, surface %.4f m, %.2f s settled, %lld steps\n",
+              adaptive_pour, rep.grains_kept, rep.surface_height_m, rep.settle_time_s, s.step_count());
+  EXPECT_EQ(s.walls.size(), 2u) << "the lid comes off before flattening";
+  return {r, rep.surface_height_m, s.step_count()};
+}
+
+}  // namespace
+
+// A bed poured at low gravity (no ramp) with the adaptive step in the pour (/bed/time_step/pour):
+// the same bed in fewer steps (measured: 198,374 against 271,200 at 0.1 m/s2, the grains falling
+// and colliding at cm/s for most of the 2 s), its surface within a grain radius of the fixed step's.
+TEST(Bed, AnAdaptivePourAtLowGravityTakesFewerStepsForTheSameBed) {
+  const LowGCup fixed = poured_at_low_g(false), adaptive = poured_at_low_g(true);
+  EXPECT_LT(static_cast<double>(adaptive.steps), 0.85 * static_cast<double>(fixed.steps));
+  EXPECT_NEAR(adaptive.surface_height_m, fixed.surface_height_m, 0.005);
+  EXPECT_GT(adaptive.surface_height_m, 0.02);
+}
