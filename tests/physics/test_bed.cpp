@@ -18,6 +18,15 @@ using namespace gravsweep::test;
 namespace {
 
 /// Grains poured and settled in a cylinder of the given diameter (Table 1 Chrono set, dt 5 us).
+/// Table 1's Chrono set (mu_r 0.09) on one thread at gravity g_m_s2 (down) and step dt_s.
+SystemConfig one_thread_config(double g_m_s2, double dt_s) {
+  SystemConfig cfg = chrono_table1_config(0.09);
+  cfg.dt_s = dt_s;
+  cfg.threads = 1;
+  cfg.gravity_m_s2 = Vec3(0, 0, -g_m_s2);
+  return cfg;
+}
+
 std::unique_ptr<System> settled_column(double diameter_m, double fill_m, double settle_s, int threads) {
   SystemConfig cfg = chrono_table1_config(0.09);
   cfg.dt_s = 5e-6;
@@ -252,10 +261,7 @@ struct LowGCup {
 /// 9.81 m/s2, ramped to 0.1 m/s2 over 0.1 s under a quench that runs 0.5 s more, then 0.1 s free
 /// (the quench and the free part with `step` when it is on).
 LowGCup low_g_cup(double surface_relax_s, const AdaptiveStep& step = {}) {
-  SystemConfig cfg = chrono_table1_config(0.09);
-  cfg.dt_s = 1e-5;
-  cfg.threads = 1;
-  cfg.gravity_m_s2 = Vec3(0, 0, -kEarthGravity_m_s2);
+  const SystemConfig cfg = one_thread_config(kEarthGravity_m_s2, 1e-5);
   System s(cfg);
   BedSpec spec;
   spec.container.diameter_m = 0.14;
@@ -313,10 +319,7 @@ namespace {
 /// Grains of a 6 cm cup (walls 6 cm tall) thrown up at 3 m/s under 0.01 m/s2 for 0.2 s, with or
 /// without the lid; returns the highest grain centre (m), or throws the engine's NumericalFailure.
 double highest_thrown_grain_m(bool lid) {
-  SystemConfig cfg = chrono_table1_config(0.09);
-  cfg.dt_s = 5e-6;
-  cfg.threads = 1;
-  cfg.gravity_m_s2 = Vec3(0, 0, -0.01);
+  const SystemConfig cfg = one_thread_config(0.01, 5e-6);
   System s(cfg);
   BedSpec spec;
   spec.container.diameter_m = 0.06;
@@ -359,10 +362,7 @@ namespace {
 /// A 10 cm cup (3 cm fill, ~300 Table 1 grains) poured, settled and relaxed at 0.1 m/s2 under a
 /// lid, with the adaptive step in the pour (BedSpec::pour_time_step) or at dt_s throughout.
 LowGCup poured_at_low_g(bool adaptive_pour) {
-  SystemConfig cfg = chrono_table1_config(0.09);
-  cfg.dt_s = 1e-5;
-  cfg.threads = 1;
-  cfg.gravity_m_s2 = Vec3(0, 0, -0.1);
+  const SystemConfig cfg = one_thread_config(0.1, 1e-5);
   System s(cfg);
   BedSpec spec;
   spec.container.diameter_m = 0.10;
