@@ -152,7 +152,8 @@ const char* to_string(SettleEnd e) {
 }
 
 SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress, BedPhase phase,
-                 double* rms_out, double* max_out, const AdaptiveStep& step) {
+                 double* rms_out, double* max_out, const AdaptiveStep& step, StageCursor* cursor,
+                 const IntervalHook& after) {
   const double dt = sys.config().dt_s;  // the adaptive step's floor, and the step after this phase
   const AdaptiveStepScope step_scope(sys);
   // The settling threshold of rolling friction holds for this phase only (SettleCriteria).
@@ -165,17 +166,34 @@ SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const 
     ~ThresholdScope() { sys.mutable_config().options.min_roll_vel_m_s = kept_m_s; }
   } threshold(sys, c.min_roll_vel_m_s);
   const auto check_steps = std::max<long long>(1, std::llround(c.check_interval_s / dt));
-  const double t0 = sys.time_s();
+  StageCursor local;
+  StageCursor& at = cursor != nullptr ? *cursor : local;
+  if (at.intervals == 0) at = StageCursor{0, sys.time_s()};
   double rms = 0, mx = 0;
   SettleEnd end = SettleEnd::time_cap;
-  // Creep floor: the lowest RMS speed since the bed became quiet, and when it was last lowered.
-  double low_m_s = std::numeric_limits<double>::infinity(), low_at_s = 0;
   // A minimum time above the cap wins: the phase runs at least min_time_s (BedSpec::relax_time_s).
   const double cap_s = std::max(c.max_time_s, min_time_s);
-  while (sys.time_s() - t0 < cap_s) {
+  while (sys.time_s() - at.start_s < cap_s) {
     sys.advance(step.on() ? choose_step(sys, step, dt, c.check_interval_s) : check_steps);
+    ++at.intervals;
     grain_speeds(sys, rms, mx);
-    const double elapsed = sys.time_s() - t0;
+    const double elapsed = sys.time_s() - at.start_s;
+    bool ended = false;
+    if (elapsed >= min_time_s && rms < c.rms_speed_m_s && mx < c.max_speed_m_s) {
+      end = SettleEnd::criteria;
+      ended = true;
+    } else if (rms >= c.max_speed_m_s) {  // not quiet yet (pour, avalanche of the whole bed): no floor
+      at.low_m_s = kInf;
+    } else if (rms < kPlateauNewLow * at.low_m_s) {
+      // Creep floor: the lowest RMS speed since the bed became quiet, and when it was last lowered.
+      at.low_m_s = rms;
+      at.low_at_s = elapsed;
+    } else if (c.plateau_window_s > 0 && elapsed >= min_time_s && elapsed - at.low_at_s >= c.plateau_window_s &&
+               rms < at.low_m_s / kPlateauNewLow) {  // at the floor now, not in a burst above it
+      end = SettleEnd::plateau;
+      ended = true;
+    }
+    if (!ended && after && elapsed < cap_s) after(at);
     if (progress) {
       // Progress: the larger of the time fraction and how close the RMS speed is to its target
       // on a log scale (settling is roughly exponential).
@@ -183,20 +201,7 @@ SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const 
       progress(phase, std::max(elapsed / cap_s, speed_frac),
                fmt::format("t={:.3f}s rms={:.2e}m/s max={:.2e}m/s", elapsed, rms, mx));
     }
-    if (elapsed >= min_time_s && rms < c.rms_speed_m_s && mx < c.max_speed_m_s) {
-      end = SettleEnd::criteria;
-      break;
-    }
-    if (rms >= c.max_speed_m_s) {  // not quiet yet (pour, avalanche of the whole bed): no floor
-      low_m_s = std::numeric_limits<double>::infinity();
-    } else if (rms < kPlateauNewLow * low_m_s) {
-      low_m_s = rms;
-      low_at_s = elapsed;
-    } else if (c.plateau_window_s > 0 && elapsed >= min_time_s && elapsed - low_at_s >= c.plateau_window_s &&
-               rms < low_m_s / kPlateauNewLow) {  // at the floor now, not in a burst above it
-      end = SettleEnd::plateau;
-      break;
-    }
+    if (ended) break;
   }
   if (rms_out) *rms_out = rms;
   if (max_out) *max_out = mx;
@@ -214,47 +219,103 @@ void stop_grains(System& sys) {
   }
 }
 
-void quench(System& sys, double time_s, double interval_s, const BedProgress& progress, const AdaptiveStep& step) {
+namespace {
+
+/// The cursor a loop runs on: the caller's, or a fresh one; a cursor at 0 intervals starts now.
+StageCursor& cursor_or(StageCursor* cursor, StageCursor& local, const System& sys) {
+  StageCursor& at = cursor != nullptr ? *cursor : local;
+  if (at.intervals == 0) at = StageCursor{0, sys.time_s()};
+  return at;
+}
+
+/// `total` steps in chunks of `chunk`, from the cursor on: `before(k)` ahead of chunk k (the ramp's
+/// gravity), `after(k)` behind it (the quench), then the hook (every chunk but the last: the state
+/// it sees is complete), then `report(k)` (progress, which may throw on a stop request: after the
+/// hook, so that a stop is saved first).
+template <class Before, class After, class Report>
+void run_chunks(System& sys, long long total, long long chunk, StageCursor& at, const IntervalHook& hook,
+                const Before& before, const After& after, const Report& report) {
+  for (long long k = at.intervals * chunk; k < total; k += chunk) {
+    before(k);
+    sys.advance(std::min(chunk, total - k));
+    ++at.intervals;
+    after(k);
+    if (hook && k + chunk < total) hook(at);
+    report(k);
+  }
+}
+
+}  // namespace
+
+void quench(System& sys, double time_s, double interval_s, const BedProgress& progress, const AdaptiveStep& step,
+            StageCursor* cursor, const IntervalHook& after) {
   const double dt = sys.config().dt_s;
+  StageCursor local;
+  StageCursor& at = cursor_or(cursor, local, sys);
   const auto report = [&](double done_s) {
     if (progress) progress(BedPhase::relax, done_s / time_s, fmt::format("quench: {:.3f} of {:.3f} s", done_s, time_s));
   };
   if (step.on()) {
     const AdaptiveStepScope step_scope(sys);
     const auto intervals = std::max<long long>(1, std::llround(time_s / interval_s));
-    for (long long k = 0; k < intervals; ++k) {
+    for (long long k = at.intervals; k < intervals; ++k) {
       sys.advance(choose_step(sys, step, dt, interval_s));
       stop_grains(sys);
+      ++at.intervals;
+      if (after && k + 1 < intervals) after(at);
       report(static_cast<double>(k + 1) * interval_s);
     }
     return;
   }
   const long long chunk = std::max<long long>(1, std::llround(interval_s / dt));
   const auto steps = static_cast<long long>(std::llround(time_s / dt));
-  for (long long k = 0; k < steps; k += chunk) {
-    sys.advance(std::min(chunk, steps - k));
-    stop_grains(sys);
-    report(static_cast<double>(k) * dt);
-  }
+  run_chunks(
+      sys, steps, chunk, at, after, [](long long) {}, [&](long long) { stop_grains(sys); },
+      [&](long long k) { report(static_cast<double>(k) * dt); });
+}
+
+void run_for(System& sys, double time_s, double interval_s, const BedProgress& progress, StageCursor* cursor,
+             const IntervalHook& after) {
+  const double dt = sys.config().dt_s;
+  StageCursor local;
+  StageCursor& at = cursor_or(cursor, local, sys);
+  const long long chunk = std::max<long long>(1, std::llround(interval_s / dt));
+  const auto steps = static_cast<long long>(std::llround(time_s / dt));
+  run_chunks(
+      sys, steps, chunk, at, after, [](long long) {}, [](long long) {},
+      [&](long long k) {
+        if (progress)
+          progress(BedPhase::relax, static_cast<double>(std::min(k + chunk, steps)) / static_cast<double>(steps),
+                   fmt::format("surface relax: {:.3f} of {:.3f} s", static_cast<double>(k + chunk) * dt, time_s));
+      });
 }
 
 void ramp_gravity(System& sys, const Vec3& to_m_s2, double ramp_s, double interval_s, const BedProgress& progress,
-                  bool quench_grains) {
+                  bool quench_grains, StageCursor* cursor, const IntervalHook& after) {
   const Vec3 g0 = sys.config().gravity_m_s2;
-  const double n0 = g0.norm(), n1 = to_m_s2.norm();
+  StageCursor local;
+  StageCursor& at = cursor_or(cursor, local, sys);
   const double dt = sys.config().dt_s;
   const auto steps = static_cast<long long>(std::llround(ramp_s / dt));
   const long long chunk = std::max<long long>(1, std::llround(interval_s / dt));
-  const bool same_direction = n0 > 0 && n1 > 0 && g0.dot(to_m_s2) > (1 - 1e-12) * n0 * n1;
+  // The ramp runs from the gravity at its start (kept with the cursor: a resumed ramp is on its way).
+  if (at.intervals == 0) at.from_m_s2 = g0.norm();
+  const double n0 = at.from_m_s2, n1 = to_m_s2.norm();
+  const bool same_direction = n0 > 0 && n1 > 0 && g0.dot(to_m_s2) > (1 - 1e-12) * g0.norm() * n1;
   if (steps > 0 && same_direction) {
-    for (long long k = 0; k < steps; k += chunk) {
-      const double f = static_cast<double>(k) / static_cast<double>(steps);
-      sys.set_gravity(to_m_s2 / n1 * (n0 * std::pow(n1 / n0, f)));  // geometric: equal ratios per step
-      sys.advance(std::min(chunk, steps - k));
-      if (quench_grains) stop_grains(sys);
-      if (progress)
-        progress(BedPhase::relax, 0.0, fmt::format("gravity ramp: {:.3g} m/s2", sys.config().gravity_m_s2.norm()));
-    }
+    run_chunks(
+        sys, steps, chunk, at, after,
+        [&](long long k) {
+          const double f = static_cast<double>(k) / static_cast<double>(steps);
+          sys.set_gravity(to_m_s2 / n1 * (n0 * std::pow(n1 / n0, f)));  // geometric: equal ratios per step
+        },
+        [&](long long) {
+          if (quench_grains) stop_grains(sys);
+        },
+        [&](long long) {
+          if (progress)
+            progress(BedPhase::relax, 0.0, fmt::format("gravity ramp: {:.3g} m/s2", sys.config().gravity_m_s2.norm()));
+        });
   }
   sys.set_gravity(to_m_s2);
 }
@@ -293,70 +354,6 @@ double surface_height(const System& sys, double container_radius_m) {
       ++cnt;
     }
   return cnt > 0 ? sum / static_cast<double>(cnt) : 0.0;
-}
-
-BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progress) {
-  if (!(spec.fill_height_m > 0)) throw ConfigError("bed: fill_height_m must be > 0");
-  if (!(spec.grains.diameter_m > 0)) throw ConfigError("bed: grain diameter_m must be > 0");
-  if (!(spec.grains.diameter_spread_m >= 0 && spec.grains.diameter_spread_m < 0.5 * spec.grains.diameter_m))
-    throw ConfigError("bed: grain diameter_spread_m must be in [0, diameter/2)");
-  if (!(spec.container.diameter_m > 4 * spec.grains.diameter_m))
-    throw ConfigError("bed: container diameter_m must exceed 4 grain diameters");
-  check_adaptive_step(spec.time_step, sys.config().dt_s, "bed");
-  BedReport rep;
-  if (progress) progress(BedPhase::fill, 0.0, "placing grains");
-  rep.grains_placed = place_grains(sys, spec);
-  double top = 0;
-  for (std::size_t i = 0; i < sys.particles.size(); ++i)
-    top = std::max(top, sys.particles.position_m[i].z() + sys.particles.radius_m[i]);
-  const double wall_h =
-      spec.container.wall_height_m > 0 ? spec.container.wall_height_m : std::max(top, spec.fill_height_m) + 0.1;
-  add_container_walls(sys, spec.container, wall_h, spec.wall_material);
-  if (spec.lid) add_lid(sys, spec.container, wall_h, spec.wall_material);
-  sys.invalidate();
-  if (progress) progress(BedPhase::fill, 1.0, fmt::format("{} grains", rep.grains_placed));
-  // Settle under gravity.
-  const double t0 = sys.time_s();
-  const AdaptiveStep pour_step = spec.pour_time_step ? spec.time_step : AdaptiveStep{};
-  rep.settle_end =
-      settle(sys, spec.settle, 0.0, progress, BedPhase::settle, &rep.rms_speed_m_s, &rep.max_speed_m_s, pour_step);
-  rep.settle_time_s = sys.time_s() - t0;
-  remove_lid(sys);
-  // Flatten: delete grains whose centre lies above the fill height.
-  std::vector<bool> remove(sys.particles.size(), false);
-  for (std::size_t i = 0; i < sys.particles.size(); ++i)
-    remove[i] = sys.particles.size_class[i] == SizeClass::grain && sys.particles.position_m[i].z() > spec.fill_height_m;
-  sys.remove_particles(remove);
-  if (progress) progress(BedPhase::flatten, 1.0, fmt::format("{} grains kept", sys.particles.size()));
-  // Relax the new surface (at the drop's gravity when the bed was settled at another, reached by a
-  // geometric ramp so that the contacts unload gradually).
-  if (spec.surface_relax_s > 0) {
-    const auto steps = static_cast<long long>(std::llround(spec.surface_relax_s / sys.config().dt_s));
-    if (progress) progress(BedPhase::relax, 0.0, fmt::format("surface relax: {:.3f} s", spec.surface_relax_s));
-    sys.advance(steps);
-    rep.surface_relax_s = spec.surface_relax_s;
-  }
-  const bool quenched = spec.quench_interval_s > 0 && spec.quench_time_s > 0;
-  // The adaptive step (when on) applies at the drop's gravity only: after a ramp.
-  const AdaptiveStep relax_step = spec.relax_gravity_m_s2 || spec.pour_time_step ? spec.time_step : AdaptiveStep{};
-  if (spec.relax_gravity_m_s2)
-    ramp_gravity(sys, *spec.relax_gravity_m_s2, spec.gravity_ramp_s, spec.settle.check_interval_s, progress, quenched);
-  if (quenched) {
-    quench(sys, spec.quench_time_s, spec.quench_interval_s, progress, relax_step);
-    rep.quench_time_s = spec.quench_time_s;
-  }
-  const double t1 = sys.time_s();
-  rep.relax_end = settle(sys, spec.settle, spec.relax_time_s, progress, BedPhase::relax, &rep.rms_speed_m_s,
-                         &rep.max_speed_m_s, relax_step);
-  rep.relax_time_s = sys.time_s() - t1;
-  rep.settled = rep.settle_end == SettleEnd::criteria && rep.relax_end == SettleEnd::criteria;
-  rep.grains_kept = sys.particles.size();
-  rep.surface_height_m = surface_height(sys, 0.5 * spec.container.diameter_m);
-  double mass = 0;
-  for (double m : sys.particles.mass_kg) mass += m;
-  const double R = 0.5 * spec.container.diameter_m;
-  rep.bulk_density_kg_m3 = rep.surface_height_m > 0 ? mass / (kPi * R * R * rep.surface_height_m) : 0;
-  return rep;
 }
 
 }  // namespace gravsweep

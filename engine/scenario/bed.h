@@ -11,6 +11,7 @@
 
 #include "engine/scenario/time_step.h"
 #include "engine/system/system.h"
+#include "engine/system/system_state.h"
 
 namespace gravsweep {
 
@@ -139,6 +140,53 @@ struct BedReport {
   double bulk_density_kg_m3 = 0;
 };
 
+/// Where a resumable loop of the preparation stands (settle, ramp_gravity, quench, the surface
+/// relaxation): intervals done since the stage began, when it began, and the settling's creep
+/// floor. A loop given a cursor with intervals = 0 starts the stage now; with intervals > 0 it
+/// continues it (the System restored to the state saved with the cursor), bit for bit.
+struct StageCursor {
+  long long intervals = 0;  ///< check (or quench, or ramp) intervals done in the stage
+  double start_s = 0;       ///< System time at the stage's start
+  double low_m_s = kInf;    ///< settle: lowest RMS grain speed since the bed became quiet
+  double low_at_s = 0;      ///< settle: when (since start_s) that low was set
+  double from_m_s2 = 0;     ///< ramp_gravity: the magnitude of gravity at the ramp's start
+};
+
+/// Called after each interval of a loop that the interval did not end (it may throw to stop the
+/// run; the System then holds the state the cursor describes).
+using IntervalHook = std::function<void(const StageCursor&)>;
+
+/// The stages of prepare_bed after the placement, in order. Flattening happens between settle and
+/// surface_relax (a checkpoint of a later stage holds the flattened bed).
+enum class BedStage : std::uint8_t { settle = 0, surface_relax, ramp, quench, relax };
+
+/// Everything prepare_bed keeps between two intervals besides the System (System::save_state):
+/// with both, a bed's preparation continues where it was, bit for bit on the same thread count.
+struct BedLoopState {
+  BedStage stage = BedStage::settle;
+  StageCursor cursor;        ///< the running stage's
+  double wall_height_m = 0;  ///< the container's wall (walls are rebuilt, not stored)
+  BedReport report;          ///< what the finished stages measured
+};
+
+/// A bed saved between two intervals of its preparation.
+struct BedState {
+  SystemState system;
+  BedLoopState loop;
+};
+
+/// Checkpoints of a bed's preparation (as DropCheckpoints for a drop): after each interval that
+/// does not end a stage, `due()` is asked; when it answers true, `save(sys, loop)` stores the state
+/// (it may throw to end the run). With `resume`, prepare_bed continues that preparation instead of
+/// placing grains: `sys` must hold the configuration it was made with; the container's walls are
+/// rebuilt from the saved state, and a state that does not fit is refused with
+/// std::invalid_argument before anything runs.
+struct BedCheckpoints {
+  std::function<bool()> due;
+  std::function<void(const System&, const BedLoopState&)> save;
+  const BedState* resume = nullptr;
+};
+
 /// Adds the container walls (disk bottom at z = 0, cylinder side) to the system.
 void add_container_walls(System& sys, const ContainerSpec& c, double height_m, std::uint8_t wall_material);
 
@@ -155,25 +203,37 @@ std::size_t place_grains(System& sys, const BedSpec& spec);
 /// Runs until the grains meet the criteria, reach their creep floor (c.plateau_window_s) or the time
 /// cap, after at least min_time_s; returns which ended it. With `step` on, the step is chosen
 /// before each check interval (AdaptiveStep) and the system's step is restored at the end.
+/// With `cursor`, the phase starts or continues there and `after` is called after each interval.
 SettleEnd settle(System& sys, const SettleCriteria& c, double min_time_s, const BedProgress& progress, BedPhase phase,
-                 double* rms_out = nullptr, double* max_out = nullptr, const AdaptiveStep& step = {});
+                 double* rms_out = nullptr, double* max_out = nullptr, const AdaptiveStep& step = {},
+                 StageCursor* cursor = nullptr, const IntervalHook& after = {});
 
 /// Takes gravity from its present value to `to_m_s2` geometrically over ramp_s (same direction; in
 /// any other case, or with ramp_s = 0, at once), advancing the system meanwhile.
 /// With quench, stop_grains after each interval (BedSpec::quench_interval_s).
+/// With `cursor`, the ramp starts or continues there and `after` is called after each interval.
 void ramp_gravity(System& sys, const Vec3& to_m_s2, double ramp_s, double interval_s, const BedProgress& progress = {},
-                  bool quench = false);
+                  bool quench = false, StageCursor* cursor = nullptr, const IntervalHook& after = {});
 
 /// Stops each free grain moving against its force, and its spin against its torque (BedSpec quench).
 void stop_grains(System& sys);
 
 /// Runs time_s, applying stop_grains every interval_s (BedSpec::quench_interval_s). With `step`
 /// on, the step is chosen before each interval and the system's step is restored at the end.
+/// With `cursor`, the quench starts or continues there and `after` is called after each interval.
 void quench(System& sys, double time_s, double interval_s, const BedProgress& progress = {},
-            const AdaptiveStep& step = {});
+            const AdaptiveStep& step = {}, StageCursor* cursor = nullptr, const IntervalHook& after = {});
 
-/// The whole preparation: walls, placement, settling, flattening, relaxation.
-BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progress = {});
+/// Runs time_s at the system's step in chunks of interval_s (the flattened surface's relaxation at
+/// the settling gravity, BedSpec::surface_relax_s); with `cursor`, starts or continues there.
+void run_for(System& sys, double time_s, double interval_s, const BedProgress& progress = {},
+             StageCursor* cursor = nullptr, const IntervalHook& after = {});
+
+/// The whole preparation: walls, placement, settling, flattening, relaxation; with checkpoints
+/// (BedCheckpoints), saved between intervals and continued from a saved state
+/// (engine/scenario/bed_prepare.cpp).
+BedReport prepare_bed(System& sys, const BedSpec& spec, const BedProgress& progress = {},
+                      const BedCheckpoints& checkpoints = {});
 
 /// Height of the bed surface: mean of the highest grain tops in the central region.
 double surface_height(const System& sys, double container_radius_m);

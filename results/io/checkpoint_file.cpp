@@ -299,13 +299,63 @@ void visit_loop(Io& io, hid_t root, DropLoopState& st) {
 }
 
 template <class Io>
+void visit_report(Io& io, hid_t g, BedReport& r) {
+  number(io, g, "grains_placed", r.grains_placed);
+  number(io, g, "grains_kept", r.grains_kept);
+  io.attr(g, "settle_time_s", r.settle_time_s);
+  io.attr(g, "relax_time_s", r.relax_time_s);
+  io.attr(g, "quench_time_s", r.quench_time_s);
+  io.attr(g, "surface_relax_s", r.surface_relax_s);
+  number(io, g, "settled", r.settled);
+  number(io, g, "settle_end", r.settle_end);
+  number(io, g, "relax_end", r.relax_end);
+  io.attr(g, "rms_speed_m_s", r.rms_speed_m_s);
+  io.attr(g, "max_speed_m_s", r.max_speed_m_s);
+  io.attr(g, "surface_height_m", r.surface_height_m);
+  io.attr(g, "bulk_density_kg_m3", r.bulk_density_kg_m3);
+}
+
+template <class Io>
+void visit_bed_loop(Io& io, hid_t root, BedLoopState& st) {
+  h5::Handle g = io.group(root, "bed");
+  number(io, g, "stage", st.stage);
+  if constexpr (Io::kReading) {
+    if (static_cast<int>(st.stage) > static_cast<int>(BedStage::relax))
+      throw CheckpointError(
+          fmt::format("{}: stage {} is not a stage of a bed's preparation", h5::where(g), static_cast<int>(st.stage)));
+  }
+  io.attr(g, "intervals", st.cursor.intervals);
+  io.attr(g, "stage_start_s", st.cursor.start_s);
+  io.attr(g, "low_m_s", st.cursor.low_m_s);
+  io.attr(g, "low_at_s", st.cursor.low_at_s);
+  io.attr(g, "ramp_from_m_s2", st.cursor.from_m_s2);
+  io.attr(g, "wall_height_m", st.wall_height_m);
+  visit_report(io, g, st.report);
+}
+
+template <class Io>
 void visit(Io& io, hid_t root, CheckpointData& c) {
+  std::string kind = c.kind();
+  io.attr(root, "kind", kind);
+  if constexpr (Io::kReading) {
+    if (kind == "bed")
+      c.state = BedState{};
+    else if (kind != "drop")
+      throw CheckpointError(fmt::format("kind '{}' is neither 'drop' nor 'bed'", kind));
+  }
   io.attr(root, "code_version", c.code_version);
   io.attr(root, "identity", c.identity_json);
   io.attr(root, "wall_time_s", c.wall_time_s);
   io.attr(root, "resumes", c.resumes);
-  visit_system(io, root, c.drop.system);
-  visit_loop(io, root, c.drop.loop);
+  io.attr(root, "position_s", c.position_s);
+  if (auto* d = std::get_if<DropState>(&c.state)) {
+    visit_system(io, root, d->system);
+    visit_loop(io, root, d->loop);
+  } else {
+    auto& b = std::get<BedState>(c.state);
+    visit_system(io, root, b.system);
+    visit_bed_loop(io, root, b.loop);
+  }
 }
 
 /// fsync of a file or a folder; a failure is an error for a file, ignored for a folder.
@@ -337,7 +387,7 @@ CheckpointData read_checkpoint(const std::filesystem::path& path) {
     h5::File f = h5::File::open_read(path);
     if (!h5::has_attr(f.id(), "format") || h5::get_attr_string(f.id(), "format") != kCheckpointFormat)
       throw CheckpointError(
-          fmt::format("not a gravsweep drop checkpoint (root attribute format != '{}')", kCheckpointFormat));
+          fmt::format("not a gravsweep checkpoint (root attribute format != '{}')", kCheckpointFormat));
     const long long version = h5::get_attr_int(f.id(), "format_version");
     if (version != kCheckpointFormatVersion)
       throw CheckpointError(

@@ -21,9 +21,10 @@ void print_checkpoint_cost(const System& sys, const std::filesystem::path& dir, 
   const std::filesystem::path file = dir / fmt::format("bench-{}.ckpt.h5", static_cast<long>(::getpid()));
   auto t0 = std::chrono::steady_clock::now();
   results::CheckpointData c;
-  c.drop.system = sys.save_state();
-  c.drop.loop.result.samples.resize(samples);  // the trace so far: a drop of samples / rate seconds
-  c.drop.loop.samples_done = static_cast<long long>(samples) - 1;
+  DropState drop{sys.save_state(), {}};
+  drop.loop.result.samples.resize(samples);  // the trace so far: a drop of samples / rate seconds
+  drop.loop.samples_done = static_cast<long long>(samples) - 1;
+  c.state = std::move(drop);
   const double save_s = seconds_since(t0);
   t0 = std::chrono::steady_clock::now();
   results::write_checkpoint(file, c);
@@ -35,7 +36,7 @@ void print_checkpoint_cost(const System& sys, const std::filesystem::path& dir, 
   t0 = std::chrono::steady_clock::now();
   System fresh(sys.config());
   fresh.walls = sys.walls;
-  fresh.restore_state(std::move(back.drop.system));
+  fresh.restore_state(std::get<DropState>(std::move(back.state)).system);
   const double restore_s = seconds_since(t0);
   std::filesystem::remove(file);
   const double n = static_cast<double>(sys.particles.size());
@@ -45,7 +46,7 @@ void print_checkpoint_cost(const System& sys, const std::filesystem::path& dir, 
       "{} bytes each: {:.1f} MB), {} listed pairs, {} wall candidates\n"
       "  save_state {:.3f} s, write + fsync {:.3f} s, read + verify {:.3f} s, restore {:.3f} s\n",
       sys.particles.size(), samples, dir.string(), bytes / 1e6, (bytes - sample_bytes) / n, sizeof(DropSample),
-      sample_bytes / 1e6, c.drop.system.list_neighbor.size(), c.drop.system.wall_candidates.size(), save_s, write_s,
+      sample_bytes / 1e6, c.drop()->system.list_neighbor.size(), c.drop()->system.wall_candidates.size(), save_s, write_s,
       read_s, restore_s);
 }
 

@@ -16,7 +16,7 @@
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
-#include "scheduler/pipeline/drop_checkpoint.h"
+#include "scheduler/pipeline/job_checkpoint.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
 #include "scheduler/queue/spawn.h"

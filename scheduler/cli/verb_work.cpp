@@ -17,7 +17,7 @@
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
-#include "scheduler/pipeline/drop_checkpoint.h"
+#include "scheduler/pipeline/job_checkpoint.h"
 #include "scheduler/queue/stop.h"
 #include "scheduler/pipeline/impact_runners.h"
 #include "scheduler/queue/campaign.h"
@@ -257,7 +257,7 @@ void add_work_options(CLI::App* sub, WorkOptions& o) {
       ->capture_default_str();
   sub->add_option("--max-releases", o.max_releases,
                   "a job whose attempts were interrupted (SIGINT/SIGTERM, a Slurm time limit) this many times in a "
-                  "row without saving progress (a drop's checkpoint further on) is stopped (dead, with the reason) "
+                  "row without saving progress (a checkpoint further on) is stopped (dead, with the reason) "
                   "instead of looping; `resume --dead` runs it again")
       ->check(CLI::Range(1, 1000000))
       ->capture_default_str();
@@ -271,7 +271,8 @@ void add_work_options(CLI::App* sub, WorkOptions& o) {
                   "there (<bed job id>.h5 + .sha256, checksum and bed key verified) copies it instead of "
                   "preparing it; a bed job that prepares its bed stores it there");
   sub->add_option("--checkpoint-interval", o.checkpoint_interval_s,
-                  "wall seconds between two checkpoints of a running drop (<files>/checkpoints/<job>.ckpt.h5; "
+                  "wall seconds between two checkpoints of a running drop or bed preparation "
+                  "(<files>/checkpoints/<job>.ckpt.h5; "
                   "also written at SIGTERM); the next attempt of the job continues from it, bit for bit on "
                   "the same thread count. 0: no checkpoints")
       ->check(CLI::Range(0.0, 1e7))
@@ -295,9 +296,9 @@ void setup_work(CLI::App& app) {
       "back to the queue without being counted against the job.\n"
       "A bed job that runs alone (nothing else running or claimable: its drops wait for it) gets the\n"
       "threads of all the workers (--workers x --threads), so no core idles while it runs.\n"
-      "A running drop is checkpointed every --checkpoint-interval seconds and at SIGTERM (scancel, a\n"
-      "Slurm time limit); the job's next attempt continues from there, so a drop longer than a task's\n"
-      "time limit still finishes.\n\n"
+      "A running drop or bed preparation is checkpointed every --checkpoint-interval seconds and at\n"
+      "SIGTERM (scancel, a Slurm time limit); the job's next attempt continues from there, so a drop\n"
+      "or a bed longer than a task's time limit still finishes.\n\n"
       "Examples:\n"
       "  gravsweep work --db campaign.db --workers 2 --threads 1\n"
       "  gravsweep work --db campaign.db --follow          # a worker that waits for new submissions\n"

@@ -84,16 +84,16 @@ void require_at_rest(const System& sys, const results::BedData& bed, const Scena
       there, r.rms_speed_m_s, c.rms_speed_fraction, c.rms_speed_fraction * v, slowest_impact_at_rest_m_s(r, c)));
 }
 
-/// Runs `drop` continuing ckpt's checkpoint; when the engine refuses that state, the checkpoint
-/// is discarded with a warning and the drop starts over (the refused state changed nothing).
-template <class Drop>
-DropResult resume_or_start(DropCheckpointer& ckpt, const Drop& drop) {
-  if (ckpt.resume() == nullptr) return drop();
+/// Runs `run` continuing ckpt's checkpoint (`resuming`); when the engine refuses that state, the
+/// checkpoint is discarded with a warning and the run starts over (the refused state changed nothing).
+template <class Run>
+auto resume_or_start(JobCheckpointer& ckpt, bool resuming, const Run& run) {
+  if (!resuming) return run();
   try {
-    return drop();
+    return run();
   } catch (const std::invalid_argument& e) {
     ckpt.discard(e.what());
-    return drop();
+    return run();
   }
 }
 
@@ -119,25 +119,13 @@ json bed_key_of_validated(const json& s) {
 
 json bed_key(const json& scenario) { return bed_key_of_validated(validate_scenario(scenario)); }
 
-BedJobResult run_bed_job(const json& scenario, const std::filesystem::path& bed_out, int threads,
-                         const Progress& progress, const std::atomic<bool>* stop) {
-  const json s = job_scenario(scenario);
-  ScenarioParams p = scenario_params(s);
-  check_stop(stop, "bed preparation");
-  if (threads > 0) p.bed_config.threads = threads;
-  const auto t0 = std::chrono::steady_clock::now();
-  System sys(p.bed_config);
-  // Sect. 2.2: mix and settle, flatten, relax; the relaxation is reported as part of "flatten".
-  const BedReport rep = prepare_bed(sys, p.bed, [&](BedPhase ph, double f, const std::string& d) {
-    check_stop(stop, "bed preparation");
-    if (!progress) return;
-    if (ph == BedPhase::relax)
-      progress("flatten", f, "relaxing the surface: " + d);
-    else
-      progress(to_string(ph), f, d);
-  });
-  const double wall_s = seconds_since(t0);
+namespace {
 
+/// Writes the prepared bed and its report (with the checkpoints' counts) to bed_out; removes the
+/// checkpoint once the bed is written.
+BedJobResult write_prepared_bed(const System& sys, const BedReport& rep, const ScenarioParams& p, const json& s,
+                                const std::filesystem::path& bed_out, double wall_s, JobCheckpointer& ckpt,
+                                const std::atomic<bool>* stop) {
   results::BedData b;
   const auto& pt = sys.particles;
   for (std::size_t i = 0; i < pt.size(); ++i) {
@@ -184,10 +172,44 @@ BedJobResult run_bed_job(const json& scenario, const std::filesystem::path& bed_
               {"dt_s", sys.config().dt_s},
               {"threads", sys.threads()},
               {"wall_time_s", wall_s}};
+  ckpt.add_metrics(report);
   b.report_json = report.dump();
   check_stop(stop, "bed preparation");
   results::write_bed(bed_out, b);
+  ckpt.finished();
   return BedJobResult{bed_out, report};
+}
+}  // namespace
+
+BedJobResult run_bed_job(const json& scenario, const std::filesystem::path& bed_out, int threads,
+                         const Progress& progress, const std::atomic<bool>* stop, const Checkpointing& checkpointing) {
+  const json s = job_scenario(scenario);
+  ScenarioParams p = scenario_params(s);
+  check_stop(stop, "bed preparation");
+  if (threads > 0) p.bed_config.threads = threads;
+  const auto t0 = std::chrono::steady_clock::now();
+  std::unique_ptr<System> sys;
+  JobCheckpointer ckpt(
+      checkpointing, "bed",
+      checkpointing.path.empty() ? json() : bed_identity(bed_key_of_validated(s), p.bed_config.threads), stop);
+  // Sect. 2.2: mix and settle, flatten, relax; the relaxation is reported as part of "flatten".
+  const auto prepare = [&] {
+    sys = std::make_unique<System>(p.bed_config);  // a fresh system for each try (a refused resume)
+    return prepare_bed(
+        *sys, p.bed,
+        [&](BedPhase ph, double f, const std::string& d) {
+          check_stop(stop, "bed preparation");
+          if (!progress) return;
+          if (ph == BedPhase::relax)
+            progress("flatten", f, ckpt.detail("relaxing the surface: " + d));
+          else
+            progress(to_string(ph), f, ckpt.detail(d));
+        },
+        ckpt.bed_hooks());
+  };
+  const BedReport rep = resume_or_start(ckpt, ckpt.resume_bed() != nullptr, prepare);
+  const double wall_s = seconds_since(t0) + ckpt.prior_wall_time_s();
+  return write_prepared_bed(*sys, rep, p, s, bed_out, wall_s, ckpt, stop);
 }
 
 std::filesystem::path bed_checksum_path(const std::filesystem::path& bed) { return bed.string() + ".sha256"; }
@@ -372,7 +394,7 @@ void add_dem_metrics(json& m, const results::TraceData& td, const DropResult& dr
 
 DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& bed_in,
                            const std::filesystem::path& trace_out, int threads, const Progress& progress,
-                           const std::atomic<bool>* stop, const DropCheckpointing& checkpointing) {
+                           const std::atomic<bool>* stop, const Checkpointing& checkpointing) {
   const json s = job_scenario(scenario);
   ScenarioParams p = scenario_params(s);
   if (threads > 0) p.drop_config.threads = threads;
@@ -388,8 +410,8 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
 
   std::unique_ptr<results::SnapshotWriter> snaps;
   const DropSnapshots ds = snapshot_hooks(p, bed, trace_out, snaps);
-  DropCheckpointer ckpt(checkpointing, checkpointing.path.empty() ? json() : drop_identity(s, bed_in, sys.threads()),
-                        stop);
+  JobCheckpointer ckpt(checkpointing, "drop",
+                       checkpointing.path.empty() ? json() : drop_identity(s, bed_in, sys.threads()), stop);
   const auto drop = [&] {
     return drop_projectile(
         sys, bed.surface_height_m, p.projectile, p.stop, p.sample_rate_hz,
@@ -397,9 +419,9 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
           check_stop(stop, "drop");
           if (progress) progress("drop", f, ckpt.detail(d));
         },
-        ds, ckpt.hooks(), p.time_step);
+        ds, ckpt.drop_hooks(), p.time_step);
   };
-  const DropResult dr = resume_or_start(ckpt, drop);
+  const DropResult dr = resume_or_start(ckpt, ckpt.resume_drop() != nullptr, drop);
   const double wall_s = seconds_since(t0) + ckpt.prior_wall_time_s();
 
   results::TraceData td = trace_of(dr, p, s, bed, bed_in);

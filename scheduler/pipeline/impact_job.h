@@ -12,7 +12,7 @@
 
 #include "engine/system/system.h"
 #include "results/io/bed_file.h"
-#include "scheduler/pipeline/drop_checkpoint.h"
+#include "scheduler/pipeline/job_checkpoint.h"
 #include "spec/json_schema.h"
 
 namespace gravsweep::pipeline {
@@ -43,8 +43,11 @@ struct DropJobResult {
 /// Validates `scenario` unless this build validated it at submit (job_scenario; throws SpecError,
 /// a ConfigError, with the JSON pointer on bad input), prepares the bed and writes it to bed_out (HDF5), written under
 /// a temporary name then renamed. threads <= 0: the scenario's "threads", else OpenMP's default.
+/// With checkpointing.path set, it continues the preparation saved there if that checkpoint is
+/// usable, saves it there as job_checkpoint.h says, and removes it once the bed is written.
 BedJobResult run_bed_job(const nlohmann::json& scenario, const std::filesystem::path& bed_out, int threads,
-                         const Progress& progress, const std::atomic<bool>* stop);
+                         const Progress& progress, const std::atomic<bool>* stop,
+                         const Checkpointing& checkpointing = {});
 
 /// Validates `scenario` unless this build validated it at submit (job_scenario), loads the bed (its
 /// key must equal the validated scenario's, bed_key_of_validated), drops the projectile, writes the trace
@@ -53,10 +56,10 @@ BedJobResult run_bed_job(const nlohmann::json& scenario, const std::filesystem::
 /// cap) is not an error: the metrics carry "metrics_error" with the reason, and null values.
 /// With /output/snapshot_interval_s > 0 it also writes results::snapshot_path_for(trace_out) and its XDMF.
 /// With checkpointing.path set, it continues the drop saved there if that checkpoint is usable,
-/// saves the drop there as drop_checkpoint.h says, and removes it once the trace is written.
+/// saves the drop there as job_checkpoint.h says, and removes it once the trace is written.
 DropJobResult run_drop_job(const nlohmann::json& scenario, const std::filesystem::path& bed_in,
                            const std::filesystem::path& trace_out, int threads, const Progress& progress,
-                           const std::atomic<bool>* stop, const DropCheckpointing& checkpointing = {});
+                           const std::atomic<bool>* stop, const Checkpointing& checkpointing = {});
 
 /// Canonical key of the bed a scenario needs (container, grains, fill, gravity, materials, contact
 /// law, preparation settings and seed): drops with equal keys share a bed. Validates the scenario.

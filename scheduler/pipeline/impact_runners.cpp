@@ -14,6 +14,22 @@ using queue::RunContext;
 using queue::RunnerTable;
 using queue::RunOutput;
 
+namespace {
+
+/// The job's checkpoints as the worker configured them: saved on SIGTERM (the process's stop
+/// flag), not when another worker took the lease over.
+Checkpointing checkpointing_of(const RunContext& ctx) {
+  Checkpointing ckpt;
+  ckpt.path = ctx.checkpoint;
+  ckpt.interval_s = ctx.checkpoint_interval_s;
+  ckpt.attempt = ctx.claim.attempt;
+  ckpt.save_on_stop = &queue::stop_requested();
+  ckpt.progress_saved = ctx.progress_saved;
+  return ckpt;
+}
+
+}  // namespace
+
 sweep::PointCheckFn impact_point_check() {
   return [](const nlohmann::json& scenario) {
     nlohmann::json validated = validate_scenario(scenario);
@@ -31,7 +47,8 @@ void add_impact_runners(RunnerTable& table) {
         return out;
       }
     }
-    auto r = run_bed_job(ctx.claim.scenario, ctx.output_tmp, ctx.threads, ctx.progress, ctx.stop);
+    auto r =
+        run_bed_job(ctx.claim.scenario, ctx.output_tmp, ctx.threads, ctx.progress, ctx.stop, checkpointing_of(ctx));
     if (r.bed_path != ctx.output_tmp && !r.bed_path.empty()) std::filesystem::rename(r.bed_path, ctx.output_tmp);
     if (!ctx.bed_cache.empty()) store_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.output_tmp);
     out.report = r.report;
@@ -40,14 +57,8 @@ void add_impact_runners(RunnerTable& table) {
   table[sweep::drop_kind()] = [](const RunContext& ctx) {
     if (ctx.dependency_output.empty())
       throw std::runtime_error(fmt::format("drop job {} has no prepared bed", ctx.claim.job_id));
-    DropCheckpointing ckpt;
-    ckpt.path = ctx.checkpoint;
-    ckpt.interval_s = ctx.checkpoint_interval_s;
-    ckpt.attempt = ctx.claim.attempt;
-    ckpt.save_on_stop = &queue::stop_requested();  // SIGTERM, not a lease taken over
-    ckpt.progress_saved = ctx.progress_saved;
     auto r = run_drop_job(ctx.claim.scenario, ctx.dependency_output, ctx.output_tmp, ctx.threads, ctx.progress,
-                          ctx.stop, ckpt);
+                          ctx.stop, checkpointing_of(ctx));
     if (r.trace_path != ctx.output_tmp && !r.trace_path.empty()) std::filesystem::rename(r.trace_path, ctx.output_tmp);
     if (!r.snapshot_path.empty()) {
       // Grain snapshots (/output/snapshot_interval_s > 0): <campaign>.files/snapshots/, a folder that

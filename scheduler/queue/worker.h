@@ -26,11 +26,11 @@ struct RunContext {
   ProgressFn progress;
   const std::atomic<bool>* stop = nullptr;  ///< set when the job must end early
   std::filesystem::path bed_cache;          ///< bed jobs: shared prepared beds (empty: none)
-  /// Drop jobs: this job's checkpoint, <files>/checkpoints/<job>.ckpt.h5 (pipeline/drop_checkpoint.h),
+  /// Drop and bed jobs: this job's checkpoint, <files>/checkpoints/<job>.ckpt.h5 (pipeline/job_checkpoint.h),
   /// written every checkpoint_interval_s of wall time (<= 0: never) and on a stop request.
   std::filesystem::path checkpoint;
   double checkpoint_interval_s = 0;
-  /// Set by a runner that saved state a later attempt continues from (a drop's checkpoint beyond
+  /// Set by a runner that saved state a later attempt continues from (a checkpoint beyond
   /// where this attempt started): a release of such an attempt does not count as a stall.
   std::atomic<bool>* progress_saved = nullptr;
 };

@@ -1,4 +1,4 @@
-// Checkpoint and restart of a drop (scheduler/pipeline/drop_checkpoint.h,
+// Checkpoint and restart of a drop (scheduler/pipeline/job_checkpoint.h,
 // results/io/checkpoint_file.h): a drop interrupted at several points and continued from its
 // checkpoints records the trace of an uninterrupted drop value for value; a checkpoint cut short,
 // with a flipped byte or of another scenario is discarded with a warning naming the file, and the
@@ -45,8 +45,8 @@ class DropCheckpoint : public ::testing::Test {
   std::vector<std::string> warnings_;
   json scenario_ = test::tiny_scenario();  ///< the drop every attempt() runs
 
-  pipeline::DropCheckpointing checkpointing() {
-    pipeline::DropCheckpointing c;
+  pipeline::Checkpointing checkpointing() {
+    pipeline::Checkpointing c;
     c.path = ckpt_;
     c.interval_s = kNeverDue_s;
     c.warn = [this](const std::string& w) { warnings_.push_back(w); };
@@ -126,11 +126,11 @@ DropCheckpoint::AdaptiveRuns DropCheckpoint::run_adaptive_interrupted(const json
 // uninterrupted one.
 TEST_F(DropCheckpoint, ResumedThreeTimesTheTraceIsTheUninterruptedOne) {
   ASSERT_NO_FATAL_FAILURE(interrupted_once(0.03));
-  const double t1 = results::read_checkpoint(ckpt_).drop.loop.result.samples.back().t_s;
+  const double t1 = results::read_checkpoint(ckpt_).drop()->loop.result.samples.back().t_s;
   EXPECT_FALSE(attempt(dir_->path / "never.h5", 0.08));
-  const double t2 = results::read_checkpoint(ckpt_).drop.loop.result.samples.back().t_s;
+  const double t2 = results::read_checkpoint(ckpt_).drop()->loop.result.samples.back().t_s;
   EXPECT_FALSE(attempt(dir_->path / "never.h5", 0.13));
-  const double t3 = results::read_checkpoint(ckpt_).drop.loop.result.samples.back().t_s;
+  const double t3 = results::read_checkpoint(ckpt_).drop()->loop.result.samples.back().t_s;
   EXPECT_LT(t1, t2);
   EXPECT_LT(t2, t3);
   json m;
@@ -172,7 +172,9 @@ TEST_F(DropCheckpoint, FileRoundTripIsExact) {
   const fs::path copy = dir_->path / "copy.ckpt.h5";
   results::write_checkpoint(copy, c);
   const results::CheckpointData d = results::read_checkpoint(copy);
-  const SystemState &a = c.drop.system, &b = d.drop.system;
+  ASSERT_NE(c.drop(), nullptr);
+  ASSERT_NE(d.drop(), nullptr);
+  const SystemState &a = c.drop()->system, &b = d.drop()->system;
   EXPECT_EQ(a.particles.position_m, b.particles.position_m);
   EXPECT_EQ(a.particles.force_N, b.particles.force_N);
   EXPECT_EQ(a.particles.size_class, b.particles.size_class);
@@ -193,9 +195,9 @@ TEST_F(DropCheckpoint, FileRoundTripIsExact) {
   EXPECT_EQ(a.time_s, b.time_s);
   EXPECT_EQ(a.step, b.step);
   EXPECT_TRUE(a.domain.has_value() == b.domain.has_value());
-  EXPECT_EQ(c.drop.loop.samples_done, d.drop.loop.samples_done);
-  EXPECT_EQ(c.drop.loop.result.samples.size(), d.drop.loop.result.samples.size());
-  EXPECT_EQ(c.drop.loop.result.samples.back().position_m, d.drop.loop.result.samples.back().position_m);
+  EXPECT_EQ(c.drop()->loop.samples_done, d.drop()->loop.samples_done);
+  EXPECT_EQ(c.drop()->loop.result.samples.size(), d.drop()->loop.result.samples.size());
+  EXPECT_EQ(c.drop()->loop.result.samples.back().position_m, d.drop()->loop.result.samples.back().position_m);
   EXPECT_EQ(c.identity_json, d.identity_json);
   EXPECT_GT(c.wall_time_s, 0);
 }
@@ -213,7 +215,7 @@ void damage(const fs::path& f, Damage how) {
     std::ofstream(f, std::ios::trunc) << "not a checkpoint\n";
     return;
   }
-  const double x = results::read_checkpoint(f).drop.system.particles.position_m[0].x();
+  const double x = results::read_checkpoint(f).drop()->system.particles.position_m[0].x();
   std::ifstream in(f, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   in.close();

@@ -1,5 +1,5 @@
 // Checkpoints of a campaign's drop through real worker processes (`gravsweep work`,
-// scheduler/pipeline/drop_checkpoint.h): a worker stopped by SIGTERM mid-drop writes the drop's
+// scheduler/pipeline/job_checkpoint.h): a worker stopped by SIGTERM mid-drop writes the drop's
 // checkpoint, gives its lease back and says so in the attempts table; a worker killed by SIGKILL
 // leaves the last periodic checkpoint, which `status` names while the drop runs (and perhaps the
 // temporary of a write it never finished); either way the next worker continues the drop and

@@ -1,4 +1,4 @@
-#include "scheduler/pipeline/drop_checkpoint.h"
+#include "scheduler/pipeline/job_checkpoint.h"
 
 #include <fmt/chrono.h>
 #include <fmt/format.h>
@@ -32,15 +32,17 @@ json drop_identity(const json& validated_scenario, const fs::path& bed, int thre
   return json{{"scenario", validated_scenario}, {"bed_sha256", queue::sha256_file(bed)}, {"threads", threads}};
 }
 
-DropCheckpointer::DropCheckpointer(DropCheckpointing cfg, json identity, const std::atomic<bool>* stop)
-    : cfg_(std::move(cfg)), identity_(std::move(identity)), stop_(stop) {
+json bed_identity(const json& bed_key, int threads) { return json{{"bed_key", bed_key}, {"threads", threads}}; }
+
+JobCheckpointer::JobCheckpointer(Checkpointing cfg, std::string kind, json identity, const std::atomic<bool>* stop)
+    : cfg_(std::move(cfg)), kind_(std::move(kind)), identity_(std::move(identity)), stop_(stop) {
   started_ = last_write_ = std::chrono::steady_clock::now();
   if (cfg_.path.empty()) return;
   remove_stale_temporaries();
   load();
 }
 
-void DropCheckpointer::remove_stale_temporaries() const {
+void JobCheckpointer::remove_stale_temporaries() const {
   // The job's lease is held by this attempt alone: a temporary of its checkpoint is a write that
   // an earlier, killed worker never finished (h5::write_atomically names it <file>.tmp<pid>).
   std::error_code ec;
@@ -53,26 +55,23 @@ void DropCheckpointer::remove_stale_temporaries() const {
   }
 }
 
-double DropCheckpointer::resumed_t_s() const {
-  if (!resume_) return -1.0;
-  return resume_->drop.loop.result.samples.empty() ? 0.0 : resume_->drop.loop.result.samples.back().t_s;
-}
+double JobCheckpointer::resumed_t_s() const { return resume_ ? resume_->position_s : -1.0; }
 
-void DropCheckpointer::warn(const std::string& message) const {
+void JobCheckpointer::warn(const std::string& message) const {
   if (cfg_.warn)
     cfg_.warn(message);
   else
     std::fprintf(stderr, "warning: %s\n", message.c_str());
 }
 
-void DropCheckpointer::load() {
+void JobCheckpointer::load() {
   std::error_code ec;
   if (!fs::exists(cfg_.path, ec)) {
     if (cfg_.attempt > 1)
       warn(
           fmt::format("no checkpoint {} of an earlier attempt (none was due before it ended, or it was removed): "
-                      "the drop starts from its release",
-                      cfg_.path.string()));
+                      "the {} starts from {}",
+                      cfg_.path.string(), kind_, start()));
     return;
   }
   std::string why;
@@ -84,54 +83,74 @@ void DropCheckpointer::load() {
     } catch (const json::exception&) {
       have = json();
     }
-    if (c->code_version != build_version())
+    if (c->kind() != kind_)
+      why = fmt::format("a {} checkpoint, this job is a {}", c->kind(), kind_);
+    else if (c->code_version != build_version())
       why = fmt::format("written by gravsweep {}, this is {}", c->code_version, build_version());
     else if (without_threads(have) != without_threads(identity_))
-      why = fmt::format("written for another drop (its identity differs at {})",
+      why = fmt::format("written for another {} (its identity differs at {})", kind_,
                         json::diff(without_threads(have), without_threads(identity_)).at(0).value("path", "/"));
     else
       resume_ = std::move(c);
     if (resume_ && have.value("threads", 0) != identity_.value("threads", 0))
       warn(
-          fmt::format("checkpoint {} was written on {} threads, the drop continues on {}: the rest of it is not "
+          fmt::format("checkpoint {} was written on {} threads, the {} continues on {}: the rest of it is not "
                       "bit-identical to an uninterrupted run",
-                      cfg_.path.string(), have.value("threads", 0), identity_.value("threads", 0)));
+                      cfg_.path.string(), have.value("threads", 0), kind_, identity_.value("threads", 0)));
   } catch (const results::CheckpointError& e) {
     why = e.what();
   }
   if (!why.empty()) discard(why);
 }
 
-void DropCheckpointer::discard(const std::string& why) {
-  warn(fmt::format("checkpoint {} discarded: {}; the drop starts over from its release", cfg_.path.string(), why));
+void JobCheckpointer::discard(const std::string& why) {
+  warn(fmt::format("checkpoint {} discarded: {}; the {} starts over from {}", cfg_.path.string(), why, kind_, start()));
   resume_.reset();
   std::error_code ec;
   fs::remove(cfg_.path, ec);
 }
 
-DropCheckpoints DropCheckpointer::hooks() {
+bool JobCheckpointer::due() const {
+  const std::atomic<bool>* save_on = cfg_.save_on_stop != nullptr ? cfg_.save_on_stop : stop_;
+  if (save_on != nullptr && save_on->load(std::memory_order_relaxed)) return true;
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - last_write_).count() >= cfg_.interval_s;
+}
+
+DropCheckpoints JobCheckpointer::drop_hooks() {
   DropCheckpoints h;
-  h.resume = resume();
+  h.resume = resume_drop();
   if (cfg_.path.empty() || !(cfg_.interval_s > 0)) return h;
-  h.due = [this] {
-    const std::atomic<bool>* save_on = cfg_.save_on_stop != nullptr ? cfg_.save_on_stop : stop_;
-    if (save_on != nullptr && save_on->load(std::memory_order_relaxed)) return true;
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - last_write_).count() >= cfg_.interval_s;
+  h.due = [this] { return due(); };
+  h.save = [this](const System& sys, const DropLoopState& loop) {
+    results::CheckpointData c;
+    c.state = DropState{sys.save_state(), loop};
+    c.position_s = loop.result.samples.empty() ? 0.0 : loop.result.samples.back().t_s;
+    save(std::move(c));
   };
-  h.save = [this](const System& sys, const DropLoopState& loop) { save(sys, loop); };
   return h;
 }
 
-void DropCheckpointer::save(const System& sys, const DropLoopState& loop) {
-  results::CheckpointData c;
-  c.drop.system = sys.save_state();
-  c.drop.loop = loop;
+BedCheckpoints JobCheckpointer::bed_hooks() {
+  BedCheckpoints h;
+  h.resume = resume_bed();
+  if (cfg_.path.empty() || !(cfg_.interval_s > 0)) return h;
+  h.due = [this] { return due(); };
+  h.save = [this](const System& sys, const BedLoopState& loop) {
+    results::CheckpointData c;
+    c.state = BedState{sys.save_state(), loop};
+    c.position_s = sys.time_s();
+    save(std::move(c));
+  };
+  return h;
+}
+
+void JobCheckpointer::save(results::CheckpointData c) {
   c.identity_json = identity_.dump();
   c.code_version = build_version();
   c.wall_time_s =
       prior_wall_time_s() + std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
   c.resumes = resume_ ? resume_->resumes + 1 : 0;
-  const double t_s = loop.result.samples.empty() ? 0.0 : loop.result.samples.back().t_s;
+  const double t_s = c.position_s;
   try {
     fs::create_directories(cfg_.path.parent_path());
     results::write_checkpoint(cfg_.path, c);
@@ -139,36 +158,34 @@ void DropCheckpointer::save(const System& sys, const DropLoopState& loop) {
     last_t_s_ = t_s;
     if (cfg_.progress_saved != nullptr && t_s > resumed_t_s()) cfg_.progress_saved->store(true);
     last_clock_ = utc_time_of_day();
-  } catch (const std::exception& e) {  // a full disk ends no drop: the next checkpoint may succeed
-    warn(fmt::format("checkpoint {} not written (the drop goes on): {}", cfg_.path.string(), e.what()));
+  } catch (const std::exception& e) {  // a full disk ends no run: the next checkpoint may succeed
+    warn(fmt::format("checkpoint {} not written (the {} goes on): {}", cfg_.path.string(), kind_, e.what()));
   }
   last_write_ = std::chrono::steady_clock::now();
   if ((stop_ != nullptr && stop_->load()) || (cfg_.save_on_stop != nullptr && cfg_.save_on_stop->load()))
-    throw Interrupted(fmt::format("drop interrupted at t = {:.4f} s; {}", t_s,
+    throw Interrupted(fmt::format("{} interrupted at t = {:.4f} s; {}", kind_, t_s,
                                   last_t_s_ == t_s ? "checkpoint " + cfg_.path.string() : "no checkpoint written"));
 }
 
-void DropCheckpointer::finished() {
+void JobCheckpointer::finished() {
   if (cfg_.path.empty()) return;
   std::error_code ec;
   fs::remove(cfg_.path, ec);
   remove_stale_temporaries();
 }
 
-std::string DropCheckpointer::detail(const std::string& drop_detail) const {
-  if (last_t_s_ >= 0) return fmt::format("{} ckpt t={:.4f}s at {}", drop_detail, last_t_s_, last_clock_);
-  if (resume_ && !resume_->drop.loop.result.samples.empty())
-    return fmt::format("{} resumed from t={:.4f}s", drop_detail, resume_->drop.loop.result.samples.back().t_s);
-  return drop_detail;
+std::string JobCheckpointer::detail(const std::string& run_detail) const {
+  if (last_t_s_ >= 0) return fmt::format("{} ckpt t={:.4f}s at {}", run_detail, last_t_s_, last_clock_);
+  if (resume_ && resume_->position_s > 0)
+    return fmt::format("{} resumed from t={:.4f}s", run_detail, resume_->position_s);
+  return run_detail;
 }
 
-double DropCheckpointer::prior_wall_time_s() const { return resume_ ? resume_->wall_time_s : 0.0; }
+double JobCheckpointer::prior_wall_time_s() const { return resume_ ? resume_->wall_time_s : 0.0; }
 
-void DropCheckpointer::add_metrics(json& m) const {
+void JobCheckpointer::add_metrics(json& m) const {
   m["checkpoint_resumes"] = resume_ ? resume_->resumes + 1 : 0;
-  m["resumed_at_s"] = resume_ && !resume_->drop.loop.result.samples.empty()
-                          ? json(resume_->drop.loop.result.samples.back().t_s)
-                          : json(nullptr);
+  m["resumed_at_s"] = resume_ && resume_->position_s > 0 ? json(resume_->position_s) : json(nullptr);
   m["checkpoints_written"] = written_;
 }
 
