@@ -561,3 +561,49 @@ TEST(Reproduction, ThePkdgravBedComesToRestOnceItsSlidersAreHeldAtTheLimit) {
   EXPECT_GT(phi, 0.58) << "Table 1's pkdgrav bulk density 1.45-1.48 g/cm3: 0.585-0.597";
   EXPECT_LT(phi, 0.60);
 }
+
+// Every committed drop (a row of any results CSV under data/) comes from a clean build, on a bed
+// that is committed beside it (data/<dataset>/beds/<bed job>.h5) and was prepared by a clean
+// build; every dataset's provenance.json agrees. A bed of a build with uncommitted changes may be
+// kept as evidence (REPRODUCTION.md's bed table) but no committed drop stands on it.
+TEST(Reproduction, NoCommittedDropComesFromOrStandsOnABuildWithUncommittedChanges) {
+  namespace fs = std::filesystem;
+  const fs::path data = fs::path(GRAVSWEEP_SOURCE_DIR) / "data";
+  const auto dirty = [](const std::string& version) { return version.find("dirty") != std::string::npos; };
+  std::map<std::string, std::string> bed_version;  // bed job id -> code version
+  for (const auto& dataset : fs::directory_iterator(data)) {
+    if (!fs::is_directory(dataset.path() / "beds")) continue;
+    for (const auto& f : fs::directory_iterator(dataset.path() / "beds"))
+      if (f.path().extension() == ".h5")
+        bed_version[f.path().stem().string()] = gravsweep::results::read_bed(f.path()).code_version;
+  }
+  ASSERT_GE(bed_version.size(), 20u);
+  int drops = 0, provenances = 0;
+  for (const auto& f : fs::recursive_directory_iterator(data)) {
+    const std::string name = f.path().filename().string();
+    if (name == "provenance.json") {
+      std::ifstream in(f.path());
+      const auto p = nlohmann::json::parse(in);
+      for (const char* key : {"drops_by_code_version", "beds_by_code_version"}) {
+        const nlohmann::json versions = p.value(key, nlohmann::json::object());
+        for (const auto& [version, count] : versions.items())
+          EXPECT_FALSE(dirty(version)) << f.path() << " " << key << ": " << version;
+      }
+      ++provenances;
+      continue;
+    }
+    if (f.path().extension() != ".csv" || name.rfind("results", 0) != 0) continue;
+    for (const auto& row : csv_rows(fs::relative(f.path(), data / "reproduction").string())) {
+      if (row.count("bed_job_id") == 0 || row.at("bed_job_id").empty()) continue;
+      ++drops;
+      EXPECT_FALSE(dirty(row.at("code_version"))) << f.path() << ": drop " << row.at("job_id");
+      const auto bed = bed_version.find(row.at("bed_job_id"));
+      ASSERT_NE(bed, bed_version.end()) << f.path() << ": drop " << row.at("job_id") << " stands on bed "
+                                        << row.at("bed_job_id") << ", which is not committed";
+      EXPECT_FALSE(dirty(bed->second)) << f.path() << ": drop " << row.at("job_id") << " stands on bed " << bed->first
+                                       << " of " << bed->second;
+    }
+  }
+  EXPECT_GE(drops, 100) << "the results tables were read";
+  EXPECT_GE(provenances, 8);
+}
