@@ -29,7 +29,10 @@ std::string ModelSpec::name() const {
   for (const auto& t : terms) {
     if (!s.empty()) s += "+";
     s += t.term->name;
-    if (t.per_gravity != t.term->per_gravity) s += t.per_gravity ? ":per_gravity" : ":shared";
+    if (t.g_scaled())
+      s += fmt::format(":g^{:g}", t.g_power);
+    else if (t.per_gravity != t.term->per_gravity)
+      s += t.per_gravity ? ":per_gravity" : ":shared";
   }
   return s;
 }
@@ -64,11 +67,27 @@ std::vector<ModelTerm> model_file_terms(const std::string& file) {
       continue;
     }
     mt.per_gravity = e.contains("shared") ? !e["shared"].get<bool>() : mt.term->per_gravity;
+    if (e.contains("g_power")) {
+      mt.g_power = e["g_power"].get<double>();
+      mt.per_gravity = false;
+    }
     mt.scale = e.value("scale", 1.0);
     terms.push_back(mt);
   }
   if (!problems.empty()) throw spec::SpecError(file, std::move(problems.list()));
   return terms;
+}
+
+/// ":g^p": one constant for all levels times (g / kGPowerReference_m_s2)^p.
+void set_g_power(ModelTerm& mt, const std::string& mode, const std::string& text) {
+  const std::string p = mode.substr(2);
+  char* end = nullptr;
+  const double x = std::strtod(p.c_str(), &end);
+  if (p.empty() || end != p.c_str() + p.size() || !std::isfinite(x) || std::abs(x) > 4)
+    throw std::invalid_argument(
+        fmt::format("model '{}': '{}' after ':' must be g^<power> with a power between -4 and 4", text, mode));
+  mt.g_power = x;
+  mt.per_gravity = false;
 }
 
 }  // namespace
@@ -106,9 +125,11 @@ ModelSpec parse_model(const std::string& text) {
         mt.per_gravity = false;
       else if (mode == "per_gravity")
         mt.per_gravity = true;
+      else if (mode.rfind("g^", 0) == 0)
+        set_g_power(mt, mode, text);
       else if (!mode.empty())
-        throw std::invalid_argument(
-            fmt::format("model '{}': '{}' after ':' must be shared or per_gravity", text, mode));
+        throw std::invalid_argument(fmt::format(
+            "model '{}': '{}' after ':' must be shared, per_gravity or g^<power> (e.g. g^0.3)", text, mode));
       mt.scale = scale;
       spec.terms.push_back(mt);
     }
@@ -147,6 +168,8 @@ void feature_row(const ModelSpec& s, const Layout& L, int gi, const TermContext&
     const auto& t = s.terms[i];
     t.term->features(c, f);
     const int np = static_cast<int>(t.term->params.size());
+    const double g_factor = t.g_scaled() ? std::pow(c.g_m_s2 / kGPowerReference_m_s2, t.g_power) : 1.0;
+    for (int j = 0; j < np; ++j) f[j] *= g_factor;
     for (int j = 0; j < np; ++j) {
       const int col = L.offset[i] + (t.per_gravity ? j * L.G + gi : j);
       row[col] = f[j];
@@ -268,6 +291,12 @@ FittedModel fit_model(const ModelSpec& spec, const Campaign& c) {
   return fit_model(spec, c, std::vector<bool>(c.trials.size(), true));
 }
 
+FittedModel fit_model(const ModelSpec& spec, const Campaign& c, const std::vector<bool>& mask) {
+  std::vector<int> count(mask.size());
+  std::transform(mask.begin(), mask.end(), count.begin(), [](bool b) { return b ? 1 : 0; });
+  return fit_model(spec, c, count);
+}
+
 namespace {
 
 /// The RMS of a_up + g over a trial's fit window (m/s2): the scale of its resisting force per
@@ -291,17 +320,22 @@ std::vector<std::string> column_names(const ModelSpec& spec, const std::vector<d
   std::vector<std::string> names;
   for (const auto& st : spec.terms)
     for (const auto& param : st.term->params) {
+      // One parameter of a term as a term of its own (scaled_base.phi) is named once.
+      const bool named =
+          st.term->name.size() > param.size() &&
+          st.term->name.compare(st.term->name.size() - param.size() - 1, std::string::npos, "." + param) == 0;
+      const std::string column = named ? st.term->name : fmt::format("{}.{}", st.term->name, param);
       if (st.per_gravity)
-        for (double g : gravity_levels) names.push_back(fmt::format("{}.{}@g={}", st.term->name, param, g));
+        for (double g : gravity_levels) names.push_back(fmt::format("{}@g={}", column, g));
       else
-        names.push_back(fmt::format("{}.{}", st.term->name, param));
+        names.push_back(column);
     }
   return names;
 }
 
 /// The least-squares fit of fit_model, unchecked; `not_finite` gets the trials whose rows of the
 /// problem (features or m (a_up + g)) hold a value that is not finite.
-FittedModel fit_unchecked(const ModelSpec& spec, const Campaign& c, const std::vector<bool>& mask,
+FittedModel fit_unchecked(const ModelSpec& spec, const Campaign& c, const std::vector<int>& count,
                           std::vector<int>& not_finite) {
   FittedModel m;
   m.spec = spec;
@@ -312,7 +346,7 @@ FittedModel fit_unchecked(const ModelSpec& spec, const Campaign& c, const std::v
   std::size_t rows = 0;
   std::vector<int> used;
   for (std::size_t ti = 0; ti < c.trials.size(); ++ti)
-    if (mask[ti] && c.trials[ti].fit_end > c.trials[ti].fit_begin) {
+    if (count[ti] > 0 && c.trials[ti].fit_end > c.trials[ti].fit_begin) {
       rows += c.trials[ti].fit_end - c.trials[ti].fit_begin;
       used.push_back(static_cast<int>(ti));
     }
@@ -321,7 +355,7 @@ FittedModel fit_unchecked(const ModelSpec& spec, const Campaign& c, const std::v
   std::vector<int> cluster(rows);
   Eigen::Index r = 0;
   std::vector<double> row(static_cast<std::size_t>(L.cols));
-  const bool one_law = one_law_for_all_levels(spec);
+  const bool one_law = one_law_for_all_levels(spec) || spec.trial_force_units;
   for (int ti : used) {
     const MeasuredTrial& t = c.trials[static_cast<std::size_t>(ti)];
     const int gi = m.gravity_index(t.info.gravity_m_s2);
@@ -331,7 +365,7 @@ FittedModel fit_unchecked(const ModelSpec& spec, const Campaign& c, const std::v
     // units of its own force (trial_force_scale_m_s2), as its trials span Froude 0.2-10 and forces
     // from m g to 300 m g.
     const double scale_m_s2 = one_law ? trial_force_scale_m_s2(t) : t.info.gravity_m_s2;
-    const double wt = 1.0 / (n_t * scale_m_s2 * scale_m_s2);
+    const double wt = count[static_cast<std::size_t>(ti)] / (n_t * scale_m_s2 * scale_m_s2);
     for (std::size_t k = t.fit_begin; k < t.fit_end; ++k, ++r) {
       const TermContext ctx = context(t, k);
       feature_row(spec, L, gi, ctx, row.data());
@@ -378,14 +412,14 @@ FittedModel fit_unchecked(const ModelSpec& spec, const Campaign& c, const std::v
 
 /// The trials a non-finite fit comes from: those with non-finite rows, else each trial whose
 /// leaving-out makes the fit finite.
-std::vector<int> trials_behind(const ModelSpec& spec, const Campaign& c, const std::vector<bool>& mask,
+std::vector<int> trials_behind(const ModelSpec& spec, const Campaign& c, const std::vector<int>& count,
                                std::vector<int> not_finite) {
   if (!not_finite.empty()) return not_finite;
   std::vector<int> out;
   for (std::size_t ti = 0; ti < c.trials.size(); ++ti) {
-    if (!mask[ti]) continue;
-    std::vector<bool> without = mask;
-    without[ti] = false;
+    if (count[ti] == 0) continue;
+    std::vector<int> without = count;
+    without[ti] = 0;
     std::vector<int> ignored;
     if (fit_unchecked(spec, c, without, ignored).coef.allFinite()) out.push_back(static_cast<int>(ti));
   }
@@ -394,14 +428,14 @@ std::vector<int> trials_behind(const ModelSpec& spec, const Campaign& c, const s
 
 }  // namespace
 
-FittedModel fit_model(const ModelSpec& spec, const Campaign& c, const std::vector<bool>& mask) {
+FittedModel fit_model(const ModelSpec& spec, const Campaign& c, const std::vector<int>& count) {
   std::vector<int> not_finite;
-  FittedModel m = fit_unchecked(spec, c, mask, not_finite);
+  FittedModel m = fit_unchecked(spec, c, count, not_finite);
   if (m.coef.allFinite()) return m;
   std::string params, trials;
   for (Eigen::Index j = 0; j < m.coef.size(); ++j)
     if (!std::isfinite(m.coef(j))) params += (params.empty() ? "" : ", ") + m.column_names[static_cast<std::size_t>(j)];
-  for (int ti : trials_behind(spec, c, mask, not_finite)) {
+  for (int ti : trials_behind(spec, c, count, not_finite)) {
     const Trial& t = c.trials[static_cast<std::size_t>(ti)].info;
     trials += fmt::format("{}{} (mass {} kg, projectile diameter {} m, grain diameter {} m, gravity {} m/s2)",
                           trials.empty() ? "" : "; ", t.trial_id, t.projectile_mass_kg, t.projectile_diameter_m,

@@ -46,8 +46,8 @@ void print_checkpoint_cost(const System& sys, const std::filesystem::path& dir, 
       "{} bytes each: {:.1f} MB), {} listed pairs, {} wall candidates\n"
       "  save_state {:.3f} s, write + fsync {:.3f} s, read + verify {:.3f} s, restore {:.3f} s\n",
       sys.particles.size(), samples, dir.string(), bytes / 1e6, (bytes - sample_bytes) / n, sizeof(DropSample),
-      sample_bytes / 1e6, c.drop()->system.list_neighbor.size(), c.drop()->system.wall_candidates.size(), save_s, write_s,
-      read_s, restore_s);
+      sample_bytes / 1e6, c.drop()->system.list_neighbor.size(), c.drop()->system.wall_candidates.size(), save_s,
+      write_s, read_s, restore_s);
 }
 
 }  // namespace gravsweep::cli

@@ -43,6 +43,7 @@ void setup_model(CLI::App& app) {
   setup_model_rank(*sub);
   setup_model_collapse(*sub);
   setup_model_lolo(*sub);
+  setup_model_scaling(*sub);
 }
 
 }  // namespace gravsweep::cli

@@ -17,6 +17,7 @@ void setup_model_check_detection(CLI::App& model);
 void setup_model_rank(CLI::App& model);
 void setup_model_collapse(CLI::App& model);
 void setup_model_lolo(CLI::App& model);
+void setup_model_scaling(CLI::App& model);
 void setup_synth(CLI::App& app);
 void setup_report(CLI::App& app);
 void setup_run(CLI::App& app);
