@@ -71,6 +71,27 @@ std::string strongest_axis(const std::vector<AxisResidual>& axes) {
       best->axis, best->eta2, best->split_half_r);
 }
 
+/// The named terms to try beside `current`, each in the sharing it is tried in. Per level: every
+/// registered term not in `current` (baselines aside) in its own sharing. Gravity-scaled (a
+/// baseline that is one law for all levels): every such term as one law for all levels too, a
+/// per-level term in its two forms, its constant shared by all levels ("depth_friction:shared":
+/// does not follow g) and carried by g ("immersion_drag:g^1"; where a registered term is that form,
+/// TermInfo::gravity_form, it stands in for it, and a term whose g-form is a baseline is not tried).
+std::vector<ModelTerm> named_candidates(const ModelSpec& current, bool gravity_scaled) {
+  std::vector<ModelTerm> named;
+  for (const auto& term : term_registry()) {
+    if (current.has(term.name) || term.baseline_only) continue;
+    if (!gravity_scaled || !term.per_gravity) {
+      named.push_back({&term, term.per_gravity, 1.0});
+      continue;
+    }
+    if (!term.gravity_form.empty() && find_term(term.gravity_form).baseline_only) continue;
+    named.push_back({&term, false, 1.0});
+    if (term.gravity_form.empty()) named.push_back({&term, false, 1.0, 1.0});
+  }
+  return named;
+}
+
 /// Each candidate added to `current` on its own, ranked by held-out improvement over `current`
 /// (grouped CV, whole trials out; a one-sided signed-rank test over trials, Bonferroni over the
 /// candidates at level alpha, and at least min_improvement mean relative gain). Named and
@@ -85,9 +106,8 @@ std::vector<Candidate> rank_candidates(const ModelSpec& current, const Campaign&
     s.terms.push_back(mt);
     const HeldOut h1 = cross_validate(s, c, folds, 1, false);
     Candidate cd;
-    cd.term = mt.term->name + (mt.per_gravity == mt.term->per_gravity ? ""
-                               : mt.per_gravity                       ? ":per_gravity"
-                                                                      : ":shared");
+    cd.term = ModelSpec{{mt}}.name();
+    cd.form = mt;
     double sum = 0;
     std::vector<double> rel_all;
     cd.trial_rel_gain.assign(c.trials.size(), NAN);
@@ -147,6 +167,45 @@ std::string generated_equivalent_to(const Candidate& winner, const ModelSpec& cu
   return held_out_equal(winner, ranked.front()) ? "c * " + form->name : "";
 }
 
+/// How the force of a term shared by all levels goes with gravity at Froude-similar states (the
+/// same z/D and Fr = v / sqrt(g D), D = 10 cm, m = 1 kg): the power p of g in the ratio of its
+/// force at 9.81 and 0.0981 m/s2 (1: Froude-scaled, it follows g; 0: it does not).
+double force_power_of_g(const ModelTerm& mt) {
+  constexpr double kG1 = 9.81, kG2 = 0.0981, kD = 0.1;
+  const auto force = [&](double g) {
+    TermContext c;
+    c.g_m_s2 = g;
+    c.diameter_m = kD;
+    c.mass_kg = 1.0;
+    c.fill_height_m = 2 * kD;
+    c.z_m = 0.3 * kD;
+    c.v_m_s = c.vc_m_s = std::sqrt(g * kD);
+    const FittedModel one = [&] {
+      FittedModel m;
+      m.spec.terms = {mt};
+      m.gravity_levels = {g};
+      m.coef = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(mt.term->params.size()));
+      return m;
+    }();
+    return one.force(c);
+  };
+  const double f1 = force(kG1), f2 = force(kG2);
+  return f1 != 0 && f2 / f1 > 0 ? std::log(f2 / f1) / std::log(kG2 / kG1) : NAN;
+}
+
+/// What the sharing of a term tried in the scaled mode says about gravity.
+std::string sharing_words(const ModelTerm& mt) {
+  if (mt.per_gravity) return "";
+  const double p = force_power_of_g(mt);
+  const std::string how = !std::isfinite(p)        ? ""
+                          : std::abs(p - 1) < 0.05 ? ": its force follows g (Froude-scaled)"
+                          : std::abs(p) < 0.05     ? ": its force does not follow g"
+                                                   : fmt::format(": its force goes as g^{:.2g}", p);
+  return (mt.g_scaled() ? fmt::format("; one constant for all gravity levels times (g / 9.81 m/s2)^{:g}", mt.g_power)
+                        : std::string("; one constant for all gravity levels")) +
+         how;
+}
+
 /// ", or equally well a and b (...)" when the trials cannot tell other terms from a winner.
 std::string equivalent_words(const std::vector<std::string>& names) {
   if (names.empty()) return "";
@@ -180,11 +239,16 @@ std::string verdict_of(const Discovery& d, const std::string& where_named, const
     v = "structure left that no named term explains, " + where_named;
   } else {
     const auto& first = d.rounds.front().front();
-    const TermInfo& w = find_term(first.term.substr(0, first.term.find(':')));
-    v = fmt::format("{} {} ({}){}; {}; references: {}",
-                    d.structure_left ? "partly explained by" : "missing effect:", w.name, w.meaning,
-                    equivalent_words(d.equivalent.front()), improvement_words(first), w.references);
-    for (std::size_t i = 1; i < d.added.size(); ++i) v += "; then " + d.added[i] + equivalent_words(d.equivalent[i]);
+    const TermInfo& w = *first.form.term;
+    v = fmt::format("{} {} ({}{}){}; {}; references: {}",
+                    d.structure_left ? "partly explained by" : "missing effect:", first.term, w.meaning,
+                    sharing_words(first.form), equivalent_words(d.equivalent.front()), improvement_words(first),
+                    w.references);
+    for (std::size_t i = 1; i < d.added.size(); ++i) {
+      const ModelTerm& t = d.rounds[i].front().form;
+      v += fmt::format("; then {} ({}{}){}", d.added[i], t.term->meaning, sharing_words(t),
+                       equivalent_words(d.equivalent[i]));
+    }
     if (d.structure_left) v += "; structure left " + where_named;
   }
   if (!d.structure_left && d.generated_worsens_metrics)
@@ -240,11 +304,8 @@ Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds, doub
   // level, the very effect whose size does not follow g that this mode is meant to find.
   d.gravity_scaled = one_law_for_all_levels(baseline);
   for (int round = 0; round < max_rounds; ++round) {
-    std::vector<ModelTerm> named;
-    for (const auto& term : term_registry())
-      if (!current.has(term.name) && !term.baseline_only && !(d.gravity_scaled && term.per_gravity))
-        named.push_back({&term, term.per_gravity, 1.0});
-    const auto cands = rank_candidates(current, c, named, folds, alpha, min_improvement);
+    const auto cands =
+        rank_candidates(current, c, named_candidates(current, d.gravity_scaled), folds, alpha, min_improvement);
     d.rounds.push_back(cands);
     if (cands.empty() || !cands.front().significant) break;
     d.equivalent.push_back(equivalent_to_winner(cands));
@@ -253,10 +314,10 @@ Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds, doub
           generated_equivalent_to(cands.front(), current, c, d.gravity_scaled, folds, alpha, min_improvement);
       if (!form.empty()) d.equivalent.back().push_back(form);
     }
-    const TermInfo& win = find_term(cands.front().term);
-    current.terms.push_back({&win, win.per_gravity, 1.0});
-    d.added.push_back(win.name);
+    current.terms.push_back(cands.front().form);
+    d.added.push_back(cands.front().term);
   }
+  d.named_model = current.name();
   const FittedModel named_fit = fit_model(current, c);
   d.residual_after = residual_axes(named_fit, c);
   std::string where_named, where_generated;

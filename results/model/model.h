@@ -176,7 +176,8 @@ std::vector<AxisResidual> residual_axes(const FittedModel& m, const Campaign& c)
 
 /// One candidate's held-out improvement over the current model.
 struct Candidate {
-  std::string term;
+  std::string term;                 ///< as a model spec names it: "depth_friction:shared", "immersion_drag:g^1"
+  ModelTerm form;                   ///< the term as it was tried (its sharing)
   double mean_rel_improvement = 0;  ///< mean over trials of (mse0 - mse1) / mse0
   int trials_better = 0, trials = 0;
   double p_value = 1;  ///< one-sided Wilcoxon signed-rank test over trials (not samples)
@@ -189,7 +190,8 @@ struct Discovery {
   /// are candidates (scaled mode, `model rank --scaled`).
   bool gravity_scaled = false;
   std::vector<std::vector<Candidate>> rounds;  ///< ranking of the named terms per forward step
-  std::vector<std::string> added;              ///< named winners, in order
+  std::vector<std::string> added;              ///< named winners, in order, as a model spec names them
+  std::string named_model;                     ///< the baseline with the named winners (parse_model reads it)
   /// Per named winner, the other significant terms of its round that the held-out trials cannot
   /// tell apart from it (detail::cannot_tell_apart): the verdict names them beside it. The best
   /// form of the generated family added to the same model is judged the same way and, when the

@@ -41,6 +41,11 @@ struct TermInfo {
   /// A baseline to start from (`--baseline`), never ranked as a missing effect: scaled_base is
   /// the whole Poncelet law again, collinear with base's per-level f0 and 1/d1.
   bool baseline_only = false;
+  /// The registered term that is this one's constant times g, when there is one
+  /// (depth_friction: gravity_depth_friction; base: scaled_base). The scaled mode of `model rank`
+  /// tries a per-level term shared by all levels and carried by g; where a registered term is the
+  /// latter, that term is tried instead (and a term whose g-form is a baseline is not tried).
+  std::string gravity_form;
 };
 
 // The registry: one row per term (the function is defined in terms/<name>.cpp).

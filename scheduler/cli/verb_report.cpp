@@ -155,11 +155,7 @@ std::pair<results::ModelSpec, results::ModelSpec> report_models(const ReportOpti
       throw UsageError(e.what());
     }
   } else {
-    after = base;
-    for (const auto& n : d.added) {
-      const auto& t = results::find_term(n);
-      after.terms.push_back({&t, t.per_gravity, 1.0});
-    }
+    after = results::parse_model(d.named_model);
   }
   return {base, after};
 }

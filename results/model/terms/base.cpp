@@ -12,6 +12,7 @@ TermInfo base_term() {
   t.signature = "-";
   t.params = {"f0_N", "inv_d1_1_m"};
   t.per_gravity = true;
+  t.gravity_form = "scaled_base";
   t.features = [](const TermContext& c, double* out) {
     out[0] = 1.0;
     out[1] = c.mass_kg * c.v_m_s * c.v_m_s;

@@ -14,6 +14,7 @@ TermInfo depth_friction_term() {
   t.signature = "residual ~ -z, independent of v; f0 fitted per trial grows with impact speed";
   t.params = {"k_N_m"};
   t.per_gravity = true;
+  t.gravity_form = "gravity_depth_friction";
   t.features = [](const TermContext& c, double* out) { out[0] = c.z_m; };
   // f0 (1 + z / lambda) with f0 = 1.6 m g and lambda = 3 cm.
   t.typical = [](double g, double m, double) { return std::vector<double>{1.6 * m * g / 0.03}; };
