@@ -44,6 +44,7 @@ void setup_model(CLI::App& app) {
   setup_model_collapse(*sub);
   setup_model_lolo(*sub);
   setup_model_scaling(*sub);
+  setup_model_predict(*sub);
 }
 
 }  // namespace gravsweep::cli

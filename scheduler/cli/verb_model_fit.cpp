@@ -10,11 +10,14 @@
 #include <string>
 #include <vector>
 
+#include "results/model/law.h"
 #include "results/model/model.h"
 #include "results/report/report.h"
 #include "results/io/table.h"
+#include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/model_inputs.h"
 #include "scheduler/cli/verbs.h"
+#include "scheduler/pipeline/build_version.h"
 
 namespace gravsweep::cli {
 
@@ -29,7 +32,29 @@ struct FitOptions {
   int folds = 6;
   std::string plot = "error_falls.png";
   bool no_plot = false;
+  std::string save;  ///< the law file (results/model/law.h); empty: none
+  int resamples = results::kLawResamples;
 };
+
+/// `--save`: the law with its bootstrap, form error by Froude number and ranges.
+void save_law(const FitOptions& o, const results::ModelSpec& spec, const results::Campaign& c) {
+  results::SavedLaw law;
+  try {
+    law = results::make_saved_law(spec, c, o.resamples);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(fmt::format("--save {}: {}", o.save, e.what()));
+  }
+  law.code_version = pipeline::build_version();
+  for (const auto& in : o.in.inputs) law.fitted_on += (law.fitted_on.empty() ? "" : " ") + in;
+  for (const auto& w : o.in.where) law.fitted_on += " --where '" + w + "'";
+  results::write_law(o.save, law);
+  if (o.in.format == "table")
+    fmt::print(
+        "\nwrote {}: {} constants, {} bootstrap resamples, form error by Froude number ({}) at {} Froude numbers, "
+        "fitted on {} trials at {} gravity levels\n",
+        o.save, law.values.size(), law.bootstrap.size(), law.form_error_source, law.form_error.size(), law.trials,
+        law.levels);
+}
 
 void print_params(const results::FittedModel& m, const std::string& format) {
   results::Table t({"parameter", "value", "std_error", "unit_note"});
@@ -117,6 +142,7 @@ void run_fit(const FitOptions& o) {
   if (table) fmt::print("\nHeld-out errors ({}-fold grouped CV, whole trials held out), before and after:\n", o.folds);
   error_table(cm).print(o.in.format);
   if (table) explain_rises(cm);
+  if (!o.save.empty()) save_law(o, spec, c);
   if (o.no_plot || o.plot.empty()) return;
   const std::filesystem::path png = std::filesystem::absolute(o.plot);
   draw_error_falls(c, cm, {base, spec}, png);
@@ -136,7 +162,13 @@ void setup_model_fit(CLI::App& model) {
       "Examples:\n"
       "  gravsweep model fit ../shared/data/measurements/depth-friction-dev --model base+depth_friction\n"
       "  gravsweep model fit DIR --model spec.json --plot fall.png --format csv\n"
-      "The figure of the error falling is written to --plot (default error_falls.png).");
+      "  gravsweep model fit data/gravity_sweep/g*/ --model scaled_base+gravity_depth_friction --save law.json\n"
+      "The figure of the error falling is written to --plot (default error_falls.png). --save writes a\n"
+      "law for all gravity levels (terms shared or carried by g^p) to a file that `model predict`\n"
+      "applies to a gravity, speed, diameter and mass of one's own: its constants and their\n"
+      "covariance, --resamples bootstrap resamples of them (whole drops, within each level), its\n"
+      "error by Froude number (held out by gravity level) and the ranges it was fitted on\n"
+      "(docs/formats/law.md).");
   add_model_inputs(sub, o->in);
   sub->add_option("--model", o->model, "model: 'base+depth_friction' or a JSON spec file")->capture_default_str();
   sub->add_option("--baseline", o->baseline, "the 'before' model")->capture_default_str();
@@ -145,6 +177,10 @@ void setup_model_fit(CLI::App& model) {
       ->capture_default_str();
   sub->add_option("--plot", o->plot, "write the error-falling figure (PNG) here")->capture_default_str();
   sub->add_flag("--no-plot", o->no_plot, "do not write the figure");
+  sub->add_option("--save", o->save, "write the fitted law to this file (JSON; for `model predict`)");
+  sub->add_option("--resamples", o->resamples, "bootstrap resamples of the constants saved with --save")
+      ->check(CLI::Range(20, 100000))
+      ->capture_default_str();
   sub->callback([o]() { run_fit(*o); });
 }
 

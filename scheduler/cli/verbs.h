@@ -18,6 +18,7 @@ void setup_model_rank(CLI::App& model);
 void setup_model_collapse(CLI::App& model);
 void setup_model_lolo(CLI::App& model);
 void setup_model_scaling(CLI::App& model);
+void setup_model_predict(CLI::App& model);
 void setup_synth(CLI::App& app);
 void setup_report(CLI::App& app);
 void setup_run(CLI::App& app);

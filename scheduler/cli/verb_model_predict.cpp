@@ -1,0 +1,165 @@
+// `gravsweep model predict`: a saved gravity-scaled law (results/model/law.h) applied to cases of
+// one's own (a gravity, an impact speed, a projectile diameter and mass): zstop, tstop and apeak
+// with 95 % intervals, the Froude number, and whether each case lies inside the law's fitted
+// ranges, just outside them (extrapolated, with a warning) or far beyond (refused, exit 2, unless
+// --extrapolate).
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/core/error.h"
+#include "results/io/csv.h"
+#include "results/io/table.h"
+#include "results/model/law.h"
+#include "scheduler/cli/exit_codes.h"
+#include "scheduler/cli/format_option.h"
+#include "scheduler/cli/verbs.h"
+
+namespace gravsweep::cli {
+
+namespace {
+
+using results::num;
+
+struct PredictOptions {
+  std::string law;
+  std::vector<double> gravity, speed;
+  double diameter_m = 0.1, mass_kg = 1.0;
+  std::string cases;
+  bool extrapolate = false;
+  std::string format = "table";
+};
+
+/// The cases of a CSV file: columns gravity_m_s2 and speed_m_s, optional diameter_m and mass_kg
+/// (the options' values where absent). ConfigError naming the file, line and column otherwise.
+std::vector<results::LawCase> read_cases(const PredictOptions& o) {
+  std::ifstream in(o.cases);
+  if (!in) throw ConfigError(fmt::format("{}: cannot read the cases file", o.cases));
+  results::CsvReader csv(in);
+  std::vector<std::string> names, f;
+  int line = 0;
+  if (!csv.next(names, line))
+    throw ConfigError(fmt::format("{}: empty; expected a header gravity_m_s2,speed_m_s[,diameter_m,mass_kg]", o.cases));
+  std::map<std::string, std::size_t> col;
+  for (std::size_t i = 0; i < names.size(); ++i) col[names[i]] = i;
+  for (const char* need : {"gravity_m_s2", "speed_m_s"})
+    if (col.count(need) == 0)
+      throw ConfigError(
+          fmt::format("{}:1: no column {} (header: gravity_m_s2,speed_m_s[,diameter_m,mass_kg])", o.cases, need));
+  std::vector<results::LawCase> out;
+  while (csv.next(f, line)) {
+    const auto value = [&](const char* name, double fallback) {
+      const auto it = col.find(name);
+      if (it == col.end()) return fallback;
+      const std::string& text = it->second < f.size() ? f[it->second] : std::string();
+      char* end = nullptr;
+      const double x = std::strtod(text.c_str(), &end);
+      if (text.empty() || *end != '\0' || !(x > 0) || !std::isfinite(x))
+        throw ConfigError(fmt::format("{}:{}: {} = '{}': expected a positive number", o.cases, line, name, text));
+      return x;
+    };
+    out.push_back({value("gravity_m_s2", NAN), value("speed_m_s", NAN), value("diameter_m", o.diameter_m),
+                   value("mass_kg", o.mass_kg)});
+  }
+  return out;
+}
+
+std::vector<results::LawCase> cases_of(const PredictOptions& o) {
+  if (!o.cases.empty()) return read_cases(o);
+  if (o.gravity.empty() || o.speed.empty())
+    throw UsageError(
+        "give --gravity and --speed (each may list several values: every pair is a case), or --cases FILE");
+  std::vector<results::LawCase> out;
+  for (double g : o.gravity)
+    for (double v : o.speed) out.push_back({g, v, o.diameter_m, o.mass_kg});
+  return out;
+}
+
+void run_predict(const PredictOptions& o) {
+  const results::SavedLaw law = results::read_law(o.law);
+  const std::vector<results::LawCase> cases = cases_of(o);
+  results::Table t({"gravity_m_s2", "speed_m_s", "diameter_m", "mass_kg", "impact_froude", "zstop_m", "zstop_lo_m",
+                    "zstop_hi_m", "tstop_s", "tstop_lo_s", "tstop_hi_s", "apeak_m_s2", "apeak_lo_m_s2", "apeak_hi_m_s2",
+                    "range", "note"});
+  int refused = 0, extrapolated = 0;
+  for (const auto& c : cases) {
+    results::LawPrediction p = results::predict_case(law, c);
+    if (p.range == results::LawRangeFlag::refused && o.extrapolate) {
+      results::SavedLaw wide = law;  // --extrapolate: predicted all the same, still flagged
+      wide.gravity_m_s2 = {0, 1e300};
+      wide.froude = {0, 1e300};
+      wide.diameter_m = {0, 1e300};
+      wide.mass_kg = {0, 1e300};
+      const std::string note = p.note;
+      p = results::predict_case(wide, c);
+      p.range = results::LawRangeFlag::refused;
+      p.note = note + " (predicted: --extrapolate)";
+    }
+    refused += p.range == results::LawRangeFlag::refused ? 1 : 0;
+    extrapolated += p.range == results::LawRangeFlag::extrapolated ? 1 : 0;
+    t.add({num(c.gravity_m_s2), num(c.speed_m_s), num(c.diameter_m), num(c.mass_kg), num(p.froude, 3),
+           num(p.zstop_m, 4), num(p.zstop_lo_m, 4), num(p.zstop_hi_m, 4), num(p.tstop_s, 4), num(p.tstop_lo_s, 4),
+           num(p.tstop_hi_s, 4), num(p.apeak_m_s2, 4), num(p.apeak_lo_m_s2, 4), num(p.apeak_hi_m_s2, 4),
+           results::to_string(p.range), p.note});
+  }
+  if (o.format == "table")
+    fmt::print("Law {} ({}; fitted on {} trials at {} levels, {:.3g}-{:.3g} m/s2, Fr {:.2g}-{:.2g}):\n", law.model,
+               o.law, law.trials, law.levels, law.gravity_m_s2.lo, law.gravity_m_s2.hi, law.froude.lo, law.froude.hi);
+  t.print(o.format);
+  if (o.format == "table")
+    fmt::print(
+        "\n95 % intervals: the constants' bootstrap spread and 1.96 x the law's RMS error at the case's Froude "
+        "number ({}), in quadrature.\n",
+        law.form_error_source);
+  if (extrapolated > 0)
+    std::fprintf(stderr, "warning: %d case(s) outside the law's fitted ranges (range = extrapolated): see the note\n",
+                 extrapolated);
+  if (refused > 0 && !o.extrapolate) {
+    std::fprintf(stderr,
+                 "error: %d case(s) far beyond the law's fitted ranges (range = refused; see the note): not predicted. "
+                 "--extrapolate predicts them all the same\n",
+                 refused);
+    throw ExitWith{kExitUsage};
+  }
+}
+
+}  // namespace
+
+void setup_model_predict(CLI::App& model) {
+  auto o = std::make_shared<PredictOptions>();
+  auto* sub = model.add_subcommand(
+      "predict",
+      "Apply a saved law (`model fit ... --save law.json`) to a gravity, impact speed, projectile\n"
+      "diameter and mass of one's own: Eq. 1 with the fitted resistance integrated from the impact\n"
+      "to the stop gives zstop (maximum depth), tstop (contact to rest) and apeak (the law's peak\n"
+      "deceleration, smooth: a measured record's peak is higher by its force chains), each with a\n"
+      "95 % interval that holds the constants' uncertainty (bootstrap over drops) and the law's\n"
+      "error at the case's Froude number Fr = v / sqrt(g D) (held out by gravity level), and a range\n"
+      "flag: inside the fitted ranges of g, Fr, D and m; extrapolated (outside them by at most a\n"
+      "factor 10 in g, 2 in Fr and D, 4 in m: a warning); refused (further: not predicted, exit 2,\n"
+      "unless --extrapolate).\n\n"
+      "Examples:\n"
+      "  gravsweep model predict --law law.json --gravity 0.01 --speed 0.2\n"
+      "  gravsweep model predict --law law.json --gravity 9.81 1.62 0.1 --speed 0.5 1 --format csv\n"
+      "  gravsweep model predict --law law.json --cases cases.csv   # gravity_m_s2,speed_m_s[,diameter_m,mass_kg]");
+  sub->add_option("--law", o->law, "the law file (model fit --save)")->required()->check(CLI::ExistingFile);
+  sub->add_option("--gravity", o->gravity, "gravity, m/s2 (several: each is a case with each --speed)")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--speed", o->speed, "impact speed, m/s (several allowed)")->check(CLI::PositiveNumber);
+  sub->add_option("--diameter", o->diameter_m, "projectile diameter, m")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  sub->add_option("--mass", o->mass_kg, "projectile mass, kg")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--cases", o->cases, "CSV of cases: gravity_m_s2,speed_m_s[,diameter_m,mass_kg]")
+      ->check(CLI::ExistingFile);
+  sub->add_flag("--extrapolate", o->extrapolate, "predict cases far beyond the fitted ranges too (still flagged)");
+  add_format_option(sub, o->format);
+  sub->callback([o]() { run_predict(*o); });
+}
+
+}  // namespace gravsweep::cli
