@@ -14,6 +14,7 @@
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/pipeline/impact_runners.h"
+#include "scheduler/pipeline/scenario_spec.h"
 #include "scheduler/queue/campaign.h"
 #include "db/where.h"
 #include "scheduler/queue/queue.h"
@@ -92,6 +93,23 @@ std::string jobs_by_kind(const Planned& p) {
   return fmt::format("{} bed, {} {}", beds, p.jobs.size() - beds, p.spec.job_kind == "noop" ? "noop" : "drop");
 }
 
+/// The dry run's memory line: the largest estimate (pipeline::job_memory_bytes) of the sweep's bed
+/// and drop jobs against what `work --max-memory` allows by default.
+void print_memory(const Planned& p) {
+  double most = 0, grains = 0;
+  for (const auto& j : p.jobs) {
+    if (j.kind != sweep::bed_kind()) continue;  // a drop loads its bed: the same bound
+    const auto s = nlohmann::json::parse(j.scenario_json);
+    if (pipeline::job_memory_bytes(s) > most)
+      most = pipeline::job_memory_bytes(s), grains = pipeline::bed_grain_bound(s);
+  }
+  if (most <= 0) return;
+  fmt::print(
+      "  memory per bed or drop job: up to {:.3g} MB (up to {:.3g} grains at {:g} bytes each); this machine "
+      "has {:.3g} MB\n",
+      most / 1048576.0, grains, pipeline::kBytesPerGrain, sweep::machine_memory_bytes() / 1048576.0);
+}
+
 void run_submit(const SubmitOptions& o) {
   // Validate and expand every spec before the database is even opened: a bad spec writes nothing.
   std::vector<Planned> planned;
@@ -107,9 +125,11 @@ void run_submit(const SubmitOptions& o) {
     }
   }
   if (o.dry_run) {
-    for (const auto& p : planned)
+    for (const auto& p : planned) {
       fmt::print("sweep {}: {} points -> {} jobs ({}) [dry run: nothing written]\n", p.spec.name, p.spec.points(),
                  p.jobs.size(), jobs_by_kind(p));
+      print_memory(p);
+    }
     return;
   }
   db::Database db = queue::open_campaign(o.db, queue::OpenMode::create, o.files);

@@ -18,6 +18,7 @@
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/pipeline/job_checkpoint.h"
+#include "scheduler/sweep/spec.h"
 #include "scheduler/queue/stop.h"
 #include "scheduler/pipeline/impact_runners.h"
 #include "scheduler/queue/campaign.h"
@@ -28,6 +29,9 @@
 namespace gravsweep::cli {
 
 namespace {
+
+/// `work --max-memory` by default: this share of the machine's memory per job.
+constexpr double kDefaultMemoryShare = 0.8;
 
 struct WorkOptions {
   std::string db = "campaign.db";
@@ -47,6 +51,7 @@ struct WorkOptions {
   bool quiet = false;
   std::string bed_cache;  ///< --bed-cache: prepared beds shared between campaigns (pipeline/bed_cache.h)
   double checkpoint_interval_s = pipeline::kDefaultCheckpointInterval_s;  ///< --checkpoint-interval
+  double max_memory_mb = 0;  ///< --max-memory; 0: kDefaultMemoryShare of the machine's
 };
 
 /// Exit code after the workers stopped: 4 when some job is dead.
@@ -86,6 +91,7 @@ std::vector<std::string> worker_args(const WorkOptions& o, int threads) {
   if (o.follow) args.push_back("--follow");
   if (!o.bed_cache.empty()) args.insert(args.end(), {"--bed-cache", o.bed_cache});
   args.insert(args.end(), {"--checkpoint-interval", fmt::format("{}", o.checkpoint_interval_s)});
+  if (o.max_memory_mb > 0) args.insert(args.end(), {"--max-memory", fmt::format("{}", o.max_memory_mb)});
   if (o.quiet) args.push_back("--quiet");
   if (o.max_jobs >= 0) args.insert(args.end(), {"--max-jobs", std::to_string(o.max_jobs)});
   return args;
@@ -210,6 +216,8 @@ int run_work(const WorkOptions& o) {
   w.verbose = !o.quiet;
   w.bed_cache = o.bed_cache;
   w.checkpoint_interval_s = o.checkpoint_interval_s;
+  w.max_memory_bytes =
+      o.max_memory_mb > 0 ? o.max_memory_mb * 1024 * 1024 : kDefaultMemoryShare * sweep::machine_memory_bytes();
   const auto rep = queue::run_worker(w, pipeline::all_runners());
   if (!o.quiet)
     fmt::print(stderr,
@@ -270,6 +278,11 @@ void add_work_options(CLI::App* sub, WorkOptions& o) {
                   "folder of prepared beds shared between campaigns and machines: a bed job whose bed is "
                   "there (<bed job id>.h5 + .sha256, checksum and bed key verified) copies it instead of "
                   "preparing it; a bed job that prepares its bed stores it there");
+  sub->add_option("--max-memory", o.max_memory_mb,
+                  "MB a job may need (its estimate from the scenario: the bed's grains at 2 kB each); a job above "
+                  "it is refused before it allocates, permanently (dead, naming the fields). Default: 80 % of the "
+                  "machine's memory")
+      ->check(CLI::Range(0.1, 1e9));
   sub->add_option("--checkpoint-interval", o.checkpoint_interval_s,
                   "wall seconds between two checkpoints of a running drop or bed preparation "
                   "(<files>/checkpoints/<job>.ckpt.h5; "

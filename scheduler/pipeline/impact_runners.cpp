@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "engine/core/error.h"
 #include "scheduler/pipeline/bed_cache.h"
 #include "scheduler/pipeline/impact_job.h"
 #include "scheduler/pipeline/scenario_spec.h"
@@ -28,6 +29,23 @@ Checkpointing checkpointing_of(const RunContext& ctx) {
   return ckpt;
 }
 
+/// Refuses, before anything is allocated, a job whose scenario needs more memory than `work
+/// --max-memory` allows (ConfigError: permanent), whatever its validation mark says.
+void check_memory(const RunContext& ctx) {
+  if (!(ctx.max_memory_bytes > 0)) return;
+  const nlohmann::json s = job_scenario(ctx.claim.scenario);
+  const double need = job_memory_bytes(s);
+  if (need > ctx.max_memory_bytes)
+    throw ConfigError(fmt::format(
+        "job {}: its bed (/grains/diameter_m {:g} m in /container/diameter_m {:g} m filled to "
+        "/container/fill_height_m {:g} m: up to {:.3g} grains) needs about {:.3g} MB, above work --max-memory "
+        "{:.3g} MB",
+        ctx.claim.job_id, s.at("/grains/diameter_m"_json_pointer).get<double>(),
+        s.at("/container/diameter_m"_json_pointer).get<double>(),
+        s.at("/container/fill_height_m"_json_pointer).get<double>(), bed_grain_bound(s), need / 1048576.0,
+        ctx.max_memory_bytes / 1048576.0));
+}
+
 }  // namespace
 
 sweep::PointCheckFn impact_point_check() {
@@ -40,6 +58,7 @@ sweep::PointCheckFn impact_point_check() {
 
 void add_impact_runners(RunnerTable& table) {
   table[sweep::bed_kind()] = [](const RunContext& ctx) {
+    check_memory(ctx);
     RunOutput out;
     if (!ctx.bed_cache.empty()) {
       if (auto cached = take_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.claim.scenario, ctx.output_tmp)) {
@@ -57,6 +76,7 @@ void add_impact_runners(RunnerTable& table) {
   table[sweep::drop_kind()] = [](const RunContext& ctx) {
     if (ctx.dependency_output.empty())
       throw std::runtime_error(fmt::format("drop job {} has no prepared bed", ctx.claim.job_id));
+    check_memory(ctx);
     auto r = run_drop_job(ctx.claim.scenario, ctx.dependency_output, ctx.output_tmp, ctx.threads, ctx.progress,
                           ctx.stop, checkpointing_of(ctx));
     if (r.trace_path != ctx.output_tmp && !r.trace_path.empty()) std::filesystem::rename(r.trace_path, ctx.output_tmp);

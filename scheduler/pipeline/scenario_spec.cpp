@@ -210,12 +210,18 @@ void engine_checks_once(const json& s, Checks& ck) {
   memo.emplace(k, std::vector<SpecProblem>(problems.begin() + static_cast<std::ptrdiff_t>(before), problems.end()));
 }
 
+/// Grains of grain diameter d in a container Dc filled to H: random close packing (0.64) of the
+/// fill, twice over for the lattice poured above it.
+double grain_bound(double d, double Dc, double H) {
+  return 2 * 0.64 * (0.25 * M_PI * Dc * Dc * H) / (M_PI / 6 * d * d * d);
+}
+
 /// Refuses a bed that cannot fit this machine's memory, and time steps too small to finish, before
 /// any work. Grains: random close packing (0.64) of the fill, twice over for
 /// the lattice poured above the fill height; ~2 kB per grain (state, Verlet pairs with contact
 /// history, per-thread force buffers).
 void check_size_and_steps(Checks& ck) {
-  constexpr double kMinDt_s = 1e-9, kBytesPerGrain = 2048, kMaxSteps = 1e10;
+  constexpr double kMinDt_s = 1e-9, kMaxSteps = 1e10;
   for (const char* p : {"/dt_s", "/bed/dt_s"})
     ck.run([&] {
       if (!(ck.num(p) >= kMinDt_s))
@@ -225,7 +231,7 @@ void check_size_and_steps(Checks& ck) {
   ck.run([&] {
     const double d = ck.num("/grains/diameter_m"), Dc = ck.num("/container/diameter_m");
     const double H = ck.num("/container/fill_height_m");
-    const double grains = 2 * 0.64 * (0.25 * M_PI * Dc * Dc * H) / (M_PI / 6 * d * d * d);
+    const double grains = grain_bound(d, Dc, H);
     const double need = grains * kBytesPerGrain, have = sweep::machine_memory_bytes();
     if (have > 0 && need > 0.8 * have)
       ck.bad("/container/fill_height_m",
@@ -533,5 +539,12 @@ ScenarioParams scenario_params(const json& s) {
 
   return out;
 }
+
+double bed_grain_bound(const json& s) {
+  const auto at = [&](const char* p) { return s.at(json::json_pointer(p)).get<double>(); };
+  return grain_bound(at("/grains/diameter_m"), at("/container/diameter_m"), at("/container/fill_height_m"));
+}
+
+double job_memory_bytes(const json& s) { return bed_grain_bound(s) * kBytesPerGrain; }
 
 }  // namespace gravsweep::pipeline

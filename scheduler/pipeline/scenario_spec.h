@@ -47,6 +47,16 @@ nlohmann::json stored_scenario(nlohmann::json validated, nlohmann::json as_writt
 /// Throws as validate_scenario (a SpecError naming the field's JSON pointer: a permanent failure).
 nlohmann::json job_scenario(const nlohmann::json& stored);
 
+/// Memory per grain of a bed in the engine (state, Verlet pairs with their contact histories,
+/// per-thread force buffers): a bound, measured at 1.1-1.6 kB on the paper's and the sweep's beds.
+inline constexpr double kBytesPerGrain = 2048;
+/// The most grains a validated (or stored) scenario's bed can hold while it is poured: random close
+/// packing (0.64) of the fill, twice over for the lattice poured above the fill height.
+double bed_grain_bound(const nlohmann::json& validated);
+/// The memory a bed or drop job of that scenario needs at most (bytes): bed_grain_bound grains at
+/// kBytesPerGrain. `work --max-memory` refuses a job above its limit, `submit --dry-run` prints it.
+double job_memory_bytes(const nlohmann::json& validated);
+
 /// How many times validation has run the engine's own checks (each builds an engine System four
 /// times) in this process: once per distinct set of the fields they read, not once per scenario.
 std::size_t engine_check_runs();

@@ -432,7 +432,8 @@ class Worker {
                      o_.bed_cache,
                      paths_.root / "checkpoints" / (c.job_id + ".ckpt.h5"),
                      o_.checkpoint_interval_s,
-                     &sig.progress_saved};
+                     &sig.progress_saved,
+                     o_.max_memory_bytes};
       a.out = runner->second(ctx);
     } catch (const ConfigError& e) {
       a.error = e.what();

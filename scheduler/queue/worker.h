@@ -33,6 +33,9 @@ struct RunContext {
   /// Set by a runner that saved state a later attempt continues from (a checkpoint beyond
   /// where this attempt started): a release of such an attempt does not count as a stall.
   std::atomic<bool>* progress_saved = nullptr;
+  /// `work --max-memory`: a job whose scenario needs more (its estimate) is refused, permanently,
+  /// before it allocates; 0: no limit.
+  double max_memory_bytes = 0;
 };
 
 struct RunOutput {
@@ -73,6 +76,7 @@ struct WorkerOptions {
   bool verbose = true;
   std::filesystem::path bed_cache;     ///< `work --bed-cache`: passed to the runners (RunContext)
   double checkpoint_interval_s = 300;  ///< `work --checkpoint-interval`: passed to the runners (RunContext)
+  double max_memory_bytes = 0;         ///< `work --max-memory`: passed to the runners (RunContext)
 };
 
 struct WorkerReport {

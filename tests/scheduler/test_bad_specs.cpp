@@ -229,3 +229,25 @@ TEST(BadSpecs, ATamperedStoredScenarioIsRefusedAtOnceNamingItsField) {
   EXPECT_EQ(q.get_int(1), 1) << "refused at its first attempt, not retried";
   EXPECT_NE(q.get_text(2).find("/container/diameter_m"), std::string::npos) << q.get_text(2);
 }
+
+// `work --max-memory`: a job whose bed needs more than the limit (its estimate from the scenario:
+// the tiny bed's up to ~490 grains at 2 kB, 0.96 MB, against 0.5 MB) is refused before it allocates,
+// permanently, naming the fields and the limit; `submit --dry-run` prints the same estimate.
+TEST(BadSpecs, AJobAboveTheMemoryLimitIsRefusedBeforeItAllocates) {
+  TempDir d;
+  json doc = {{"sweep", "memory"}, {"base", json::parse(tiny_base())}};
+  write_text(d.path / "spec.json", doc.dump());
+  auto r = run_cli({"submit", "spec.json", "--db", "c.db", "--dry-run"}, d.path);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("memory per bed or drop job: up to 0.96 MB"), std::string::npos) << r.out;
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
+  r = run_cli({"work", "--db", "c.db", "--workers", "1", "--quiet", "--max-memory", "0.5"}, d.path);
+  EXPECT_EQ(r.code, 4) << r.err;  // some job is dead
+  db::Database db((d.path / "c.db").string());
+  db::Statement q(db, "SELECT state, attempts, last_error FROM jobs WHERE kind = 'bed'");
+  ASSERT_TRUE(q.step());
+  EXPECT_EQ(q.get_text(0), "dead") << r.err;
+  EXPECT_EQ(q.get_int(1), 1) << "refused at its first attempt, not retried";
+  EXPECT_NE(q.get_text(2).find("/container/fill_height_m"), std::string::npos) << q.get_text(2);
+  EXPECT_NE(q.get_text(2).find("above work --max-memory 0.5 MB"), std::string::npos) << q.get_text(2);
+}
