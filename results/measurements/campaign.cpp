@@ -26,6 +26,18 @@ std::vector<double> Campaign::gravity_levels() const {
   return gravity_levels_of(g);
 }
 
+std::vector<std::vector<std::size_t>> Campaign::trials_by_level() const {
+  const std::vector<double> levels = gravity_levels();
+  std::vector<std::vector<std::size_t>> out(levels.size());
+  for (std::size_t i = 0; i < trials.size(); ++i)
+    for (std::size_t gi = 0; gi < levels.size(); ++gi)
+      if (same_gravity_level(levels[gi], trials[i].info.gravity_m_s2)) {
+        out[gi].push_back(i);
+        break;
+      }
+  return out;
+}
+
 void process_trial(MeasuredTrial& t) {
   t.raw.source = t.info.source;
   MetricOptions o = metric_options(t.info);

@@ -39,6 +39,8 @@ struct Campaign {
   std::vector<MeasuredTrial> trials;                         ///< the trials read and processed successfully
   std::vector<ImportIssue> issues;                           ///< one per rejected row, trace or unmeasurable trial
   [[nodiscard]] std::vector<double> gravity_levels() const;  ///< same_gravity_level(), descending
+  /// The indices of the trials of each level, in the order of gravity_levels().
+  [[nodiscard]] std::vector<std::vector<std::size_t>> trials_by_level() const;
 };
 
 /// The one processing entry: options from the trial (metric_options), bias removal from the

@@ -13,6 +13,7 @@
 #include "engine/core/error.h"
 #include "results/model/froude.h"
 #include "results/model/level_out.h"
+#include "results/model/stats.h"
 
 namespace gravsweep::results {
 
@@ -36,21 +37,12 @@ void widen(LawRange& r, double x) {
 /// The constants refitted on resamples of whole drops, drawn within each gravity level.
 std::vector<std::vector<double>> bootstrap_constants(const ModelSpec& law, const Campaign& c, int resamples,
                                                      unsigned seed) {
-  const std::vector<double> levels = c.gravity_levels();
-  std::vector<std::vector<std::size_t>> by_level(levels.size());
-  for (std::size_t i = 0; i < c.trials.size(); ++i)
-    for (std::size_t gi = 0; gi < levels.size(); ++gi)
-      if (same_gravity_level(levels[gi], c.trials[i].info.gravity_m_s2)) by_level[gi].push_back(i);
+  const auto by_level = c.trials_by_level();
   std::mt19937 rng(seed);
   std::vector<std::vector<double>> out;
   for (int b = 0; b < resamples; ++b) {
-    std::vector<int> count(c.trials.size(), 0);
-    for (const auto& trials : by_level) {
-      std::uniform_int_distribution<std::size_t> pick(0, trials.size() - 1);
-      for (std::size_t k = 0; k < trials.size(); ++k) ++count[trials[pick(rng)]];
-    }
     try {
-      const FittedModel m = fit_model(law, c, count);
+      const FittedModel m = fit_model(law, c, resample_within(by_level, c.trials.size(), rng));
       out.emplace_back(m.coef.data(), m.coef.data() + m.coef.size());
     } catch (const std::exception&) {  // a resample the fit cannot solve: left out
     }
@@ -358,20 +350,10 @@ double form_error_at(const std::vector<LawFormError>& f, double fr, int k) {
   return pts.back().second;
 }
 
-double percentile(std::vector<double> v, double q) {
-  std::erase_if(v, [](double x) { return !std::isfinite(x); });
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const double at = q * static_cast<double>(v.size() - 1);
-  const auto lo = static_cast<std::size_t>(at);
-  const auto hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (at - static_cast<double>(lo)) * (v[hi] - v[lo]);
-}
-
 /// The 95 % interval of one metric: the bootstrap's spread and the form error, in quadrature.
 void interval(double value, const std::vector<double>& boot, double form_rms_pct, double& lo, double& hi) {
   constexpr double kZ95 = 1.959964;
-  const double b_lo = percentile(boot, 0.025), b_hi = percentile(boot, 0.975);
+  const double b_lo = quantile(boot, 0.025), b_hi = quantile(boot, 0.975);
   const double param_rel = value > 0 && std::isfinite(b_lo) ? 0.5 * (b_hi - b_lo) / value : 0.0;
   const double form_rel = std::isfinite(form_rms_pct) ? kZ95 * form_rms_pct / 100 : 0.0;
   const double half = std::hypot(param_rel, form_rel);

@@ -8,6 +8,8 @@
 #include <random>
 #include <stdexcept>
 
+#include "results/model/stats.h"
+
 namespace gravsweep::results {
 
 namespace {
@@ -44,31 +46,13 @@ double power_of(const std::vector<double>& g, const Freed& f) {
   return det > 0 ? (sw * sxy - sx * sy) / det : NAN;
 }
 
-/// Counts of a bootstrap resample: each level's trials drawn with replacement, as many as it has.
-std::vector<int> resample(const std::vector<std::vector<std::size_t>>& by_level, std::size_t n, std::mt19937& rng) {
-  std::vector<int> count(n, 0);
-  for (const auto& trials : by_level) {
-    std::uniform_int_distribution<std::size_t> pick(0, trials.size() - 1);
-    for (std::size_t k = 0; k < trials.size(); ++k) ++count[trials[pick(rng)]];
-  }
-  return count;
-}
-
-double quantile(std::vector<double> v, double q) {
-  std::sort(v.begin(), v.end());
-  const double at = q * static_cast<double>(v.size() - 1);
-  const auto lo = static_cast<std::size_t>(std::floor(at));
-  const auto hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (at - static_cast<double>(lo)) * (v[hi] - v[lo]);
-}
-
 /// The power and its bootstrap interval of constant k (row.value filled from the full fit).
 void bootstrap_power(const ModelSpec& freed, const Campaign& c, const std::vector<std::vector<std::size_t>>& by_level,
                      std::size_t k, int resamples, unsigned seed, ScalingRow& row) {
   std::mt19937 rng(seed + static_cast<unsigned>(k) * 7919u);
   std::vector<double> powers;
   for (int b = 0; b < resamples; ++b) {
-    const std::vector<int> count = resample(by_level, c.trials.size(), rng);
+    const std::vector<int> count = resample_within(by_level, c.trials.size(), rng);
     try {
       const double p = power_of(row.gravity_m_s2, freed_values(fit_model(freed, c, count), k));
       if (std::isfinite(p)) powers.push_back(p);
@@ -257,9 +241,7 @@ ScalingCheck scaling_check(const ModelSpec& law, const Campaign& c, int resample
   current.trial_force_units = true;
   const ModelSpec as_given = current;
   const FittedModel given = fit_model(as_given, c);
-  std::vector<std::vector<std::size_t>> by_level(levels.size());
-  for (std::size_t i = 0; i < c.trials.size(); ++i)
-    by_level[static_cast<std::size_t>(given.gravity_index(c.trials[i].info.gravity_m_s2))].push_back(i);
+  const std::vector<std::vector<std::size_t>> by_level = c.trials_by_level();
   // Freed one at a time, a constant that does not scale as assumed drags the others along (they
   // absorb part of its g-dependence): carry the most significant one by its g^p, then check every
   // constant again against that law, until none differs (kScalingMaxRounds at most).

@@ -1,6 +1,9 @@
 // Distribution functions (see stats.h).
 #include "results/model/stats.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <cmath>
 #include <limits>
 
@@ -57,6 +60,27 @@ double f_upper_p(double f, double d1, double d2) {
   if (!(d1 > 0) || !(d2 > 0)) return kNaN;
   if (!(f > 0)) return 1.0;
   return regularized_beta(0.5 * d2, 0.5 * d1, d2 / (d2 + d1 * f));
+}
+
+double quantile(std::vector<double> v, double q) {
+  std::erase_if(v, [](double x) { return !std::isfinite(x); });
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  const double at = q * static_cast<double>(v.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(at));
+  const auto hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (at - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+std::vector<int> resample_within(const std::vector<std::vector<std::size_t>>& groups, std::size_t n,
+                                 std::mt19937& rng) {
+  std::vector<int> count(n, 0);
+  for (const auto& g : groups) {
+    if (g.empty()) continue;
+    std::uniform_int_distribution<std::size_t> pick(0, g.size() - 1);
+    for (std::size_t k = 0; k < g.size(); ++k) ++count[g[pick(rng)]];
+  }
+  return count;
 }
 
 }  // namespace gravsweep::results

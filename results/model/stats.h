@@ -2,8 +2,19 @@
 // definitions (Abramowitz & Stegun 26.5, 26.6): the regularised incomplete beta function and the
 // upper tail of Fisher's F distribution.
 #pragma once
+#include <cstddef>
+#include <random>
+#include <vector>
 
 namespace gravsweep::results {
+
+/// The q-quantile (0 <= q <= 1) of the finite values of v, linear between order statistics; NaN
+/// when there are none.
+double quantile(std::vector<double> v, double q);
+
+/// A cluster bootstrap's draw: how many times each of n items is taken when each group (indices
+/// into the n) is resampled with replacement to its own size (whole drops, within each level).
+std::vector<int> resample_within(const std::vector<std::vector<std::size_t>>& groups, std::size_t n, std::mt19937& rng);
 
 /// I_x(a, b), the regularised incomplete beta function, for a, b > 0 and 0 <= x <= 1 (A&S 26.5.1),
 /// by its continued fraction (A&S 26.5.8) evaluated with the modified Lentz method, on the side
