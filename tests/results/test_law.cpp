@@ -4,6 +4,7 @@
 // level of the committed sweep predicted by the law saved from the other levels.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -195,6 +196,41 @@ TEST(Law, TheVerbsSaveAndPredictWithExitCodesScriptsCanTrust) {
       "model predict --law '" + (d.path / "bad.json").string() + "' --gravity 0.1 --speed 0.3", true);
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("bad.json: /format"), std::string::npos) << r.out;
+}
+
+}  // namespace gravsweep::results
+
+namespace gravsweep::results {
+
+// The worked examples of docs/mission.md stay true: each committed output of
+// examples/mission/run.sh (the command on its first line, the exit code on its last) is what
+// `model predict` prints today with the committed law.
+TEST(Law, TheWorkedExamplesMatchTheirCommittedOutputs) {
+  const auto dir = std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "examples" / "mission";
+  int checked = 0;
+  for (const char* name : {"lander", "lander_extrapolated", "moon_sampler", "mars_rock"}) {
+    std::ifstream in(dir / (std::string(name) + ".txt"));
+    ASSERT_TRUE(in.good()) << name;
+    std::vector<std::string> lines;
+    for (std::string l; std::getline(in, l);) lines.push_back(l);
+    ASSERT_GE(lines.size(), 3u) << name;
+    const std::string prefix = "$ gravsweep ";
+    ASSERT_EQ(lines.front().rfind(prefix, 0), 0u) << lines.front();
+    // From the example's folder, where the command names its law.
+    const std::string cmd = "cd '" + dir.string() + "' && '" + GRAVSWEEP_BINARY + "' " +
+                            lines.front().substr(prefix.size()) + " 2>&1; echo \"(exit $?)\"";
+    FILE* p = popen(cmd.c_str(), "r");
+    ASSERT_NE(p, nullptr);
+    std::string out;
+    std::array<char, 4096> buf{};
+    while (fgets(buf.data(), buf.size(), p)) out += buf.data();
+    pclose(p);
+    std::string want;
+    for (std::size_t i = 1; i < lines.size(); ++i) want += lines[i] + "\n";
+    EXPECT_EQ(out, want) << name;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 4);
 }
 
 }  // namespace gravsweep::results
