@@ -1,6 +1,8 @@
 // The design's Froude numbers (see froude.h).
 #include "results/model/froude.h"
 
+#include <cmath>
+
 #include <algorithm>
 #include <cstddef>
 
@@ -17,6 +19,10 @@ std::vector<int> froude_groups(const std::vector<double>& ln_froude) {
     group[order[k]] = g;
   }
   return group;
+}
+
+double impact_froude(const MeasuredTrial& t) {
+  return t.processed.metrics.vc_m_s / std::sqrt(t.info.gravity_m_s2 * t.info.projectile_diameter_m);
 }
 
 }  // namespace gravsweep::results

@@ -5,6 +5,8 @@
 #pragma once
 #include <vector>
 
+#include "results/measurements/campaign.h"
+
 namespace gravsweep::results {
 
 /// Froude numbers closer than this in ln Fr (5 %) are one speed of the design.
@@ -13,5 +15,9 @@ inline constexpr double kSameFroudeLn = 0.05;
 /// The design point of each ln Fr value: runs of sorted values whose gaps are at most
 /// kSameFroudeLn, numbered 0, 1, ... from the smallest Fr. Same size and order as `ln_froude`.
 std::vector<int> froude_groups(const std::vector<double>& ln_froude);
+
+/// A measured trial's impact Froude number vc / sqrt(g D), vc its measured collision speed and D
+/// the projectile's diameter.
+double impact_froude(const MeasuredTrial& t);
 
 }  // namespace gravsweep::results

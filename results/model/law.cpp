@@ -21,10 +21,6 @@ using nlohmann::json;
 
 namespace {
 
-double impact_froude(const MeasuredTrial& t) {
-  return t.processed.metrics.vc_m_s / std::sqrt(t.info.gravity_m_s2 * t.info.projectile_diameter_m);
-}
-
 /// A bed deep enough that no floor enters a prediction (bottom_stiffening reads the fill height).
 constexpr double kUnboundedFill_m = 1e3;
 

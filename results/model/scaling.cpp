@@ -8,6 +8,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "results/model/froude.h"
 #include "results/model/stats.h"
 
 namespace gravsweep::results {
@@ -124,7 +125,7 @@ constexpr double kFroudeRangeRatio = 0.8;
 std::string froude_note(const Campaign& c, const std::vector<double>& levels) {
   std::vector<double> top(levels.size(), 0.0);
   for (const auto& t : c.trials) {
-    const double fr = t.processed.metrics.vc_m_s / std::sqrt(t.info.gravity_m_s2 * t.info.projectile_diameter_m);
+    const double fr = impact_froude(t);
     for (std::size_t gi = 0; gi < levels.size(); ++gi)
       if (same_gravity_level(levels[gi], t.info.gravity_m_s2) && std::isfinite(fr)) top[gi] = std::max(top[gi], fr);
   }
