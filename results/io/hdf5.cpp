@@ -1,7 +1,11 @@
 #include "results/io/hdf5.h"
 
 #include <fmt/format.h>
+#include <fcntl.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <atomic>
 
@@ -105,6 +109,28 @@ void set_scalar_attr(hid_t obj, const std::string& name, hid_t file_type, hid_t 
   if (a.get() < 0 || H5Awrite(a, mem_type, &value) < 0) fail(obj, fmt::format("cannot write attribute '{}'", name));
 }
 
+/// The in-memory file grows by this much at a time.
+constexpr std::size_t kMemoryFileIncrementBytes = 4u << 20;
+
+/// Writes a memory-backed file's image to `path` (created by File::create), naming the errno.
+void write_image(const std::filesystem::path& path, const std::vector<char>& image) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
+  if (fd < 0) throw H5Error(fmt::format("HDF5 {}: cannot open to write: {}", path.string(), std::strerror(errno)));
+  std::size_t done = 0;
+  while (done < image.size()) {
+    const ssize_t w = ::write(fd, image.data() + done, image.size() - done);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) {
+      const int err = errno;
+      ::close(fd);
+      throw H5Error(fmt::format("HDF5 {}: cannot write ({} of {} bytes written): {}", path.string(), done, image.size(),
+                                std::strerror(err)));
+    }
+    done += static_cast<std::size_t>(w);
+  }
+  if (::close(fd) != 0) throw H5Error(fmt::format("HDF5 {}: cannot write: {}", path.string(), std::strerror(errno)));
+}
+
 }  // namespace
 
 std::string where(hid_t obj) { return fmt::format("{}:{}", name_of(obj, &fget_name), name_of(obj, &iget_name)); }
@@ -115,11 +141,23 @@ std::filesystem::path temporary_sibling(const std::filesystem::path& final_path)
   return tmp;
 }
 
-File File::create(const std::filesystem::path& path) {
+File File::create(const std::filesystem::path& path, Backing backing) {
   silence_hdf5();
   File f;
   f.path_ = path;
-  f.handle_ = Handle(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), &H5Fclose);
+  f.backing_ = backing;
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), &H5Pclose);
+  if (backing == Backing::memory) {
+    // Fail now, as the streaming file would, when the folder cannot take the file.
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0)
+      throw H5Error(fmt::format("HDF5 {}: cannot create the file ({}; does the folder exist and is it writable?)",
+                                path.string(), std::strerror(errno)));
+    ::close(fd);
+    if (H5Pset_fapl_core(fapl, kMemoryFileIncrementBytes, 0) < 0)
+      throw H5Error(fmt::format("HDF5 {}: cannot set up an in-memory file", path.string()));
+  }
+  f.handle_ = Handle(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl), &H5Fclose);
   if (f.handle_.get() < 0)
     throw H5Error(
         fmt::format("HDF5 {}: cannot create the file (does the folder exist and is it "
@@ -140,11 +178,19 @@ File File::open_read(const std::filesystem::path& path) {
 }
 
 void File::close() {
-  if (handle_.get() >= 0) {
-    if (H5Fflush(handle_, H5F_SCOPE_LOCAL) < 0) throw H5Error(fmt::format("HDF5 {}: flush failed", path_.string()));
-    const hid_t id = handle_.release();
-    if (H5Fclose(id) < 0) throw H5Error(fmt::format("HDF5 {}: close failed", path_.string()));
+  if (handle_.get() < 0) return;
+  if (H5Fflush(handle_, H5F_SCOPE_LOCAL) < 0) throw H5Error(fmt::format("HDF5 {}: flush failed", path_.string()));
+  std::vector<char> image;
+  if (backing_ == Backing::memory) {
+    const ssize_t n = H5Fget_file_image(handle_, nullptr, 0);
+    if (n < 0) throw H5Error(fmt::format("HDF5 {}: cannot take the file's image", path_.string()));
+    image.resize(static_cast<std::size_t>(n));
+    if (H5Fget_file_image(handle_, image.data(), image.size()) != n)
+      throw H5Error(fmt::format("HDF5 {}: cannot take the file's image", path_.string()));
   }
+  const hid_t id = handle_.release();
+  if (H5Fclose(id) < 0) throw H5Error(fmt::format("HDF5 {}: close failed", path_.string()));
+  if (backing_ == Backing::memory) write_image(path_, image);
 }
 
 Handle create_group(hid_t parent, const std::string& name) {

@@ -57,21 +57,32 @@ class Handle {
   Closer closer_ = nullptr;
 };
 
+/// Where a file being written lives until close().
+///  - memory: HDF5 builds the whole file in memory (its core driver, no backing store) and close()
+///    writes the image to disk with plain POSIX calls. A full or failing disk is then an error of
+///    ours, thrown with the errno's text, and never an error inside HDF5 (whose library keeps a
+///    file whose close failed and crashes on it in its exit handler, HDF5 1.10).
+///  - streaming: written through to disk as it grows (snapshot series, which may be larger than
+///    memory); a disk that fills under it can still fail inside HDF5.
+enum class Backing { memory, streaming };
+
 /// An open HDF5 file; remembers its path for error messages.
 class File {
  public:
   /// Creates (truncates) a file for writing.
-  static File create(const std::filesystem::path& path);
+  static File create(const std::filesystem::path& path, Backing backing = Backing::memory);
   /// Opens an existing file read-only.
   static File open_read(const std::filesystem::path& path);
   [[nodiscard]] hid_t id() const { return handle_.get(); }
   [[nodiscard]] const std::filesystem::path& path() const { return path_; }
-  /// Flushes and closes now (errors surface here rather than in a destructor).
+  /// Flushes and closes now (errors surface here rather than in a destructor). A memory-backed
+  /// file is written to its path here; a file destroyed without close() leaves nothing on disk.
   void close();
 
  private:
   Handle handle_;
   std::filesystem::path path_;
+  Backing backing_ = Backing::streaming;
 };
 
 /// Creates a group `name` under `parent`.

@@ -99,7 +99,7 @@ SnapshotWriter::SnapshotWriter(const std::filesystem::path& h5_path, const std::
   impl_->final_path = h5_path;
   impl_->tmp_path = h5::temporary_sibling(h5_path);
   impl_->grains = grain_radius_m.size();
-  impl_->file = h5::File::create(impl_->tmp_path);
+  impl_->file = h5::File::create(impl_->tmp_path, h5::Backing::streaming);
   const hid_t f = impl_->file.id();
   h5::set_attr(f, "format", kSnapshotFormat);
   h5::set_attr(f, "format_version", kSnapshotFormatVersion);
