@@ -325,8 +325,8 @@ void check_range(const char* what, double x, const LawRange& r, double factor, L
                         r.hi, far ? fmt::format(" (beyond a factor {:g}: refused)", factor) : "");
 }
 
-/// The form error (RMS %, of metric k: 0 zstop, 1 tstop, 2 apeak) at Froude number fr: linear in
-/// ln Fr between the design's Froude numbers, the end values beyond them.
+}  // namespace
+
 double form_error_at(const std::vector<LawFormError>& f, double fr, int k) {
   const auto value = [k](const LawFormError& e) {
     return k == 0 ? e.zstop_rms_pct : k == 1 ? e.tstop_rms_pct : e.apeak_rms_pct;
@@ -346,6 +346,8 @@ double form_error_at(const std::vector<LawFormError>& f, double fr, int k) {
   return pts.back().second;
 }
 
+namespace {
+
 /// The 95 % interval of one metric: the bootstrap's spread and the form error, in quadrature.
 void interval(double value, const std::vector<double>& boot, double form_rms_pct, double& lo, double& hi) {
   constexpr double kZ95 = 1.959964;
@@ -359,6 +361,24 @@ void interval(double value, const std::vector<double>& boot, double form_rms_pct
 
 }  // namespace
 
+TermContext law_case_context(const LawCase& c) {
+  TermContext ctx;
+  ctx.g_m_s2 = c.gravity_m_s2;
+  ctx.diameter_m = c.diameter_m;
+  ctx.mass_kg = c.mass_kg;
+  ctx.fill_height_m = kUnboundedFill_m;
+  ctx.v_m_s = ctx.vc_m_s = c.speed_m_s;
+  return ctx;
+}
+
+SavedLaw without_ranges(SavedLaw law) {
+  law.gravity_m_s2 = {0, 1e300};
+  law.froude = {0, 1e300};
+  law.diameter_m = {0, 1e300};
+  law.mass_kg = {0, 1e300};
+  return law;
+}
+
 LawPrediction predict_case(const SavedLaw& law, const LawCase& c) {
   LawPrediction p;
   p.froude = c.speed_m_s / std::sqrt(c.gravity_m_s2 * c.diameter_m);
@@ -367,12 +387,7 @@ LawPrediction predict_case(const SavedLaw& law, const LawCase& c) {
   check_range("projectile diameter (m)", c.diameter_m, law.diameter_m, kLawExtrapolateDiameter, p);
   check_range("projectile mass (kg)", c.mass_kg, law.mass_kg, kLawExtrapolateMass, p);
   if (p.range == LawRangeFlag::refused) return p;
-  TermContext ctx;
-  ctx.g_m_s2 = c.gravity_m_s2;
-  ctx.diameter_m = c.diameter_m;
-  ctx.mass_kg = c.mass_kg;
-  ctx.fill_height_m = kUnboundedFill_m;
-  ctx.v_m_s = ctx.vc_m_s = c.speed_m_s;
+  const TermContext ctx = law_case_context(c);
   FittedModel m = law_model(law);
   const Prediction best = predict(m, ctx);
   p.zstop_m = best.zstop_m, p.tstop_s = best.tstop_s, p.apeak_m_s2 = best.apeak_m_s2;

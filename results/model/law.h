@@ -83,6 +83,19 @@ struct LawPrediction {
   std::string note;  ///< which ranges a case leaves, by how much
 };
 
+/// The context of a case for predict (model.h): its gravity, speed, diameter and mass, on a bed
+/// deep enough not to matter.
+TermContext law_case_context(const LawCase& c);
+
+/// The law with no fitted ranges (--extrapolate: every case is predicted; the caller keeps the
+/// flag of the real ranges).
+SavedLaw without_ranges(SavedLaw law);
+
+/// The law's RMS relative error, %, of metric k (0 zstop, 1 tstop, 2 apeak) at Froude number fr:
+/// linear in ln Fr between the design's Froude numbers, the end values beyond them; NaN when the
+/// law has none for that metric.
+double form_error_at(const std::vector<LawFormError>& f, double fr, int k);
+
 /// Integrates the law from the impact speed to the stop (predict, model.h). The 95 % interval
 /// holds the constants' uncertainty (the 2.5 and 97.5 % points of the predictions of the bootstrap
 /// resamples) and the law's form error at the case's Froude number (1.96 times its RMS relative

@@ -72,6 +72,32 @@ double quantile(std::vector<double> v, double q) {
   return v[lo] + (at - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
+double weighted_quantile(const std::vector<double>& v, const std::vector<double>& w, double q) {
+  std::vector<std::size_t> order;
+  double total = 0;
+  for (std::size_t i = 0; i < v.size() && i < w.size(); ++i)
+    if (std::isfinite(v[i]) && w[i] > 0) {
+      order.push_back(i);
+      total += w[i];
+    }
+  if (order.empty() || !(total > 0)) return NAN;
+  std::sort(order.begin(), order.end(), [&v](std::size_t a, std::size_t b) { return v[a] < v[b]; });
+  // Each value sits at the middle of its weight's share of [0, total].
+  double below = 0, prev_pos = NAN, prev_v = NAN;
+  const double target = q * total;
+  for (const std::size_t i : order) {
+    const double pos = below + 0.5 * w[i];
+    if (pos >= target) {
+      if (std::isnan(prev_pos)) return v[i];
+      return prev_v + (v[i] - prev_v) * (target - prev_pos) / (pos - prev_pos);
+    }
+    below += w[i];
+    prev_pos = pos;
+    prev_v = v[i];
+  }
+  return prev_v;
+}
+
 std::vector<int> resample_within(const std::vector<std::vector<std::size_t>>& groups, std::size_t n,
                                  std::mt19937& rng) {
   std::vector<int> count(n, 0);

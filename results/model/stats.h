@@ -12,6 +12,10 @@ namespace gravsweep::results {
 /// when there are none.
 double quantile(std::vector<double> v, double q);
 
+/// The q-quantile of values v carrying weights w (same length, w >= 0): the smallest value whose
+/// cumulative weight reaches q of the total, linear between neighbours; NaN when no weight.
+double weighted_quantile(const std::vector<double>& v, const std::vector<double>& w, double q);
+
 /// A cluster bootstrap's draw: how many times each of n items is taken when each group (indices
 /// into the n) is resampled with replacement to its own size (whole drops, within each level).
 std::vector<int> resample_within(const std::vector<std::vector<std::size_t>>& groups, std::size_t n, std::mt19937& rng);

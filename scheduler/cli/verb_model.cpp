@@ -45,6 +45,7 @@ void setup_model(CLI::App& app) {
   setup_model_lolo(*sub);
   setup_model_scaling(*sub);
   setup_model_predict(*sub);
+  setup_model_infer(*sub);
 }
 
 }  // namespace gravsweep::cli

@@ -90,13 +90,8 @@ void run_predict(const PredictOptions& o) {
   for (const auto& c : cases) {
     results::LawPrediction p = results::predict_case(law, c);
     if (p.range == results::LawRangeFlag::refused && o.extrapolate) {
-      results::SavedLaw wide = law;  // --extrapolate: predicted all the same, still flagged
-      wide.gravity_m_s2 = {0, 1e300};
-      wide.froude = {0, 1e300};
-      wide.diameter_m = {0, 1e300};
-      wide.mass_kg = {0, 1e300};
-      const std::string note = p.note;
-      p = results::predict_case(wide, c);
+      const std::string note = p.note;  // --extrapolate: predicted all the same, still flagged
+      p = results::predict_case(results::without_ranges(law), c);
       p.range = results::LawRangeFlag::refused;
       p.note = note + " (predicted: --extrapolate)";
     }

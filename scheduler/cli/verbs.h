@@ -19,6 +19,7 @@ void setup_model_collapse(CLI::App& model);
 void setup_model_lolo(CLI::App& model);
 void setup_model_scaling(CLI::App& model);
 void setup_model_predict(CLI::App& model);
+void setup_model_infer(CLI::App& model);
 void setup_synth(CLI::App& app);
 void setup_report(CLI::App& app);
 void setup_run(CLI::App& app);

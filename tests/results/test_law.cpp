@@ -204,11 +204,12 @@ namespace gravsweep::results {
 
 // The worked examples of docs/mission.md stay true: each committed output of
 // examples/mission/run.sh (the command on its first line, the exit code on its last) is what
-// `model predict` prints today with the committed law.
+// `model predict` and `model infer` print today with the committed law.
 TEST(Law, TheWorkedExamplesMatchTheirCommittedOutputs) {
   const auto dir = std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "examples" / "mission";
   int checked = 0;
-  for (const char* name : {"lander", "lander_extrapolated", "moon_sampler", "mars_rock"}) {
+  for (const char* name : {"lander", "lander_extrapolated", "moon_sampler", "mars_rock", "moon_sampler_infer",
+                           "moon_sampler_infer_tstop"}) {
     std::ifstream in(dir / (std::string(name) + ".txt"));
     ASSERT_TRUE(in.good()) << name;
     std::vector<std::string> lines;
@@ -230,7 +231,7 @@ TEST(Law, TheWorkedExamplesMatchTheirCommittedOutputs) {
     EXPECT_EQ(out, want) << name;
     ++checked;
   }
-  EXPECT_EQ(checked, 4);
+  EXPECT_EQ(checked, 6);
 }
 
 }  // namespace gravsweep::results
