@@ -295,4 +295,28 @@ void draw_collapse(const Campaign& campaign, const std::string& out, const std::
   plot(tmp, "collapse", json{{"out", fs::absolute(out).string()}, {"title", title}, {"rows", rows}}, out);
 }
 
+void draw_law_against_gravity(const std::vector<LawCurvePoint>& points, const LawRange& fitted_gravity,
+                              const std::string& out, const std::string& title) {
+  check_png(out);
+  ScratchDir tmp("law_g");
+  {
+    std::ofstream f(tmp.path / "law_g.csv");
+    f << "curve,gravity_m_s2,zstop_m,zstop_lo_m,zstop_hi_m,tstop_s,tstop_lo_s,tstop_hi_s,apeak_m_s2,apeak_lo_m_s2,"
+         "apeak_hi_m_s2,range\n";
+    for (const auto& q : points) {
+      const auto& p = q.p;
+      f << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{}\n", q.curve, q.gravity_m_s2, p.zstop_m, p.zstop_lo_m,
+                       p.zstop_hi_m, p.tstop_s, p.tstop_lo_s, p.tstop_hi_s, p.apeak_m_s2, p.apeak_lo_m_s2,
+                       p.apeak_hi_m_s2, to_string(p.range));
+    }
+    if (!f) throw std::runtime_error(fmt::format("{}: cannot write", (tmp.path / "law_g.csv").string()));
+  }
+  plot(tmp, "law_g",
+       json{{"out", fs::absolute(out).string()},
+            {"title", title},
+            {"fitted_g_min", fitted_gravity.lo},
+            {"fitted_g_max", fitted_gravity.hi}},
+       out);
+}
+
 }  // namespace gravsweep::results

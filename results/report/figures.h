@@ -14,6 +14,7 @@
 #include "results/processing/trace.h"
 
 #include "results/measurements/campaign.h"
+#include "results/model/law.h"
 
 namespace gravsweep::results {
 
@@ -40,5 +41,19 @@ std::string draw_fig1(const Fig1Request& request);
 /// The Froude-number collapse (results/model/collapse.h): zstop/D, tstop sqrt(g/D), apeak/g against
 /// Fr, one colour per gravity level, each panel titled with its collapse numbers. `out`: PNG.
 void draw_collapse(const Campaign& campaign, const std::string& out, const std::string& title = "");
+
+/// One point of a saved law's prediction against gravity: the curve it belongs to (a fixed speed
+/// or a fixed Froude number) and the prediction (with its interval and range flag).
+struct LawCurvePoint {
+  std::string curve;
+  double gravity_m_s2 = NAN;
+  LawPrediction p;
+};
+
+/// zstop, tstop and apeak of a saved law against g (log axes), one curve per fixed speed or Froude
+/// number with its 95 % band; the fitted gravity range unshaded, extrapolated points dashed,
+/// refused ones (predicted with --extrapolate) dotted. `out`: PNG.
+void draw_law_against_gravity(const std::vector<LawCurvePoint>& points, const LawRange& fitted_gravity,
+                              const std::string& out, const std::string& title);
 
 }  // namespace gravsweep::results

@@ -446,6 +446,49 @@ def plot_collapse():
     written.append(spec["out"])
 
 
+def plot_law_g():
+    """A saved law's zstop, tstop and apeak against g (log axes), one curve per fixed speed or
+    Froude number with its 95 % band; outside the fitted g range shaded, extrapolated points
+    dashed, refused ones (predicted with --extrapolate) dotted."""
+    import json
+    spec = json.load(open(os.path.join(D, "law_g.json")))
+    rows = read(os.path.join(D, "law_g.csv"))
+    curves = list(dict.fromkeys(r["curve"] for r in rows))
+    cmap = plt.get_cmap("viridis")
+    panels = [("zstop", "m", "zstop (m)"), ("tstop", "s", "tstop (s)"), ("apeak", "m_s2", "apeak (m/s2)")]
+    fig, axs = plt.subplots(1, 3, figsize=(13, 4.2))
+    gmin, gmax = num(spec["fitted_g_min"]), num(spec["fitted_g_max"])
+    for ax, (key, unit, lab) in zip(axs, panels):
+        for k, name in enumerate(curves):
+            c = cmap(k / max(1, len(curves) - 1))
+            pts = [r for r in rows if r["curve"] == name and num(r[f"{key}_{unit}"]) > 0]
+            g = [num(r["gravity_m_s2"]) for r in pts]
+            ax.fill_between(g, [num(r[f"{key}_lo_{unit}"]) for r in pts], [num(r[f"{key}_hi_{unit}"]) for r in pts],
+                            color=c, alpha=0.15, lw=0)
+            for flag, style in (("inside", "-"), ("extrapolated", "--"), ("refused", ":")):
+                ys = [num(r[f"{key}_{unit}"]) if r["range"] == flag else float("nan") for r in pts]
+                ax.plot(g, ys, style, color=c, lw=1.6, label=name if flag == "inside" else None)
+        ax.axvspan(1e-300, gmin, color="0.85", alpha=0.5, lw=0)
+        ax.axvspan(gmax, 1e300, color="0.85", alpha=0.5, lw=0)
+        allg = [num(r["gravity_m_s2"]) for r in rows]
+        ax.set_xlim(min(allg), max(allg))
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("g (m/s2)")
+        ax.set_ylabel(lab)
+        ax.grid(alpha=0.3, which="both")
+    axs[0].legend(fontsize=7)
+    axs[1].set_title("shaded: outside the fitted g; dashed: extrapolated; dotted: refused", fontsize=8)
+    if spec.get("title"):
+        fig.suptitle(spec["title"], fontsize=10)
+    fig.tight_layout()
+    fig.savefig(spec["out"], dpi=120)
+    plt.close(fig)
+    written.append(spec["out"])
+
+
+if WHICH == "law_g":
+    plot_law_g()
 if WHICH == "collapse":
     plot_collapse()
 if WHICH == "trace":

@@ -5,6 +5,7 @@
 // --extrapolate).
 #include <fmt/format.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -16,6 +17,7 @@
 #include "results/io/csv.h"
 #include "results/io/table.h"
 #include "results/model/law.h"
+#include "results/report/figures.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/format_option.h"
 #include "scheduler/cli/verbs.h"
@@ -33,7 +35,41 @@ struct PredictOptions {
   std::string cases;
   bool extrapolate = false;
   std::string format = "table";
+  std::string plot;                 ///< PNG of the prediction against g; empty: none
+  std::vector<double> plot_froude;  ///< the figure's curves at these Froude numbers (else at the speeds)
 };
+
+/// Points of the figure's g grid per decade, and how far beyond the fitted g range it reaches
+/// (a factor: past the extrapolation limit, so that the refused zone shows).
+constexpr int kPlotPointsPerDecade = 12;
+constexpr double kPlotBeyondGravity = 30.0;
+
+/// The prediction against g: one curve per --plot-froude value (v = Fr sqrt(g D)) or per --speed.
+void plot_against_gravity(const PredictOptions& o, const results::SavedLaw& law) {
+  const bool by_froude = !o.plot_froude.empty();
+  const std::vector<double>& fixed = by_froude ? o.plot_froude : o.speed;
+  if (fixed.empty()) throw UsageError("--plot: give --speed (curves at fixed speeds) or --plot-froude");
+  const double lo = std::log10(law.gravity_m_s2.lo / kPlotBeyondGravity);
+  const double hi = std::log10(law.gravity_m_s2.hi * kPlotBeyondGravity);
+  const int n = static_cast<int>(std::ceil((hi - lo) * kPlotPointsPerDecade));
+  std::vector<results::LawCurvePoint> pts;
+  for (const double x : fixed) {
+    const std::string curve = by_froude ? fmt::format("Fr = {:g}", x) : fmt::format("v = {:g} m/s", x);
+    for (int i = 0; i <= n; ++i) {
+      const double g = std::pow(10.0, lo + (hi - lo) * i / n);
+      const results::LawCase c{g, by_froude ? x * std::sqrt(g * o.diameter_m) : x, o.diameter_m, o.mass_kg};
+      results::LawPrediction p = results::predict_case(law, c);
+      if (p.range == results::LawRangeFlag::refused) {
+        p = results::predict_case(results::without_ranges(law), c);
+        p.range = results::LawRangeFlag::refused;
+      }
+      pts.push_back({curve, g, p});
+    }
+  }
+  results::draw_law_against_gravity(
+      pts, law.gravity_m_s2, o.plot,
+      fmt::format("{}: D = {:g} m, m = {:g} kg ({})", law.model, o.diameter_m, o.mass_kg, o.law));
+}
 
 /// The cases of a CSV file: columns gravity_m_s2 and speed_m_s, optional diameter_m and mass_kg
 /// (the options' values where absent). ConfigError naming the file, line and column otherwise.
@@ -82,6 +118,11 @@ std::vector<results::LawCase> cases_of(const PredictOptions& o) {
 
 void run_predict(const PredictOptions& o) {
   const results::SavedLaw law = results::read_law(o.law);
+  if (!o.plot.empty()) {
+    plot_against_gravity(o, law);
+    if (o.format == "table") fmt::print("wrote {}\n", o.plot);
+    if (o.gravity.empty() && o.cases.empty()) return;  // the figure alone
+  }
   const std::vector<results::LawCase> cases = cases_of(o);
   results::Table t({"gravity_m_s2", "speed_m_s", "diameter_m", "mass_kg", "impact_froude", "zstop_m", "zstop_lo_m",
                     "zstop_hi_m", "tstop_s", "tstop_lo_s", "tstop_hi_s", "apeak_m_s2", "apeak_lo_m_s2", "apeak_hi_m_s2",
@@ -141,7 +182,8 @@ void setup_model_predict(CLI::App& model) {
       "Examples:\n"
       "  gravsweep model predict --law law.json --gravity 0.01 --speed 0.2\n"
       "  gravsweep model predict --law law.json --gravity 9.81 1.62 0.1 --speed 0.5 1 --format csv\n"
-      "  gravsweep model predict --law law.json --cases cases.csv   # gravity_m_s2,speed_m_s[,diameter_m,mass_kg]");
+      "  gravsweep model predict --law law.json --cases cases.csv   # gravity_m_s2,speed_m_s[,diameter_m,mass_kg]\n"
+      "  gravsweep model predict --law law.json --plot-froude 0.5 2 8 --plot law_g.png   # against g at fixed Fr");
   sub->add_option("--law", o->law, "the law file (model fit --save)")->required()->check(CLI::ExistingFile);
   sub->add_option("--gravity", o->gravity, "gravity, m/s2 (several: each is a case with each --speed)")
       ->check(CLI::PositiveNumber);
@@ -153,6 +195,11 @@ void setup_model_predict(CLI::App& model) {
   sub->add_option("--cases", o->cases, "CSV of cases: gravity_m_s2,speed_m_s[,diameter_m,mass_kg]")
       ->check(CLI::ExistingFile);
   sub->add_flag("--extrapolate", o->extrapolate, "predict cases far beyond the fitted ranges too (still flagged)");
+  sub->add_option("--plot", o->plot,
+                  "also draw zstop, tstop and apeak against g with their 95 % bands (PNG): one curve per --speed, "
+                  "or per --plot-froude value; --gravity is then optional");
+  sub->add_option("--plot-froude", o->plot_froude, "the figure's curves at these Froude numbers (v = Fr sqrt(g D))")
+      ->check(CLI::PositiveNumber);
   add_format_option(sub, o->format);
   sub->callback([o]() { run_predict(*o); });
 }

@@ -202,6 +202,22 @@ TEST(Law, TheVerbsSaveAndPredictWithExitCodesScriptsCanTrust) {
 
 namespace gravsweep::results {
 
+// The prediction against g: a figure at fixed Froude numbers with the law alone (no --gravity),
+// and --plot without a curve is a usage error.
+TEST(Law, PredictDrawsTheLawAgainstGravity) {
+  gravsweep::testing::TempDir d;
+  const std::string law = (std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "examples" / "mission" / "law.json").string();
+  const std::string png = d.str() + "/law_g.png";
+  auto r = gravsweep::testing::run_gravsweep(
+      "model predict --law '" + law + "' --plot-froude 0.5 2 --plot '" + png + "'", true);
+  EXPECT_EQ(r.code, 0) << r.out;
+  ASSERT_TRUE(std::filesystem::exists(png)) << r.out;
+  EXPECT_GT(std::filesystem::file_size(png), 20000u);
+  r = gravsweep::testing::run_gravsweep("model predict --law '" + law + "' --plot '" + png + "'", true);
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.out.find("--plot-froude"), std::string::npos) << r.out;
+}
+
 // The worked examples of docs/mission.md stay true: each committed output of
 // examples/mission/run.sh (the command on its first line, the exit code on its last) is what
 // `model predict` and `model infer` print today with the committed law.
