@@ -13,23 +13,25 @@
 # build/scheduler/gravsweep), WORKERS (1), THREADS (2), SPECS (the folder of level specs, default
 # examples/gravity_sweep; examples/gravity_sweep/extend holds the design's extensions: Fr 2-3 at
 # 9.81 m/s2 with their dt check, a second bed and a deeper, wider bed at 0.01 m/s2; run them in a
-# campaign of their own).
+# campaign of their own), DATA (where export writes, default data/gravity_sweep; the projectile
+# sweep: SPECS=examples/projectile_sweep DATA=data/projectile_sweep, on the gravity sweep's beds).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 gs="${GRAVSWEEP_BIN:-$root/build/scheduler/gravsweep}"
 db="${GRAVSWEEP_CAMPAIGN:-$root/runs/gravity_sweep/sweep.db}"
-data="$root/data/gravity_sweep"
+data="${DATA:-$root/data/gravity_sweep}"
 specs="${SPECS:-$root/examples/gravity_sweep}"
+beds="$root/data/gravity_sweep/beds"  # the bed cache of every sweep (the projectile sweep's beds are the gravity sweep's)
 [ -x "$gs" ] || { "$root/deploy/install-deps.sh" && "$root/deploy/build.sh"; }
 
 case "${1:-}" in
   run)
-    mkdir -p "$(dirname "$db")" "$data/beds"
+    mkdir -p "$(dirname "$db")" "$beds"
     for spec in "$specs"/g*.json; do "$gs" submit "$spec" --db "$db"; done
     "$gs" resume --db "$db"
     # Beds are kept in data/gravity_sweep/beds/ (commit them: a fresh machine skips their preparation).
     exec nice -n 10 "$gs" work --db "$db" --workers "${WORKERS:-1}" --threads "${THREADS:-2}" --lease 300 \
-      --bed-cache "$data/beds"
+      --bed-cache "$beds"
     ;;
   status)
     exec "$gs" status --db "$db"
@@ -38,7 +40,7 @@ case "${1:-}" in
     # One measurement campaign per level with finished drops, and one result table of all levels.
     for spec in "$specs"/g*.json; do
       sweep=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["sweep"])' "$spec")
-      dir="$data/${sweep#gravity_sweep_}"
+      dir="$data/${sweep#*_sweep_}"
       rm -rf "$dir.tmp"
       if "$gs" export --db "$db" --sweep "$sweep" --out "$dir.tmp" --rate-hz 2000 &&
         [ "$(wc -l < "$dir.tmp/trials.csv")" -gt 1 ]; then
@@ -76,7 +78,7 @@ print(f"{len(rows)} drops from {len(set(seen.values()))} folders -> {os.path.joi
 PY
     ;;
   *)
-    sed -n '2,14p' "$0"
+    sed -n '2,17p' "$0"
     exit 2
     ;;
 esac

@@ -245,6 +245,19 @@ double signed_rank_p(const std::vector<double>& d) {
 }
 
 std::vector<int> fold_of(const Campaign& c, int folds, unsigned seed) {
+  if (folds == kLeaveOneProjectileOut) {
+    std::vector<std::pair<double, double>> seen;
+    std::vector<int> f;
+    for (const auto& t : c.trials) {
+      const std::pair<double, double> p{t.info.projectile_diameter_m, t.info.projectile_mass_kg};
+      const auto it = std::find_if(seen.begin(), seen.end(), [&p](const auto& q) {
+        return std::abs(q.first - p.first) <= 1e-9 * q.first && std::abs(q.second - p.second) <= 1e-9 * q.second;
+      });
+      f.push_back(static_cast<int>(it - seen.begin()));
+      if (it == seen.end()) seen.push_back(p);
+    }
+    return f;
+  }
   // Stratified by gravity level: shuffle within each level, deal round-robin.
   std::mt19937 rng(seed);
   std::vector<int> idx(c.trials.size());
@@ -476,7 +489,7 @@ HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds, unsi
   h.trace_mse.assign(c.trials.size(), NAN);
   h.pred.assign(c.trials.size(), Prediction{});
   const auto f = fold_of(c, folds, seed);
-  for (int k = 0; k < folds; ++k) {
+  for (int k = 0; k < fold_count(f); ++k) {
     std::vector<bool> mask(c.trials.size());
     bool any = false;
     for (std::size_t i = 0; i < mask.size(); ++i) {

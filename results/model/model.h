@@ -123,6 +123,9 @@ struct HeldOut {
   std::vector<double> trace_mse;  ///< per trial
   std::vector<Prediction> pred;   ///< per trial, from the model fitted without that trial
 };
+/// `folds` = kLeaveOneProjectileOut: one fold per projectile (its diameter and mass), so that each
+/// projectile is predicted by the model fitted on the others.
+inline constexpr int kLeaveOneProjectileOut = -1;
 HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds = 6, unsigned seed = 1);
 /// The same; without predictions (trace residuals only) when with_predictions is false.
 HeldOut cross_validate(const ModelSpec& spec, const Campaign& c, int folds, unsigned seed, bool with_predictions);

@@ -27,8 +27,16 @@ double signed_rank_p(const std::vector<double>& d);
 /// (that it is worse, that it is better) falls below kEquivalentLevel.
 inline constexpr double kEquivalentLevel = 0.05;
 bool cannot_tell_apart(const std::vector<double>& other_worse);
-/// Fold of each trial, stratified by gravity level (same_gravity_level).
+/// Fold of each trial, stratified by gravity level (same_gravity_level); with folds =
+/// kLeaveOneProjectileOut, the index of the trial's projectile (distinct diameter and mass, in
+/// order of first appearance).
 std::vector<int> fold_of(const Campaign& c, int folds, unsigned seed);
+/// How many folds a fold_of assignment has.
+inline int fold_count(const std::vector<int>& f) {
+  int n = 0;
+  for (const int k : f) n = k + 1 > n ? k + 1 : n;
+  return n;
+}
 
 /// One forward step over the generated family (search_generated.cpp). The form is the one that,
 /// added per gravity level to `current`, fits all trials best (shared instead when that is as good

@@ -113,7 +113,7 @@ GeneratedSearch search_generated(const ModelSpec& current, const Campaign& c, in
   // held-out ones against the current model fitted to the same training trials.
   const auto fold = fold_of(c, folds, 1);
   std::vector<double> mse0(n, NAN), mse1(n, NAN);
-  for (int k = 0; k < folds; ++k) {
+  for (int k = 0; k < fold_count(fold); ++k) {
     std::vector<bool> train(n);
     bool any = false;
     for (std::size_t i = 0; i < n; ++i) {

@@ -185,7 +185,7 @@ int write_synthetic_campaign(const std::string& dir, const ModelSpec& truth, con
         const double t_free = (0.01 + 0.02 * std::uniform_real_distribution<double>(0, 1)(rng)) * time_factor(o, g);
         const int first = static_cast<int>(std::ceil(t_free * o.sample_rate_hz));  // first sample after contact
         const SynthDrop drop = integrate_drop(m, c, o, first / o.sample_rate_hz - t_free, rng, n01);
-        const std::string name = fmt::format("S{:03d}", id), rel = fmt::format("traces/{}.csv", name);
+        const std::string name = fmt::format("{}{:03d}", o.trial_prefix, id), rel = fmt::format("traces/{}.csv", name);
         write_trace(fs::path(dir) / rel, first, drop.a_up_m_s2, g, bias, g_sensor, o, rng, n01);
         const double v_rep = v0 * (1.0 + o.speed_spread * n01(rng));
         // (Speeds by Froude number reach mm/s at low gravity: all their digits.)

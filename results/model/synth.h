@@ -37,6 +37,8 @@ struct SynthOptions {
   double speed_spread = 0.005;    ///< relative scatter of the reported impact speed
   double contact_ramp_m = 1e-3;   ///< force ramps in over the first millimetre
   unsigned seed = 1;
+  /// Trial names are this followed by a number (S001, ...): campaigns read together need their own.
+  std::string trial_prefix = "S";
   /// Non-empty: the speeds by Froude number, v = Fr sqrt(g D) at each level, in place of
   /// impact_speed_m_s (the design of a gravity sweep).
   std::vector<double> froude;

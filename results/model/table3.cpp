@@ -192,7 +192,7 @@ HeldOut cross_validate_paper(const Campaign& c, int folds, unsigned seed) {
   h.trace_mse.assign(c.trials.size(), NAN);
   h.pred.assign(c.trials.size(), Prediction{});
   const auto f = fold_of(c, folds, seed);
-  for (int k = 0; k < folds; ++k) {
+  for (int k = 0; k < fold_count(f); ++k) {
     std::vector<bool> mask(c.trials.size());
     for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = f[i] != k;
     const auto rows = table3_of(c, mask);

@@ -52,6 +52,7 @@ struct TermInfo {
 #define GRAVSWEEP_MODEL_TERMS(X) \
   X(base)                        \
   X(scaled_base)                 \
+  X(area_scaled_base)            \
   X(depth_friction)              \
   X(gravity_depth_friction)      \
   X(viscous_drag)                \

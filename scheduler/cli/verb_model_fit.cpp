@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,7 @@ struct FitOptions {
   std::string model = "base+depth_friction";
   std::string baseline = "base";
   int folds = 6;
+  std::string leave_out = "trials";
   std::string plot = "error_falls.png";
   bool no_plot = false;
   std::string save;  ///< the law file (results/model/law.h); empty: none
@@ -130,6 +132,13 @@ void draw_error_falls(const results::Campaign& c, const std::vector<results::Com
   fs::copy_file(tmp.p / "error_falls.png", png, fs::copy_options::overwrite_existing);
 }
 
+/// Distinct projectiles (diameter and mass) of a campaign.
+int count_projectiles(const results::Campaign& c) {
+  std::set<std::pair<double, double>> p;
+  for (const auto& t : c.trials) p.insert({t.info.projectile_diameter_m, t.info.projectile_mass_kg});
+  return static_cast<int>(p.size());
+}
+
 void run_fit(const FitOptions& o) {
   const bool table = o.in.format == "table";
   const auto c = load_model_campaign(o.in);
@@ -138,8 +147,13 @@ void run_fit(const FitOptions& o) {
   const auto fm = results::fit_model(spec, c);
   if (table) fmt::print("Model {} fitted on {} trials ({} samples):\n", spec.name(), fm.trials_used, fm.samples_used);
   print_params(fm, o.in.format);
-  const auto cm = results::compare_models(c, {base, spec}, o.folds);
-  if (table) fmt::print("\nHeld-out errors ({}-fold grouped CV, whole trials held out), before and after:\n", o.folds);
+  const int folds = o.leave_out == "projectile" ? results::kLeaveOneProjectileOut : o.folds;
+  const auto cm = results::compare_models(c, {base, spec}, folds);
+  if (table && folds == results::kLeaveOneProjectileOut)
+    fmt::print("\nHeld-out errors (leave one projectile out: {} projectiles by diameter and mass), before and after:\n",
+               count_projectiles(c));
+  else if (table)
+    fmt::print("\nHeld-out errors ({}-fold grouped CV, whole trials held out), before and after:\n", o.folds);
   error_table(cm).print(o.in.format);
   if (table) explain_rises(cm);
   if (!o.save.empty()) save_law(o, spec, c);
@@ -174,6 +188,11 @@ void setup_model_fit(CLI::App& model) {
   sub->add_option("--baseline", o->baseline, "the 'before' model")->capture_default_str();
   sub->add_option("--folds", o->folds, "cross-validation folds (whole trials)")
       ->check(CLI::Range(2, 100))
+      ->capture_default_str();
+  sub->add_option("--leave-out", o->leave_out,
+                  "trials: the folds of --folds, whole trials; projectile: each projectile (diameter and mass) "
+                  "predicted by the model fitted on the others")
+      ->check(CLI::IsMember({"trials", "projectile"}))
       ->capture_default_str();
   sub->add_option("--plot", o->plot, "write the error-falling figure (PNG) here")->capture_default_str();
   sub->add_flag("--no-plot", o->no_plot, "do not write the figure");

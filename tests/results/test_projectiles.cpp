@@ -1,0 +1,75 @@
+// Beyond one projectile: the law with the projectile's size written out (area_scaled_base: depth
+// friction and drag on the cross-section, Katsuragi & Durian 2007) and leave one projectile out
+// (`model fit --leave-out projectile`). On synthetic campaigns of three projectiles whose truth
+// is that law, each projectile is predicted from the other two far better by it than by the law
+// that carries the drag with the projectile's mass (scaled_base + gravity_depth_friction).
+#include <gtest/gtest.h>
+
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "results/model/model.h"
+#include "results/model/synth.h"
+#include "results_helpers.h"
+
+namespace gravsweep::results {
+namespace {
+
+/// The held-out zstop_rel_pct of each model row of `model fit --format csv`.
+std::map<std::string, double> zstop_rel_by_model(const std::string& csv) {
+  std::istringstream in(csv);
+  std::string line;
+  std::vector<std::string> header;
+  std::map<std::string, double> out;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
+    if (!f.empty() && f[0] == "model") {
+      header = f;
+      continue;
+    }
+    if (header.empty() || f.size() != header.size()) continue;
+    for (std::size_t i = 0; i < f.size(); ++i)
+      if (header[i] == "zstop_rel_pct") out[f[0]] = std::stod(f[i]);
+  }
+  return out;
+}
+
+TEST(Projectiles, LeavingOneOutTellsADragOnTheCrossSectionFromOneCarriedByTheMass) {
+  gravsweep::testing::TempDir d;
+  const ModelSpec truth = parse_model("area_scaled_base");
+  std::string inputs;
+  int k = 0;
+  for (const auto& [diameter, mass] : std::vector<std::pair<double, double>>{{0.1, 1.0}, {0.05, 0.125}, {0.1, 2.0}}) {
+    SynthOptions o;
+    o.gravity_m_s2 = {9.81, 0.1};
+    o.froude = {0.5, 1.0, 2.0};
+    o.repeats = 2;
+    o.diameter_m = diameter;
+    o.mass_kg = mass;
+    o.seed = static_cast<unsigned>(1 + k);
+    o.trial_prefix = "P" + std::to_string(k) + "_";
+    const std::string dir = d.str() + "/p" + std::to_string(k++);
+    write_synthetic_campaign(dir, truth, o);
+    inputs += " '" + dir + "'";
+  }
+  const auto r = gravsweep::testing::run_gravsweep(
+      "model fit" + inputs +
+          " --model area_scaled_base --baseline scaled_base+gravity_depth_friction --leave-out projectile "
+          "--no-plot --format csv",
+      true);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto err = zstop_rel_by_model(r.out);
+  ASSERT_EQ(err.count("area_scaled_base"), 1u) << r.out;
+  ASSERT_EQ(err.count("scaled_base+gravity_depth_friction"), 1u) << r.out;
+  std::printf("held out by projectile, zstop: area_scaled_base %.1f %%, mass-scaled drag %.1f %%\n",
+              err.at("area_scaled_base"), err.at("scaled_base+gravity_depth_friction"));
+  EXPECT_LT(err.at("area_scaled_base"), 15.0) << "the truth, held out: the synthetic bed's per-drop spread";
+  EXPECT_GT(err.at("scaled_base+gravity_depth_friction"), 2 * err.at("area_scaled_base"));
+}
+
+}  // namespace
+}  // namespace gravsweep::results
