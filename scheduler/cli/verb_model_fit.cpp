@@ -132,6 +132,45 @@ void draw_error_falls(const results::Campaign& c, const std::vector<results::Com
   fs::copy_file(tmp.p / "error_falls.png", png, fs::copy_options::overwrite_existing);
 }
 
+/// Leave one projectile out, projectile by projectile: the held-out drops' mean signed error
+/// (predicted - measured, % of measured) in zstop and tstop of each model.
+results::Table projectile_table(const results::Campaign& c, const std::vector<results::ComparedModel>& cm) {
+  std::vector<std::string> cols{"projectile_diameter_m", "projectile_mass_kg", "drops"};
+  for (const auto& m : cm) {
+    cols.push_back(m.name + ":zstop_err_pct");
+    cols.push_back(m.name + ":tstop_err_pct");
+  }
+  results::Table t(cols);
+  std::set<std::pair<double, double>> projectiles;
+  for (const auto& tr : c.trials) projectiles.insert({tr.info.projectile_diameter_m, tr.info.projectile_mass_kg});
+  for (const auto& [d, mass] : projectiles) {
+    std::vector<std::string> row{num(d), num(mass)};
+    int drops = 0;
+    std::vector<std::string> errs;
+    for (const auto& m : cm) {
+      double ez = 0, et = 0;
+      int nz = 0, nt = 0;
+      drops = 0;
+      for (std::size_t i = 0; i < c.trials.size(); ++i) {
+        const auto& tr = c.trials[i];
+        if (tr.info.projectile_diameter_m != d || tr.info.projectile_mass_kg != mass) continue;
+        ++drops;
+        const auto& p = m.held_out.pred[i];
+        const auto& meas = tr.processed.metrics;
+        if (!p.stopped) continue;
+        if (meas.zstop_m > 0) ez += 100 * (p.zstop_m - meas.zstop_m) / meas.zstop_m, ++nz;
+        if (meas.tstop_s > 0) et += 100 * (p.tstop_s - meas.tstop_s) / meas.tstop_s, ++nt;
+      }
+      errs.push_back(nz ? num(ez / nz, 3) : "");
+      errs.push_back(nt ? num(et / nt, 3) : "");
+    }
+    row.push_back(std::to_string(drops));
+    row.insert(row.end(), errs.begin(), errs.end());
+    t.add(row);
+  }
+  return t;
+}
+
 /// Distinct projectiles (diameter and mass) of a campaign.
 int count_projectiles(const results::Campaign& c) {
   std::set<std::pair<double, double>> p;
@@ -155,6 +194,10 @@ void run_fit(const FitOptions& o) {
   else if (table)
     fmt::print("\nHeld-out errors ({}-fold grouped CV, whole trials held out), before and after:\n", o.folds);
   error_table(cm).print(o.in.format);
+  if (table && folds == results::kLeaveOneProjectileOut) {
+    fmt::print("\nEach projectile held out: mean signed error of its drops (predicted - measured, % of measured):\n");
+    projectile_table(c, cm).print("table");
+  }
   if (table) explain_rises(cm);
   if (!o.save.empty()) save_law(o, spec, c);
   if (o.no_plot || o.plot.empty()) return;
