@@ -39,6 +39,16 @@ def save(fig, name):
     written.append(p)
 
 
+def save_spec(fig, spec):
+    """Finishes a figure drawn for a spec file: its title (if any), then spec["out"] at 120 dpi."""
+    if spec.get("title"):
+        fig.suptitle(spec["title"], fontsize=10)
+    fig.tight_layout()
+    fig.savefig(spec["out"], dpi=120)
+    plt.close(fig)
+    written.append(spec["out"])
+
+
 def plot_errors():
     rows = read(os.path.join(D, "errors.csv"))
     keys = [("trace_rel_pct", "trace RMS (%)"), ("zstop_rel_pct", "zstop (%)"),
@@ -438,12 +448,7 @@ def plot_collapse():
         axs[i].set_title(f"scatter about one curve {f[0]:.0f} %, within levels {f[1]:.0f} %, ratio {f[2]:.2f}",
                          fontsize=8)
     axs[0].legend(fontsize=7)
-    if spec.get("title"):
-        fig.suptitle(spec["title"], fontsize=10)
-    fig.tight_layout()
-    fig.savefig(spec["out"], dpi=120)
-    plt.close(fig)
-    written.append(spec["out"])
+    save_spec(fig, spec)
 
 
 def plot_law_g():
@@ -479,12 +484,7 @@ def plot_law_g():
         ax.grid(alpha=0.3, which="both")
     axs[0].legend(fontsize=7)
     axs[1].set_title("shaded: outside the fitted g; dashed: extrapolated; dotted: refused", fontsize=8)
-    if spec.get("title"):
-        fig.suptitle(spec["title"], fontsize=10)
-    fig.tight_layout()
-    fig.savefig(spec["out"], dpi=120)
-    plt.close(fig)
-    written.append(spec["out"])
+    save_spec(fig, spec)
 
 
 if WHICH == "law_g":

@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <string>
 #include <nlohmann/json.hpp>
 
 #include "db/database.h"
@@ -19,17 +20,34 @@ using namespace gravsweep;
 using namespace gravsweep::test;
 namespace fs = std::filesystem;
 
+/// A tmpfs of `size` (mount's notation: 1m, 256k) mounted at dir/small for the test's life;
+/// `mounted` is false, with the reason, where this process may not mount one.
+struct SmallTmpfs {
+  fs::path path;
+  bool mounted = false;
+  std::string why;
+  SmallTmpfs(const fs::path& dir, const std::string& size) : path(dir / "small") {
+    fs::create_directories(path);
+    mounted = ::mount("tmpfs", path.c_str(), "tmpfs", 0, ("size=" + size).c_str()) == 0;
+    if (!mounted) why = std::strerror(errno);
+  }
+  ~SmallTmpfs() {
+    if (mounted) ::umount2(path.c_str(), MNT_DETACH);
+  }
+  SmallTmpfs(const SmallTmpfs&) = delete;
+  SmallTmpfs& operator=(const SmallTmpfs&) = delete;
+};
+
+#define SKIP_WITHOUT(tmpfs)                                          \
+  if (!(tmpfs).mounted)                                              \
+  GTEST_SKIP() << "cannot mount a small tmpfs here (" << (tmpfs).why \
+               << "): needs root and CAP_SYS_ADMIN; the disk-full case is not tested"
+
 TEST(DiskFull, WorkerExitsOneCleanlyAndFinishedWorkStaysIntact) {
   TempDir d;
-  const fs::path mnt = d.path / "small";
-  fs::create_directories(mnt);
-  if (::mount("tmpfs", mnt.c_str(), "tmpfs", 0, "size=1m") != 0)
-    GTEST_SKIP() << "cannot mount a 1 MB tmpfs here (" << std::strerror(errno)
-                 << "): needs root and CAP_SYS_ADMIN; the disk-full case is not tested";
-  struct Unmount {
-    fs::path p;
-    ~Unmount() { ::umount2(p.c_str(), MNT_DETACH); }
-  } unmount{mnt};
+  const SmallTmpfs tmpfs(d.path, "1m");
+  SKIP_WITHOUT(tmpfs);
+  const fs::path& mnt = tmpfs.path;
   const std::string example = std::string(GRAVSWEEP_SOURCE_DIR) + "/examples/sweep_tiny.json";
   ASSERT_EQ(run_cli({"submit", example, "--db", "c.db"}, mnt).code, 0);
   // stderr is captured outside the tmpfs: on the full disk the message itself could not be written.
@@ -55,15 +73,9 @@ TEST(DiskFull, WorkerExitsOneCleanlyAndFinishedWorkStaysIntact) {
 // the errno's text; it is never recorded done with an empty output.
 TEST(DiskFull, ANoopJobOnAFullFilesRootFailsWithTheErrno) {
   TempDir d;
-  const fs::path mnt = d.path / "small";
-  fs::create_directories(mnt);
-  if (::mount("tmpfs", mnt.c_str(), "tmpfs", 0, "size=256k") != 0)
-    GTEST_SKIP() << "cannot mount a 256 kB tmpfs here (" << std::strerror(errno)
-                 << "): needs root and CAP_SYS_ADMIN; the disk-full case is not tested";
-  struct Unmount {
-    fs::path p;
-    ~Unmount() { ::umount2(p.c_str(), MNT_DETACH); }
-  } unmount{mnt};
+  const SmallTmpfs tmpfs(d.path, "256k");
+  SKIP_WITHOUT(tmpfs);
+  const fs::path& mnt = tmpfs.path;
   nlohmann::json doc = {{"sweep", "full"},
                         {"job", "noop"},
                         {"max_attempts", 1},
@@ -93,15 +105,9 @@ TEST(DiskFull, ANoopJobOnAFullFilesRootFailsWithTheErrno) {
 // back to the queue uncounted; with space again every job finishes.
 TEST(DiskFull, AFullFilesRootStopsClaimingAndCountsNothingAgainstTheJobs) {
   TempDir d;
-  const fs::path mnt = d.path / "small";
-  fs::create_directories(mnt);
-  if (::mount("tmpfs", mnt.c_str(), "tmpfs", 0, "size=256k") != 0)
-    GTEST_SKIP() << "cannot mount a 256 kB tmpfs here (" << std::strerror(errno)
-                 << "): needs root and CAP_SYS_ADMIN; the disk-full case is not tested";
-  struct Unmount {
-    fs::path p;
-    ~Unmount() { ::umount2(p.c_str(), MNT_DETACH); }
-  } unmount{mnt};
+  const SmallTmpfs tmpfs(d.path, "256k");
+  SKIP_WITHOUT(tmpfs);
+  const fs::path& mnt = tmpfs.path;
   nlohmann::json doc = {{"sweep", "full"},
                         {"job", "noop"},
                         {"max_attempts", 1},
@@ -147,16 +153,10 @@ TEST(DiskFull, ACheckpointThatCannotBeWrittenLeavesTheWorkerAndItsSupervisorExit
   for (const int workers : {1, 2}) {
     SCOPED_TRACE("--workers " + std::to_string(workers));
     TempDir d;
-    const fs::path mnt = d.path / "small";
-    fs::create_directories(mnt);
     // 1.3 MB: the bed (190 kB) and the trace (140 kB) fit, a checkpoint (1 MB) beside them does not.
-    if (::mount("tmpfs", mnt.c_str(), "tmpfs", 0, "size=1300k") != 0)
-      GTEST_SKIP() << "cannot mount a 1.3 MB tmpfs here (" << std::strerror(errno)
-                   << "): needs root and CAP_SYS_ADMIN; the full-disk checkpoint is not tested";
-    struct Unmount {
-      fs::path p;
-      ~Unmount() { ::umount2(p.c_str(), MNT_DETACH); }
-    } unmount{mnt};
+    const SmallTmpfs tmpfs(d.path, "1300k");
+    SKIP_WITHOUT(tmpfs);
+    const fs::path& mnt = tmpfs.path;
     write_text(d.path / "one.json", spec.dump());
     const std::string root = (mnt / "files").string();
     ASSERT_EQ(run_cli({"submit", "one.json", "--db", "c.db", "--files", root}, d.path).code, 0);
