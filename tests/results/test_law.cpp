@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -133,6 +134,7 @@ TEST(Law, HeldOutLevelsOfTheSweepFallInsideTheirIntervals) {
     for (auto& t : parts[i].trials) all.trials.push_back(t);
   const ModelSpec law = parse_model("scaled_base+gravity_depth_friction+immersion_drag:shared");
   int drops = 0, z_in = 0, t_in = 0;
+  std::map<long, std::array<int, 3>> by_froude;  // 10 Fr rounded -> drops, zstop inside, tstop inside
   for (double g : all.gravity_levels()) {
     Campaign others = all, held = all;
     std::erase_if(others.trials, [g](const MeasuredTrial& t) { return same_gravity_level(t.info.gravity_m_s2, g); });
@@ -144,13 +146,18 @@ TEST(Law, HeldOutLevelsOfTheSweepFallInsideTheirIntervals) {
       const LawPrediction p =
           predict_case(s, {t.info.gravity_m_s2, m.vc_m_s, t.info.projectile_diameter_m, t.info.projectile_mass_kg});
       ++drops;
-      level_z += m.zstop_m >= p.zstop_lo_m && m.zstop_m <= p.zstop_hi_m ? 1 : 0;
-      level_t += m.tstop_s >= p.tstop_lo_s && m.tstop_s <= p.tstop_hi_s ? 1 : 0;
+      const int zi = m.zstop_m >= p.zstop_lo_m && m.zstop_m <= p.zstop_hi_m ? 1 : 0;
+      const int ti = m.tstop_s >= p.tstop_lo_s && m.tstop_s <= p.tstop_hi_s ? 1 : 0;
+      level_z += zi, level_t += ti;
+      auto& f = by_froude[std::lround(10 * p.froude)];
+      f[0] += 1, f[1] += zi, f[2] += ti;
     }
     std::printf("held out %g m/s2: zstop inside %d of %zu, tstop inside %d of %zu\n", g, level_z, held.trials.size(),
                 level_t, held.trials.size());
     z_in += level_z, t_in += level_t;
   }
+  for (const auto& [fr10, f] : by_froude)
+    std::printf("Fr %.1f: zstop inside %d of %d, tstop inside %d of %d\n", fr10 / 10.0, f[1], f[0], f[2], f[0]);
   std::printf("all levels: zstop inside %d of %d, tstop %d of %d\n", z_in, drops, t_in, drops);
   EXPECT_EQ(drops, 50);
   EXPECT_GE(z_in, 0.9 * drops);
