@@ -53,6 +53,9 @@ std::vector<PriorAxis> prior_of(const SavedLaw& law, double width) {
   return axes;
 }
 
+/// The metrics by index k (0 zstop, 1 tstop, 2 apeak), as law.h's form_error_at numbers them.
+constexpr std::array<const char*, 3> kName{"zstop_m", "tstop_s", "apeak_m_s2"};
+
 /// The measured metrics with their log-normal sigma (relative, as a fraction).
 struct Observed {
   int metric = 0;  ///< 0 zstop, 1 tstop, 2 apeak
@@ -62,7 +65,6 @@ struct Observed {
 std::vector<Observed> observed_of(const SavedLaw& law, double froude, const InferMeasurement& m) {
   const std::array<double, 3> value{m.zstop_m, m.tstop_s, m.apeak_m_s2};
   const std::array<double, 3> own{m.zstop_error_pct, m.tstop_error_pct, m.apeak_error_pct};
-  static const std::array<const char*, 3> kName{"zstop_m", "tstop_s", "apeak_m_s2"};
   std::vector<Observed> out;
   for (int k = 0; k < 3; ++k) {
     if (std::isnan(value[k])) continue;
@@ -231,7 +233,6 @@ ConstantPosterior constant_posterior(const std::string& name, double campaign, c
 MetricPosterior metric_posterior(int k, const InferMeasurement& m, const std::vector<Observed>& obs,
                                  const LawPrediction& campaign, const std::vector<Sample>& s,
                                  const std::vector<double>& w) {
-  static const std::array<const char*, 3> kName{"zstop_m", "tstop_s", "apeak_m_s2"};
   MetricPosterior r;
   r.name = kName[k];
   r.measured = k == 0 ? m.zstop_m : k == 1 ? m.tstop_s : m.apeak_m_s2;

@@ -245,19 +245,7 @@ double signed_rank_p(const std::vector<double>& d) {
 }
 
 std::vector<int> fold_of(const Campaign& c, int folds, unsigned seed) {
-  if (folds == kLeaveOneProjectileOut) {
-    std::vector<std::pair<double, double>> seen;
-    std::vector<int> f;
-    for (const auto& t : c.trials) {
-      const std::pair<double, double> p{t.info.projectile_diameter_m, t.info.projectile_mass_kg};
-      const auto it = std::find_if(seen.begin(), seen.end(), [&p](const auto& q) {
-        return std::abs(q.first - p.first) <= 1e-9 * q.first && std::abs(q.second - p.second) <= 1e-9 * q.second;
-      });
-      f.push_back(static_cast<int>(it - seen.begin()));
-      if (it == seen.end()) seen.push_back(p);
-    }
-    return f;
-  }
+  if (folds == kLeaveOneProjectileOut) return projectile_index(c);
   // Stratified by gravity level: shuffle within each level, deal round-robin.
   std::mt19937 rng(seed);
   std::vector<int> idx(c.trials.size());
@@ -278,6 +266,21 @@ std::vector<int> fold_of(const Campaign& c, int folds, unsigned seed) {
 }  // namespace detail
 
 using namespace detail;
+
+std::vector<int> projectile_index(const Campaign& c, int* count) {
+  std::vector<std::pair<double, double>> seen;
+  std::vector<int> index;
+  for (const auto& t : c.trials) {
+    const std::pair<double, double> p{t.info.projectile_diameter_m, t.info.projectile_mass_kg};
+    const auto it = std::find_if(seen.begin(), seen.end(), [&p](const auto& q) {
+      return std::abs(q.first - p.first) <= 1e-9 * q.first && std::abs(q.second - p.second) <= 1e-9 * q.second;
+    });
+    index.push_back(static_cast<int>(it - seen.begin()));
+    if (it == seen.end()) seen.push_back(p);
+  }
+  if (count) *count = static_cast<int>(seen.size());
+  return index;
+}
 
 int FittedModel::gravity_index(double g) const {
   for (std::size_t i = 0; i < gravity_levels.size(); ++i)

@@ -123,6 +123,9 @@ struct HeldOut {
   std::vector<double> trace_mse;  ///< per trial
   std::vector<Prediction> pred;   ///< per trial, from the model fitted without that trial
 };
+/// The projectile of each trial: the index of its (diameter, mass), distinct to 1e-9 relative, in
+/// order of first appearance; `count` receives how many there are.
+std::vector<int> projectile_index(const Campaign& c, int* count = nullptr);
 /// `folds` = kLeaveOneProjectileOut: one fold per projectile (its diameter and mass), so that each
 /// projectile is predicted by the model fitted on the others.
 inline constexpr int kLeaveOneProjectileOut = -1;

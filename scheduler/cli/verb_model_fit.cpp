@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -141,41 +140,37 @@ results::Table projectile_table(const results::Campaign& c, const std::vector<re
     cols.push_back(m.name + ":tstop_err_pct");
   }
   results::Table t(cols);
-  std::set<std::pair<double, double>> projectiles;
-  for (const auto& tr : c.trials) projectiles.insert({tr.info.projectile_diameter_m, tr.info.projectile_mass_kg});
-  for (const auto& [d, mass] : projectiles) {
-    std::vector<std::string> row{num(d), num(mass)};
-    int drops = 0;
-    std::vector<std::string> errs;
+  int projectiles = 0;
+  const std::vector<int> of = results::projectile_index(c, &projectiles);
+  for (int k = 0; k < projectiles; ++k) {
+    std::vector<std::size_t> drops;
+    for (std::size_t i = 0; i < of.size(); ++i)
+      if (of[i] == k) drops.push_back(i);
+    const auto& info = c.trials[drops.front()].info;
+    std::vector<std::string> row{num(info.projectile_diameter_m), num(info.projectile_mass_kg),
+                                 std::to_string(drops.size())};
     for (const auto& m : cm) {
       double ez = 0, et = 0;
       int nz = 0, nt = 0;
-      drops = 0;
-      for (std::size_t i = 0; i < c.trials.size(); ++i) {
-        const auto& tr = c.trials[i];
-        if (tr.info.projectile_diameter_m != d || tr.info.projectile_mass_kg != mass) continue;
-        ++drops;
+      for (const std::size_t i : drops) {
         const auto& p = m.held_out.pred[i];
-        const auto& meas = tr.processed.metrics;
+        const auto& meas = c.trials[i].processed.metrics;
         if (!p.stopped) continue;
         if (meas.zstop_m > 0) ez += 100 * (p.zstop_m - meas.zstop_m) / meas.zstop_m, ++nz;
         if (meas.tstop_s > 0) et += 100 * (p.tstop_s - meas.tstop_s) / meas.tstop_s, ++nt;
       }
-      errs.push_back(nz ? num(ez / nz, 3) : "");
-      errs.push_back(nt ? num(et / nt, 3) : "");
+      row.push_back(nz ? num(ez / nz, 3) : "");
+      row.push_back(nt ? num(et / nt, 3) : "");
     }
-    row.push_back(std::to_string(drops));
-    row.insert(row.end(), errs.begin(), errs.end());
     t.add(row);
   }
   return t;
 }
 
-/// Distinct projectiles (diameter and mass) of a campaign.
-int count_projectiles(const results::Campaign& c) {
-  std::set<std::pair<double, double>> p;
-  for (const auto& t : c.trials) p.insert({t.info.projectile_diameter_m, t.info.projectile_mass_kg});
-  return static_cast<int>(p.size());
+int projectile_count(const results::Campaign& c) {
+  int n = 0;
+  results::projectile_index(c, &n);
+  return n;
 }
 
 void run_fit(const FitOptions& o) {
@@ -190,7 +185,7 @@ void run_fit(const FitOptions& o) {
   const auto cm = results::compare_models(c, {base, spec}, folds);
   if (table && folds == results::kLeaveOneProjectileOut)
     fmt::print("\nHeld-out errors (leave one projectile out: {} projectiles by diameter and mass), before and after:\n",
-               count_projectiles(c));
+               projectile_count(c));
   else if (table)
     fmt::print("\nHeld-out errors ({}-fold grouped CV, whole trials held out), before and after:\n", o.folds);
   error_table(cm).print(o.in.format);
