@@ -1,4 +1,4 @@
-// Collision models (see model.h): the ranking of candidate terms and the verdict (residuals along
+// Discovery (see discover.h): the ranking of candidate terms and the verdict (residuals along
 // axes: residuals.cpp).
 #include <fmt/format.h>
 
@@ -8,7 +8,11 @@
 #include <stdexcept>
 
 #include "results/model/generated.h"
-#include "results/model/model.h"
+#include "results/model/cross_validation.h"
+#include "results/model/discover.h"
+#include "results/model/fit.h"
+#include "results/model/model_spec.h"
+#include "results/model/residual_axes.h"
 #include "results/model/model_internal.h"
 
 namespace gravsweep::results {
@@ -77,10 +81,12 @@ std::string strongest_axis(const std::vector<AxisResidual>& axes) {
 /// per-level term in its two forms, its constant shared by all levels ("depth_friction:shared":
 /// does not follow g) and carried by g ("immersion_drag:g^1"; where a registered term is that form,
 /// TermInfo::gravity_form, it stands in for it, and a term whose g-form is a baseline is not tried).
-std::vector<ModelTerm> named_candidates(const ModelSpec& current, bool gravity_scaled) {
+/// A term identifiable only across projectile diameters is tried when `several_diameters`.
+std::vector<ModelTerm> named_candidates(const ModelSpec& current, bool gravity_scaled, bool several_diameters) {
   std::vector<ModelTerm> named;
   for (const auto& term : term_registry()) {
     if (current.has(term.name) || term.baseline_only) continue;
+    if (term.across_diameters && !several_diameters) continue;
     if (!gravity_scaled || !term.per_gravity) {
       named.push_back({&term, term.per_gravity, 1.0});
       continue;
@@ -303,9 +309,13 @@ Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds, doub
   // against terms that are one law for all levels too: a per-level term would absorb, level by
   // level, the very effect whose size does not follow g that this mode is meant to find.
   d.gravity_scaled = one_law_for_all_levels(baseline);
+  const bool several_diameters = std::any_of(c.trials.begin(), c.trials.end(), [&c](const MeasuredTrial& t) {
+    return std::abs(t.info.projectile_diameter_m - c.trials.front().info.projectile_diameter_m) >
+           1e-9 * t.info.projectile_diameter_m;
+  });
   for (int round = 0; round < max_rounds; ++round) {
-    const auto cands =
-        rank_candidates(current, c, named_candidates(current, d.gravity_scaled), folds, alpha, min_improvement);
+    const auto cands = rank_candidates(current, c, named_candidates(current, d.gravity_scaled, several_diameters),
+                                       folds, alpha, min_improvement);
     d.rounds.push_back(cands);
     if (cands.empty() || !cands.front().significant) break;
     d.equivalent.push_back(equivalent_to_winner(cands));

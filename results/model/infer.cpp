@@ -9,7 +9,8 @@
 #include <random>
 #include <stdexcept>
 
-#include "results/model/model.h"
+#include "results/model/fit.h"
+#include "results/model/predict.h"
 #include "results/model/stats.h"
 
 namespace gravsweep::results {

@@ -1,4 +1,7 @@
 // A gravity-scaled law kept in a file and applied to new cases (see law.h).
+#include "results/model/model_spec.h"
+#include "results/model/fit.h"
+#include "results/model/predict.h"
 #include "results/model/law.h"
 
 #include <fmt/format.h>

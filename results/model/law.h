@@ -10,7 +10,8 @@
 #include <vector>
 
 #include "results/measurements/campaign.h"
-#include "results/model/model.h"
+#include "results/model/fit.h"
+#include "results/model/model_spec.h"
 
 namespace gravsweep::results {
 
@@ -83,7 +84,7 @@ struct LawPrediction {
   std::string note;  ///< which ranges a case leaves, by how much
 };
 
-/// The context of a case for predict (model.h): its gravity, speed, diameter and mass, on a bed
+/// The context of a case for predict (predict.h): its gravity, speed, diameter and mass, on a bed
 /// deep enough not to matter, of the grains the law was fitted on (the geometric middle of its
 /// grain-diameter range; Table 1's 1 cm when the law records none).
 TermContext law_case_context(const SavedLaw& law, const LawCase& c);
@@ -97,7 +98,7 @@ SavedLaw without_ranges(SavedLaw law);
 /// law has none for that metric.
 double form_error_at(const std::vector<LawFormError>& f, double fr, int k);
 
-/// Integrates the law from the impact speed to the stop (predict, model.h). The 95 % interval
+/// Integrates the law from the impact speed to the stop (predict, predict.h). The 95 % interval
 /// holds the constants' uncertainty (the 2.5 and 97.5 % points of the predictions of the bootstrap
 /// resamples) and the law's form error at the case's Froude number (1.96 times its RMS relative
 /// error there, interpolated in ln Fr, held at the end values beyond them), added in quadrature

@@ -1,4 +1,7 @@
 // Leave one gravity level out (see level_out.h).
+#include "results/model/model_spec.h"
+#include "results/model/fit.h"
+#include "results/model/predict.h"
 #include "results/model/level_out.h"
 
 #include <fmt/format.h>

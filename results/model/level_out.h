@@ -1,6 +1,6 @@
 // Leave one gravity level out: one law for all levels (one_law_for_all_levels, e.g. scaled_base:
 // R = phi m g + m v^2 / d1) is fitted on the trials of every other level and predicts zstop, tstop
-// and apeak of each trial of the level left out, the way they were measured (predict, model.h).
+// and apeak of each trial of the level left out, the way they were measured (predict, predict.h).
 // A law whose gravity dependence is right predicts a level it has never seen as well as the
 // levels it was fitted on; a resistance that does not follow g shows as errors at the held-out
 // levels. Targets (median |error| over the drops of a level inside the fitted range of g):
@@ -11,7 +11,9 @@
 #include <vector>
 
 #include "results/measurements/campaign.h"
-#include "results/model/model.h"
+#include "results/model/fit.h"
+#include "results/model/model_spec.h"
+#include "results/model/predict.h"
 
 namespace gravsweep::results {
 

@@ -1,10 +1,15 @@
-// Helpers shared by the files of results/model/ (model.cpp, table3.cpp, discover.cpp); not API.
+// Helpers shared by the files of results/model/ (fit.cpp, cross_validation.cpp, table3.cpp,
+// discover.cpp, ...); not API.
 #pragma once
 #include <functional>
 #include <vector>
 
+#include "results/model/model_spec.h"
+#include "results/model/fit.h"
 #include "results/measurements/campaign.h"
-#include "results/model/model.h"
+#include "results/model/cross_validation.h"
+#include "results/model/discover.h"
+#include "results/model/predict.h"
 #include "results/model/term.h"
 
 namespace gravsweep::results::detail {
@@ -37,6 +42,11 @@ inline int fold_count(const std::vector<int>& f) {
   for (const int k : f) n = k + 1 > n ? k + 1 : n;
   return n;
 }
+/// Fits on one fold's training trials (`train`) and fills the held-out trials' entries of `h`.
+using FoldFit = std::function<void(const std::vector<bool>& train, HeldOut& h)>;
+/// The loop of every grouped K-fold cross-validation (fold_of): `fit_fold` once per fold that
+/// holds a trial out, on a HeldOut sized to the campaign's trials (NaN until filled).
+HeldOut over_folds(const Campaign& c, int folds, unsigned seed, const FoldFit& fit_fold);
 
 /// One forward step over the generated family (search_generated.cpp). The form is the one that,
 /// added per gravity level to `current`, fits all trials best (shared instead when that is as good

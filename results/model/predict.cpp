@@ -1,4 +1,4 @@
-// Predictions of a fitted model (see model.h): Eq. 1 integrated by RK4 from the impact speed to
+// Predictions of a fitted model (see predict.h): Eq. 1 integrated by RK4 from the impact speed to
 // the stop, and the metrics of a trial predicted the way the trial was measured:
 // the model's record on the trial's own sample grid, processed like the data, so that apeak is
 // read off the filtered model record exactly as off the filtered measurement.
@@ -9,7 +9,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "results/model/model.h"
+#include "results/model/fit.h"
+#include "results/model/predict.h"
 #include "results/model/model_internal.h"
 
 namespace gravsweep::results {
@@ -198,5 +199,15 @@ Prediction predict(const FittedModel& m, const MeasuredTrial& t, const std::vect
 }
 
 Prediction predict(const FittedModel& m, const MeasuredTrial& t) { return predict(m, t, {}); }
+
+std::vector<const std::vector<double>*> same_level_fluctuations(const Campaign& c,
+                                                                const std::vector<std::vector<double>>& fluct,
+                                                                std::size_t i) {
+  std::vector<const std::vector<double>*> out;
+  for (std::size_t j = 0; j < fluct.size() && out.size() < kMaxFluctuationTrials; ++j)
+    if (j != i && !fluct[j].empty() && same_gravity_level(c.trials[j].info.gravity_m_s2, c.trials[i].info.gravity_m_s2))
+      out.push_back(&fluct[j]);
+  return out;
+}
 
 }  // namespace gravsweep::results

@@ -1,4 +1,6 @@
 // The regime map of a fitted collision law (see regimes.h).
+#include "results/model/fit.h"
+#include "results/model/predict.h"
 #include "results/model/regimes.h"
 
 #include <algorithm>

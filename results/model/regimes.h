@@ -1,6 +1,6 @@
 // The regime map of a fitted collision law (paper II, Sunday et al. 2022: a quasi-static friction
 // regime below Fr ~ 1.5, an inertial-drag regime above). Along each drop's integrated motion
-// (predict, model.h) the resistance is split into its quasi-static part, what the bed resists with
+// (predict, predict.h) the resistance is split into its quasi-static part, what the bed resists with
 // at rest at that depth, R(z, v = 0) (phi m g and any depth term), and its dynamic part,
 // R(z, v) - R(z, 0) (the inertial drag m v^2 / d1 and any other speed-dependent term). Froude
 // number Fr = v / sqrt(g D), D the projectile diameter. For R = phi m g + m v^2 / d1 the parts are
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "results/measurements/campaign.h"
-#include "results/model/model.h"
+#include "results/model/fit.h"
 
 namespace gravsweep::results {
 

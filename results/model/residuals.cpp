@@ -1,11 +1,12 @@
-// Residuals of a fitted model along the state and trial axes (model.h, residual_axes): where a
+// Residuals of a fitted model along the state and trial axes (residual_axes.h): where a
 // model fails, binned in equal-weight bins and tested for structure (eta^2, a split-half profile,
 // a sign test of the within-trial slope over trials).
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 
-#include "results/model/model.h"
+#include "results/model/fit.h"
+#include "results/model/residual_axes.h"
 #include "results/model/model_internal.h"
 
 namespace gravsweep::results {

@@ -1,4 +1,6 @@
 // The scaling check (see scaling.h).
+#include "results/model/model_spec.h"
+#include "results/model/fit.h"
 #include "results/model/scaling.h"
 
 #include <fmt/format.h>

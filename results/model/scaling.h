@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "results/measurements/campaign.h"
-#include "results/model/model.h"
+#include "results/model/model_spec.h"
 
 namespace gravsweep::results {
 

@@ -6,7 +6,10 @@
 #include <limits>
 
 #include "results/model/generated.h"
-#include "results/model/model.h"
+#include "results/model/cross_validation.h"
+#include "results/model/discover.h"
+#include "results/model/fit.h"
+#include "results/model/model_spec.h"
 #include "results/model/model_internal.h"
 
 namespace gravsweep::results::detail {

@@ -1,4 +1,6 @@
 // Synthetic measurement campaigns (see synth.h).
+#include "results/model/model_spec.h"
+#include "results/model/fit.h"
 #include "results/model/synth.h"
 
 #include <fmt/format.h>

@@ -5,7 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "results/model/model.h"
+#include "results/model/fit.h"
+#include "results/model/model_spec.h"
 
 namespace gravsweep::results {
 

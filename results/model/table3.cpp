@@ -1,4 +1,4 @@
-// Collision models (see model.h): the paper's method, Table 3 (Sect. 4, Eqs. 2-5).
+// The paper's method, Table 3 (Sect. 4, Eqs. 2-5).
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -9,7 +9,9 @@
 #include <utility>
 #include <stdexcept>
 
-#include "results/model/model.h"
+#include "results/model/cross_validation.h"
+#include "results/model/predict.h"
+#include "results/model/table3.h"
 #include "results/model/model_internal.h"
 
 namespace gravsweep::results {
@@ -188,35 +190,26 @@ Prediction predict_paper(const Table3Row& row, double m, double vc) {
 }
 
 HeldOut cross_validate_paper(const Campaign& c, int folds, unsigned seed) {
-  HeldOut h;
-  h.trace_mse.assign(c.trials.size(), NAN);
-  h.pred.assign(c.trials.size(), Prediction{});
-  const auto f = fold_of(c, folds, seed);
-  for (int k = 0; k < fold_count(f); ++k) {
-    std::vector<bool> mask(c.trials.size());
-    for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = f[i] != k;
-    const auto rows = table3_of(c, mask);
-    for (std::size_t i = 0; i < mask.size(); ++i) {
-      if (mask[i]) continue;
+  return over_folds(c, folds, seed, [&](const std::vector<bool>& train, HeldOut& h) {
+    const auto rows = table3_of(c, train);
+    for (std::size_t i = 0; i < train.size(); ++i) {
+      if (train[i]) continue;
       const auto& t = c.trials[i];
-      for (const auto& r : rows)
-        if (r.g_m_s2 == t.info.gravity_m_s2)
-          h.pred[i] = predict_paper(r, t.info.projectile_mass_kg, t.processed.metrics.vc_m_s);
-      // Trace residual of Eq. 1 with the Table 3 f0, d1 (per gravity level).
-      for (const auto& r : rows)
-        if (r.g_m_s2 == t.info.gravity_m_s2) {
-          double s = 0;
-          std::size_t n = 0;
-          for (std::size_t q = t.fit_begin; q < t.fit_end; ++q, ++n) {
-            const double v = t.processed.velocity_down_m_s[q];
-            const double a_model = r.f0_N / t.info.projectile_mass_kg + r.inv_d1_1_m * v * v - r.g_m_s2;
-            s += std::pow(t.processed.accel_up_m_s2[q] - a_model, 2);
-          }
-          if (n) h.trace_mse[i] = s / static_cast<double>(n);
+      for (const auto& r : rows) {
+        if (r.g_m_s2 != t.info.gravity_m_s2) continue;
+        h.pred[i] = predict_paper(r, t.info.projectile_mass_kg, t.processed.metrics.vc_m_s);
+        // Trace residual of Eq. 1 with the Table 3 f0, d1 (per gravity level).
+        double s = 0;
+        std::size_t n = 0;
+        for (std::size_t q = t.fit_begin; q < t.fit_end; ++q, ++n) {
+          const double v = t.processed.velocity_down_m_s[q];
+          const double a_model = r.f0_N / t.info.projectile_mass_kg + r.inv_d1_1_m * v * v - r.g_m_s2;
+          s += std::pow(t.processed.accel_up_m_s2[q] - a_model, 2);
         }
+        if (n) h.trace_mse[i] = s / static_cast<double>(n);
+      }
     }
-  }
-  return h;
+  });
 }
 
 }  // namespace gravsweep::results

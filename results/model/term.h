@@ -42,6 +42,10 @@ struct TermInfo {
   /// A baseline to start from (`--baseline`), never ranked as a missing effect: scaled_base is
   /// the whole Poncelet law again, collinear with base's per-level f0 and 1/d1.
   bool baseline_only = false;
+  /// Identifiable only across projectile diameters: at one diameter and grain size its features
+  /// are another term's (grain_drag is a shared v^2 drag), so `model rank` tries it only on a
+  /// campaign of two diameters or more.
+  bool across_diameters = false;
   /// The registered term that is this one's constant times g, when there is one
   /// (depth_friction: gravity_depth_friction; base: scaled_base). The scaled mode of `model rank`
   /// tries a per-level term shared by all levels and carried by g; where a registered term is the

@@ -1,4 +1,10 @@
 // Held-out comparisons and report data (see report.h).
+#include "results/model/model_spec.h"
+#include "results/model/fit.h"
+#include "results/model/predict.h"
+#include "results/model/cross_validation.h"
+#include "results/model/table3.h"
+#include "results/model/discover.h"
 #include "results/report/report.h"
 
 #include <fmt/format.h>

@@ -5,7 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "results/model/model.h"
+#include "results/model/cross_validation.h"
+#include "results/model/discover.h"
+#include "results/model/model_spec.h"
 
 namespace gravsweep::results {
 

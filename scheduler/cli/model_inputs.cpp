@@ -5,6 +5,8 @@
 
 #include <stdexcept>
 
+#include "results/model/model_spec.h"
+#include "results/model/residual_axes.h"
 #include "results/io/table.h"
 #include "scheduler/cli/campaign_input.h"
 #include "scheduler/cli/exit_codes.h"

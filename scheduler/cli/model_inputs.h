@@ -8,7 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "results/model/model.h"
+#include "results/model/model_spec.h"
+#include "results/model/residual_axes.h"
 
 namespace gravsweep::cli {
 

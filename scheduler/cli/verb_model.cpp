@@ -4,7 +4,7 @@
 #include <memory>
 #include <string>
 
-#include "results/model/model.h"
+#include "results/model/model_spec.h"
 #include "results/io/table.h"
 #include "scheduler/cli/format_option.h"
 #include "scheduler/cli/verbs.h"

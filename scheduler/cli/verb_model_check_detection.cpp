@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "results/model/model.h"
+#include "results/model/discover.h"
 #include "results/model/synth.h"
 #include "results/io/table.h"
 #include "scheduler/cli/format_option.h"

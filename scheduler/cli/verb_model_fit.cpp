@@ -11,7 +11,9 @@
 #include <vector>
 
 #include "results/model/law.h"
-#include "results/model/model.h"
+#include "results/model/cross_validation.h"
+#include "results/model/fit.h"
+#include "results/model/model_spec.h"
 #include "results/report/report.h"
 #include "results/io/table.h"
 #include "scheduler/cli/exit_codes.h"

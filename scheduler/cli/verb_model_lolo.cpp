@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "results/model/fit.h"
 #include "results/model/level_out.h"
 #include "results/model/regimes.h"
 #include "results/io/table.h"

@@ -8,7 +8,7 @@
 #include <memory>
 #include <string>
 
-#include "results/model/model.h"
+#include "results/model/discover.h"
 #include "results/io/table.h"
 #include "scheduler/cli/model_inputs.h"
 #include "scheduler/cli/verbs.h"

@@ -7,7 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "results/model/model.h"
+#include "results/model/fit.h"
+#include "results/model/predict.h"
+#include "results/model/residual_axes.h"
 #include "results/io/table.h"
 #include "scheduler/cli/model_inputs.h"
 #include "scheduler/cli/verbs.h"

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "results/model/model_spec.h"
 #include "results/io/table.h"
 #include "results/model/scaling.h"
 #include "scheduler/cli/exit_codes.h"

@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "results/model/model.h"
+#include "results/model/table3.h"
 #include "results/io/table.h"
 #include "scheduler/cli/model_inputs.h"
 #include "scheduler/cli/verbs.h"

@@ -11,7 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "results/model/model.h"
+#include "results/model/discover.h"
+#include "results/model/model_spec.h"
+#include "results/model/table3.h"
 #include "results/report/html.h"
 #include "results/report/report.h"
 #include "results/io/table.h"

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "results/model/model_spec.h"
 #include "results/model/synth.h"
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"

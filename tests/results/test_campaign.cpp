@@ -7,7 +7,8 @@
 #include <sstream>
 
 #include "results/measurements/campaign.h"
-#include "results/model/model.h"
+#include "results/model/fit.h"
+#include "results/model/model_spec.h"
 #include "results/model/synth.h"
 #include "results/processing/metric_fields.h"
 #include "results_helpers.h"

@@ -12,7 +12,8 @@
 #include "db/database.h"
 #include "results/measurements/campaign.h"
 #include "results/model/collapse.h"
-#include "results/model/model.h"
+#include "results/model/model_spec.h"
+#include "results/model/table3.h"
 #include "results/model/synth.h"
 #include "results_helpers.h"
 

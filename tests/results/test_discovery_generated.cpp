@@ -12,7 +12,8 @@
 #include <string>
 
 #include "results/model/generated.h"
-#include "results/model/model.h"
+#include "results/model/discover.h"
+#include "results/model/model_spec.h"
 #include "results/model/synth.h"
 #include "results_helpers.h"
 

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "results/model/model_spec.h"
 #include "results/measurements/campaign.h"
 #include "results/model/synth.h"
 #include "results_helpers.h"

@@ -13,7 +13,8 @@
 
 #include "results/model/infer.h"
 #include "results/model/law.h"
-#include "results/model/model.h"
+#include "results/model/fit.h"
+#include "results/model/predict.h"
 #include "results_helpers.h"
 
 namespace gravsweep::results {

@@ -17,7 +17,8 @@
 #include "engine/core/error.h"
 #include "results/measurements/campaign.h"
 #include "results/model/law.h"
-#include "results/model/model.h"
+#include "results/model/model_spec.h"
+#include "results/model/predict.h"
 #include "results/model/synth.h"
 #include "results_helpers.h"
 

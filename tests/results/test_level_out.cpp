@@ -11,7 +11,10 @@
 
 #include "results/measurements/campaign.h"
 #include "results/model/level_out.h"
-#include "results/model/model.h"
+#include "results/model/discover.h"
+#include "results/model/fit.h"
+#include "results/model/model_spec.h"
+#include "results/model/predict.h"
 #include "results/model/regimes.h"
 #include "results/model/synth.h"
 #include "results_helpers.h"

@@ -14,7 +14,13 @@
 
 #include "engine/core/error.h"
 #include "spec/json_schema.h"
-#include "results/model/model.h"
+#include "results/model/cross_validation.h"
+#include "results/model/discover.h"
+#include "results/model/fit.h"
+#include "results/model/model_spec.h"
+#include "results/model/predict.h"
+#include "results/model/residual_axes.h"
+#include "results/model/table3.h"
 #include "results/model/synth.h"
 #include "results_helpers.h"
 

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "results/model/model.h"
+#include "results/model/model_spec.h"
 #include "results/model/synth.h"
 #include "results_helpers.h"
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "engine/scenario/bed.h"
+#include "results/model/table3.h"
 #include "results/io/bed_file.h"
 #include "results/io/csv.h"
 #include "results/measurements/campaign.h"

@@ -13,7 +13,8 @@
 
 #include "engine/core/error.h"
 #include "results/measurements/campaign.h"
-#include "results/model/model.h"
+#include "results/model/fit.h"
+#include "results/model/model_spec.h"
 #include "results/model/scaling.h"
 #include "results/model/synth.h"
 #include "results_helpers.h"

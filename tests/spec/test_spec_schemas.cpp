@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "tests/common/temp_dir.h"
-#include "results/model/model.h"
+#include "results/model/model_spec.h"
 #include "scheduler/sweep/spec.h"
 #include "spec/json_text.h"
 #include "spec/schemas.h"

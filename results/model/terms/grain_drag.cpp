@@ -20,6 +20,7 @@ TermInfo grain_drag_term() {
   t.signature = "across projectiles: a drag on D^2 stops the small projectile too deep, at every mass";
   t.params = {"c_g_kg_m3"};
   t.per_gravity = false;
+  t.across_diameters = true;
   t.features = [](const TermContext& c, double* out) {
     out[0] = c.grain_diameter_m * c.diameter_m * c.v_m_s * c.v_m_s;
   };
