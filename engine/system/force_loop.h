@@ -147,7 +147,7 @@ GRAVSWEEP_INLINE void visit_touching(const Particles& p, ContactHistory* hist, s
 /// distance test (whether a listed pair touches is a coin toss at rest, about 60 % of the listed
 /// pairs), then the visits in list order. Otherwise one pass with a branch per listed pair.
 /// Always inlined: called through a lambda, the batch state of the caller would otherwise be read
-/// through references on every pair (slower on the 1 g drop, measured: BENCHMARKS.md).
+/// through references on every pair (slower on the 1 g drop, measured: docs/history/benchmarks.md).
 template <bool kFilter, class Visit>
 GRAVSWEEP_INLINE void for_each_touching_pair(ForceContext& c, std::size_t row_begin, std::size_t row_end,
                                              OverlapFailure& worst, Visit&& visit) {
@@ -424,7 +424,7 @@ void force_loop(ForceContext& c) {
     // Thread 0 accumulates straight into the particles' force and torque arrays (one buffer pair
     // per extra thread; the sum below keeps the order gravity + thread 0 + thread 1 + ...), and
     // clears them whole; thread t >= 1 clears its buffers from its first row on (zeroing them as
-    // the sum reads them instead was slower, BENCHMARKS.md).
+    // the sum reads them instead was slower, docs/history/benchmarks.md).
     // Nothing reads force_N / torque_N_m between here and the sum.
     Vec3* F = t == 0 ? p.force_N.data() : c.thread_force[t].data();
     Vec3* T = t == 0 ? p.torque_N_m.data() : c.thread_torque[t].data();
