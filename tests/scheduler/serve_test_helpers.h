@@ -62,9 +62,12 @@ struct ServeProcess {
   std::string url;
   std::filesystem::path log;
 
-  ServeProcess(const std::filesystem::path& dir, const std::vector<std::string>& extra = {}) : log(dir / "serve.log") {
-    std::vector<std::string> args{"serve", "--db", (dir / "c.db").string(), "--port", "0"};
-    args.insert(args.end(), extra.begin(), extra.end());
+  /// On `db_args` (--db LOCATION [--files DIR]; default `<dir>/c.db`), its output in `<dir>/serve.log`.
+  explicit ServeProcess(const std::filesystem::path& dir, std::vector<std::string> db_args = {})
+      : log(dir / "serve.log") {
+    if (db_args.empty()) db_args = {"--db", (dir / "c.db").string()};
+    std::vector<std::string> args{"serve", "--port", "0"};
+    args.insert(args.end(), db_args.begin(), db_args.end());
     pid = start_cli(args, log);
     const std::regex re(R"(http://127\.0\.0\.1:(\d+)/)");
     const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(30);
