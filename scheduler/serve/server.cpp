@@ -183,11 +183,15 @@ void serve(const ServeOptions& o, const std::function<void(const std::string& ur
   } else if (!svr.bind_to_port(o.bind, o.port)) {
     port = -1;
   }
-  if (port <= 0)
-    throw ConfigError(
-        fmt::format("cannot listen on {}:{}: {} (another program uses the port? choose one with "
-                    "--port, or --port 0 for any free port)",
-                    o.bind, o.port, errno ? std::strerror(errno) : "the address was refused"));
+  if (port <= 0) {
+    const int err = errno;
+    const std::string hint = err == EADDRINUSE ? "another program listens on it: choose another --port, or --port 0 "
+                                                 "for any free port"
+                                               : "is --bind an address of this machine (127.0.0.1, 0.0.0.0, one of "
+                                                 "its interfaces)?";
+    throw ConfigError(fmt::format("cannot listen on {}:{}: {}; {}", o.bind, o.port,
+                                  err ? std::strerror(err) : "the address cannot be resolved or bound", hint));
+  }
   queue::install_stop_signals();
   std::thread watcher([&svr] {
     while (!queue::stop_requested().load()) std::this_thread::sleep_for(std::chrono::milliseconds(100));

@@ -180,6 +180,12 @@ TEST(Serve, ABadDatabaseOrABusyPortIsRefusedNamingIt) {
   EXPECT_EQ(r.code, 2) << r.out << r.err;
   EXPECT_NE(r.err.find("127.0.0.1:" + port), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("--port 0"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("another program listens on it"), std::string::npos) << r.err;
+  // An address that is not this machine's (TEST-NET-1, RFC 5737).
+  r = run_cli({"serve", "--db", "c.db", "--port", "0", "--bind", "192.0.2.1"}, d.path);
+  EXPECT_EQ(r.code, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("192.0.2.1"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("is --bind an address of this machine"), std::string::npos) << r.err;
   r = run_cli({"serve", "--db", "c.db", "--port", "70000"}, d.path);
   EXPECT_EQ(r.code, 2) << r.err;
 }
