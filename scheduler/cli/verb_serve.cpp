@@ -14,13 +14,11 @@ namespace gravsweep::cli {
 
 namespace {
 
-bool is_loopback(const std::string& host) { return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0; }
-
 void run_serve(const serve::ServeOptions& o) {
   if (o.port < 0 || o.port > 65535) throw UsageError(fmt::format("--port {}: expected 0 to 65535", o.port));
   serve::serve(o, [&o](const std::string& url) {
     fmt::print("serving campaign {} at {}\n", o.db, url);
-    if (is_loopback(o.bind))
+    if (serve::is_loopback(o.bind))
       fmt::print("loopback only: reachable from this machine alone (--bind 0.0.0.0 to serve others)\n");
     else
       fmt::print("bound to {}: reachable from other machines; the page and API are read-only, without login\n", o.bind);

@@ -115,6 +115,12 @@ httplib::Server::Handler with_db(Connections& pool, std::function<Reply(db::Data
   };
 }
 
+/// The host of a Host header ("127.0.0.1:8080" -> 127.0.0.1, "[::1]:8080" -> ::1).
+std::string host_of(const std::string& header) {
+  if (!header.empty() && header[0] == '[') return header.substr(1, header.find(']') - 1);
+  return header.substr(0, header.find(':'));
+}
+
 void add_routes(httplib::Server& svr, Connections& pool, StatusCache& status, const ServeOptions& o,
                 const queue::CampaignPaths& paths) {
   svr.Get("/", [](const httplib::Request&, httplib::Response& res) {
@@ -133,12 +139,20 @@ void add_routes(httplib::Server& svr, Connections& pool, StatusCache& status, co
   svr.Get(R"(/api/drop/([^/]+))", with_db(pool, [&paths](db::Database& db, const httplib::Request& req) {
             return drop_reply(db, paths, req.matches[1].str(), params_of(req));
           }));
-  // Read-only: every other method is refused, whatever the path, before any body is read.
-  svr.set_pre_routing_handler([](const httplib::Request& req, httplib::Response& res) {
-    if (req.method == "GET" || req.method == "HEAD") return httplib::Server::HandlerResponse::Unhandled;
-    send(res, error_reply(405, fmt::format("{} {}: gravsweep serve is read-only (GET only)", req.method, req.path)));
-    res.set_header("Allow", "GET, HEAD");
-    return httplib::Server::HandlerResponse::Handled;
+  // Read-only: every other method is refused, whatever the path, before any body is read. Served
+  // on loopback, a request must also name a loopback host: a web page elsewhere that points one of
+  // its own host names at 127.0.0.1 (DNS rebinding) gets nothing.
+  svr.set_pre_routing_handler([loopback = is_loopback(o.bind)](const httplib::Request& req, httplib::Response& res) {
+    if (req.method != "GET" && req.method != "HEAD") {
+      send(res, error_reply(405, fmt::format("{} {}: gravsweep serve is read-only (GET only)", req.method, req.path)));
+      res.set_header("Allow", "GET, HEAD");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    if (loopback && !is_loopback(host_of(req.get_header_value("Host")))) {
+      send(res, error_reply(403, "served on loopback: ask for it as 127.0.0.1 or localhost"));
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
   });
   svr.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
     if (!res.body.empty()) return;
@@ -202,6 +216,8 @@ void serve(const ServeOptions& o, const std::function<void(const std::string& ur
   queue::stop_requested().store(true);  // the server ended of its own: let the watcher go
   watcher.join();
 }
+
+bool is_loopback(const std::string& host) { return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0; }
 
 const char* page_html() { return kPageHtml; }
 

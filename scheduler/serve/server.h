@@ -22,6 +22,9 @@ struct ServeOptions {
 /// cannot be bound) before serving anything.
 void serve(const ServeOptions& o, const std::function<void(const std::string& url)>& listening);
 
+/// True for a name or address of this machine's loopback interface (localhost, 127.x.y.z, ::1).
+bool is_loopback(const std::string& host);
+
 /// The page at / (page.html, compiled in).
 const char* page_html();
 

@@ -144,6 +144,13 @@ TEST(Serve, TheApiFollowsAWorkerAsItFinishesJobs) {
     ASSERT_TRUE(put);
     EXPECT_EQ(put->status, 405) << p;
   }
+  // A page elsewhere whose host name points at 127.0.0.1 (DNS rebinding) is refused.
+  const auto rebound = c.Get("/api/status", httplib::Headers{{"Host", "campaign.evil.example:80"}});
+  ASSERT_TRUE(rebound);
+  EXPECT_EQ(rebound->status, 403);
+  const auto local = c.Get("/api/status", httplib::Headers{{"Host", "localhost:" + std::to_string(serve.port)}});
+  ASSERT_TRUE(local);
+  EXPECT_EQ(local->status, 200);
   get_json(c, "/api/nothing", 404);
   get_json(c, "/api/status/../../c.db", 404);
   EXPECT_EQ(campaign_state(d.path / "c.db"), before);
