@@ -58,8 +58,9 @@ PY
 "$gs" serve --db big.db --port 0 > serve.log 2>&1 &
 serve=$!
 trap 'kill $serve 2>/dev/null || true' EXIT
-for _ in $(seq 100); do grep -q http serve.log && break; sleep 0.1; done
+for _ in $(seq 600); do grep -q http serve.log && break; sleep 0.1; done
 url="$(grep -o 'http://[0-9.:]*/' serve.log | head -1)"
+[ -n "$url" ] || { echo "bench-serve: serve printed no URL within 60 s:" >&2; cat serve.log >&2; exit 1; }
 for path in "api/status" "api/status" "api/status" "api/results?limit=50" "api/results?limit=50&sort=-impact_speed_m_s" \
             "api/results?limit=50&offset=80000&where=gravity_m_s2%3C1" "api/failed?limit=20" \
             "api/results?columns=impact_speed_m_s,noop_value,gravity_m_s2&limit=5000" "api/results?format=csv"; do
