@@ -172,7 +172,7 @@ json trace_json(const std::filesystem::path& file, std::int64_t points) {
           {"velocity_down_m_s", thinned(d.velocity_down_m_s, stride)}};
 }
 
-Reply drop_unchecked(db::Database& db, const queue::CampaignPaths& paths, const std::string& id, const Params& p) {
+Reply drop_unchecked(db::Database& db, const queue::CampaignPaths* paths, const std::string& id, const Params& p) {
   if (!is_job_id(id)) throw ApiError(404, fmt::format("'{}' is not a job id (hexadecimal digits)", id));
   const std::int64_t points = int_param(p, "points", kDefaultTracePoints, 2, kMaxTracePoints);
   queue::ResultsQuery q;
@@ -189,7 +189,11 @@ Reply drop_unchecked(db::Database& db, const queue::CampaignPaths& paths, const 
     out["trace_error"] = fmt::format("a {} job has no trace", kind.is_string() ? kind.get<std::string>() : "?");
     return json_reply(out);
   }
-  const std::filesystem::path file = paths.abs(rel.get<std::string>());
+  if (!paths) {
+    out["trace_error"] = "the campaign's files root is unknown: serve it with --files";
+    return json_reply(out);
+  }
+  const std::filesystem::path file = paths->abs(rel.get<std::string>());
   try {
     out["trace"] = trace_json(file, points);
   } catch (const std::exception& e) {  // moved, deleted, unreadable: the row still answers
@@ -250,7 +254,7 @@ Reply failed_reply(db::Database& db, const Params& params) {
   });
 }
 
-Reply drop_reply(db::Database& db, const queue::CampaignPaths& paths, const std::string& job_id, const Params& params) {
+Reply drop_reply(db::Database& db, const queue::CampaignPaths* paths, const std::string& job_id, const Params& params) {
   return guarded([&] { return drop_unchecked(db, paths, job_id, params); });
 }
 

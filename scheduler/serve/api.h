@@ -49,7 +49,8 @@ Reply results_reply(db::Database& db, const Params& params);
 Reply failed_reply(db::Database& db, const Params& params);
 
 /// /api/drop/ID: the job's results row and, for a drop, its trace (time, acceleration, depth,
-/// speed) thinned to at most `points` samples, read from the trace file under `files_root`.
-Reply drop_reply(db::Database& db, const queue::CampaignPaths& paths, const std::string& job_id, const Params& params);
+/// speed) thinned to at most `points` samples, read from the trace file under the files root
+/// (`paths`; null: a server campaign served without --files, the row alone).
+Reply drop_reply(db::Database& db, const queue::CampaignPaths* paths, const std::string& job_id, const Params& params);
 
 }  // namespace gravsweep::serve

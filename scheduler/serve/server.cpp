@@ -8,6 +8,7 @@
 #include <cstring>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -122,7 +123,7 @@ std::string host_of(const std::string& header) {
 }
 
 void add_routes(httplib::Server& svr, Connections& pool, StatusCache& status, const ServeOptions& o,
-                const queue::CampaignPaths& paths) {
+                const std::optional<queue::CampaignPaths>& paths) {
   svr.Get("/", [](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-store");
     res.set_content(page_html(), "text/html; charset=utf-8");
@@ -137,7 +138,7 @@ void add_routes(httplib::Server& svr, Connections& pool, StatusCache& status, co
             return failed_reply(db, params_of(req));
           }));
   svr.Get(R"(/api/drop/([^/]+))", with_db(pool, [&paths](db::Database& db, const httplib::Request& req) {
-            return drop_reply(db, paths, req.matches[1].str(), params_of(req));
+            return drop_reply(db, paths ? &*paths : nullptr, req.matches[1].str(), params_of(req));
           }));
   // Read-only: every other method is refused, whatever the path, before any body is read. Served
   // on loopback, a request must also name a loopback host: a web page elsewhere that points one of
@@ -182,7 +183,9 @@ std::string url_of(const std::string& host, int port) {
 void serve(const ServeOptions& o, const std::function<void(const std::string& url)>& listening) {
   Connections pool(o);
   { auto first = pool.take(); }  // not a campaign, unreadable: refused now, naming the file
-  const queue::CampaignPaths paths(o.db, o.files);
+  // A server campaign read without its files root still shows everything but the traces.
+  std::optional<queue::CampaignPaths> paths;
+  if (!db::is_postgres_url(o.db) || !o.files.empty()) paths.emplace(o.db, o.files);
   httplib::Server svr;
   const int threads = std::max(2, o.threads);
   svr.new_task_queue = [threads] { return new httplib::ThreadPool(static_cast<std::size_t>(threads)); };
@@ -211,8 +214,14 @@ void serve(const ServeOptions& o, const std::function<void(const std::string& ur
     while (!queue::stop_requested().load()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
     svr.stop();
   });
-  listening(url_of(o.bind, port));
-  svr.listen_after_bind();
+  try {
+    listening(url_of(o.bind, port));
+    svr.listen_after_bind();
+  } catch (...) {
+    queue::stop_requested().store(true);
+    watcher.join();
+    throw;
+  }
   queue::stop_requested().store(true);  // the server ended of its own: let the watcher go
   watcher.join();
 }
