@@ -80,10 +80,12 @@ queue::ResultsQuery results_query(db::Database& db, const Params& p, bool csv) {
     q.descending = (*s)[0] == '-';
     q.order_by = q.descending ? s->substr(1) : *s;
   }
+  // No columns named: as `results`, a table shows the job, the parameters and the paper's metrics,
+  // a CSV export every column (empty: all).
   const std::string* cols = param(p, "columns");
   if (cols && *cols != "all" && !cols->empty())
     q.columns = split_commas(*cols);
-  else if (!cols || cols->empty())  // the summary of `results`: the job, the parameters, the paper's metrics
+  else if ((!cols || cols->empty()) && !csv)
     q.columns = queue::summary_result_columns(db, results::headline_metric_keys());
   q.offset = int_param(p, "offset", 0, 0, std::numeric_limits<std::int64_t>::max() / 2);
   q.limit = csv ? int_param(p, "limit", kMaxCsvRows, 0, kMaxCsvRows)

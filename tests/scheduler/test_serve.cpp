@@ -96,6 +96,10 @@ TEST(Serve, TheApiFollowsAWorkerAsItFinishesJobs) {
   EXPECT_EQ(csv->status, 200);
   EXPECT_EQ(csv->body, "gravity_m_s2,kind\r\n1,noop\r\n2,noop\r\n3,noop\r\n4,noop\r\n");
   EXPECT_NE(csv->get_header_value("Content-Disposition").find("results.csv"), std::string::npos);
+  // Without columns, a CSV download is what `results --format csv` writes: every column, every row.
+  const auto full = c.Get("/api/results?format=csv");
+  ASSERT_TRUE(full);
+  EXPECT_EQ(full->body, run_cli({"results", "--db", "c.db", "--format", "csv"}, d.path).out);
   json bad =
       get_json(c, "/api/results?where=" + httplib::detail::encode_query_param("gravity_m_s2<1; DELETE FROM jobs"), 400);
   EXPECT_NE(bad.value("error", "").find("expected 'and'"), std::string::npos) << bad.dump();
