@@ -6,6 +6,8 @@
     ds.trace(ds.results().trial_id[0])                           # t_s, accel_m_s2, ... of one drop
     c = gravsweep.open_campaign("runs/sweep.db")                 # a campaign database (or postgresql://...)
     c.counts(), c.status()["eta_s"], c.results(where="gravity_m_s2<1"), c.trace(job_id)
+    gravsweep.metrics(["data/gravity_sweep/g9.81", "data/gravity_sweep/g0.1"])  # each drop processed in its own scales
+    gravsweep.collapse([...])                                     # the Froude collapse's verdict per metric
     gravsweep.fit(["data/gravity_sweep/g9.81"], model="scaled_base+gravity_depth_friction")
     gravsweep.predict("law.json", gravity=0.01, speed=0.2)
 
@@ -27,7 +29,7 @@ from typing import Iterable, Sequence
 import pandas as pd
 
 __all__ = ["GravsweepError", "binary", "open_campaign", "open_dataset", "Campaign", "Dataset",
-           "fit", "rank", "predict", "infer", "run_cli"]
+           "metrics", "collapse", "fit", "rank", "predict", "infer", "run_cli"]
 
 _REPO = Path(__file__).resolve().parents[2]
 
@@ -174,6 +176,41 @@ def _inputs(inputs) -> list[str]:
     for x in inputs:
         out.append(x.folder if isinstance(x, Dataset) else x.db if isinstance(x, Campaign) else x)
     return [str(x) for x in out]
+
+
+def _processing_args(time_scale: str | None, end_rule: str | None) -> list[str]:
+    return ((["--time-scale", time_scale] if time_scale else []) + (["--end-rule", end_rule] if end_rule else []))
+
+
+def metrics(inputs, where: str | None = None, time_scale: str | None = None,
+            end_rule: str | None = None) -> pd.DataFrame:
+    """Every trial's metrics as the model verbs process it (`measurements import --format csv`):
+    trial_id, source, gravity_m_s2, vc_m_s, apeak_m_s2, zstop_mm, tstop_ms, ... DEM drops in their
+    own scales unless time_scale="fixed" (the paper's 500 Hz at every gravity); end_rule "speed"
+    (default), "paper" or "depth". Nothing is written beside the inputs (a temporary database)."""
+    import tempfile
+    frames = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for k, x in enumerate(_inputs(inputs)):
+            args = ["measurements", "import", x, "--db", str(Path(tmp) / f"m{k}.db"), "--format", "csv"]
+            args += _processing_args(time_scale, end_rule) + (["--where", where] if where else [])
+            text = run_cli(args)
+            if text.strip():
+                frame = pd.read_csv(io.StringIO(text))
+                frame.insert(0, "input", x)
+                frames.append(frame)
+    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+
+
+def collapse(inputs, where: str | None = None, time_scale: str | None = None,
+             end_rule: str | None = None) -> pd.DataFrame:
+    """`gravsweep model collapse --format json`: one row per scaled metric (zstop_over_D,
+    tstop_sqrt_g_over_D, apeak_over_g) with the collapse ratio, the level and repeat scatter and
+    the nested analysis of variance's F and p of the level effect at equal Froude number."""
+    args = ["model", "collapse", *_inputs(inputs), "--format", "json"] + _processing_args(time_scale, end_rule)
+    if where:
+        args += ["--where", where]
+    return pd.DataFrame(_json_documents(run_cli(args))[0])
 
 
 def fit(inputs, model: str, baseline: str | None = None, where: str | None = None, **options) -> dict:

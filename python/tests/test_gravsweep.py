@@ -54,6 +54,22 @@ def test_a_campaign_run_here_gives_its_status_results_and_trace(tmp_path):
     assert tr.depth_m.max() == pytest.approx(drops.zstop_m.iloc[0], rel=0.2)
 
 
+def test_metrics_are_each_drops_own_scales_and_the_sweep_collapses():
+    folders = [SWEEP / "g9.81", SWEEP / "g0.001"]
+    own = gravsweep.metrics(folders)
+    fixed = gravsweep.metrics(folders, time_scale="fixed")
+    assert len(own) == len(fixed) == 12
+    assert {"trial_id", "gravity_m_s2", "vc_m_s", "zstop_mm", "tstop_ms", "apeak_m_s2"} <= set(own.columns)
+    at_1g = own.gravity_m_s2 == 9.81
+    # The processing is the paper's at 1 g and differs only below it.
+    assert (own[at_1g].tstop_ms.values == fixed[at_1g].tstop_ms.values).all()
+    assert (own[~at_1g].apeak_m_s2.values != fixed[~at_1g].apeak_m_s2.values).any()
+    c = gravsweep.collapse([SWEEP / f for f in ("g9.81", "g1.62", "g0.1", "g0.1_axis", "g0.01", "g0.01_axis",
+                                                 "g0.001", "g0.001_axis")])
+    assert list(c.metric) == ["zstop_over_D", "tstop_sqrt_g_over_D", "apeak_over_g"]
+    assert (c.level_p > 0.01).all()  # GRAVITY.md: all three collapse in the drops' own scales
+
+
 def test_fit_predict_and_infer_through_the_cli():
     f = gravsweep.fit([SWEEP / "g9.81", SWEEP / "g0.1"], model="scaled_base+gravity_depth_friction",
                       baseline="scaled_base")

@@ -91,7 +91,7 @@ struct Sample {
 class Posterior {
  public:
   Posterior(const SavedLaw& law, const LawCase& c, std::vector<PriorAxis> prior, std::vector<Observed> obs)
-      : model_(law_model(law)), ctx_(law_case_context(c)), prior_(std::move(prior)), obs_(std::move(obs)) {}
+      : model_(law_model(law)), ctx_(law_case_context(law, c)), prior_(std::move(prior)), obs_(std::move(obs)) {}
 
   [[nodiscard]] std::size_t dims() const { return prior_.size(); }
   [[nodiscard]] const std::vector<PriorAxis>& prior() const { return prior_; }

@@ -361,8 +361,10 @@ void interval(double value, const std::vector<double>& boot, double form_rms_pct
 
 }  // namespace
 
-TermContext law_case_context(const LawCase& c) {
+TermContext law_case_context(const SavedLaw& law, const LawCase& c) {
   TermContext ctx;
+  const LawRange& d = law.grain_diameter_m;
+  if (d.lo > 0 && d.hi > 0 && std::isfinite(d.lo) && std::isfinite(d.hi)) ctx.grain_diameter_m = std::sqrt(d.lo * d.hi);
   ctx.g_m_s2 = c.gravity_m_s2;
   ctx.diameter_m = c.diameter_m;
   ctx.mass_kg = c.mass_kg;
@@ -387,7 +389,7 @@ LawPrediction predict_case(const SavedLaw& law, const LawCase& c) {
   check_range("projectile diameter (m)", c.diameter_m, law.diameter_m, kLawExtrapolateDiameter, p);
   check_range("projectile mass (kg)", c.mass_kg, law.mass_kg, kLawExtrapolateMass, p);
   if (p.range == LawRangeFlag::refused) return p;
-  const TermContext ctx = law_case_context(c);
+  const TermContext ctx = law_case_context(law, c);
   FittedModel m = law_model(law);
   const Prediction best = predict(m, ctx);
   p.zstop_m = best.zstop_m, p.tstop_s = best.tstop_s, p.apeak_m_s2 = best.apeak_m_s2;

@@ -84,8 +84,9 @@ struct LawPrediction {
 };
 
 /// The context of a case for predict (model.h): its gravity, speed, diameter and mass, on a bed
-/// deep enough not to matter.
-TermContext law_case_context(const LawCase& c);
+/// deep enough not to matter, of the grains the law was fitted on (the geometric middle of its
+/// grain-diameter range; Table 1's 1 cm when the law records none).
+TermContext law_case_context(const SavedLaw& law, const LawCase& c);
 
 /// The law with no fitted ranges (--extrapolate: every case is predicted; the caller keeps the
 /// flag of the real ranges).

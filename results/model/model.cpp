@@ -191,6 +191,7 @@ TermContext context(const MeasuredTrial& t, std::size_t k) {
   c.fill_height_m = t.info.fill_height_m;
   c.diameter_m = t.info.projectile_diameter_m;
   c.mass_kg = t.info.projectile_mass_kg;
+  if (t.info.grain_diameter_m > 0) c.grain_diameter_m = t.info.grain_diameter_m;
   c.vc_m_s = p.metrics.vc_m_s;
   return c;
 }
@@ -201,6 +202,7 @@ TermContext context(const Trial& i) {
   c.fill_height_m = i.fill_height_m;
   c.diameter_m = i.projectile_diameter_m;
   c.mass_kg = i.projectile_mass_kg;
+  if (i.grain_diameter_m > 0) c.grain_diameter_m = i.grain_diameter_m;
   c.vc_m_s = i.impact_speed_m_s;
   c.v_m_s = i.impact_speed_m_s;
   return c;

@@ -21,7 +21,8 @@ struct TermContext {
   double fill_height_m = 0.1;
   double diameter_m = 0.1;
   double mass_kg = 1.0;
-  double vc_m_s = 0;  ///< impact speed of the trial
+  double grain_diameter_m = 0.01;  ///< the bed's grains (Table 1: 1 cm)
+  double vc_m_s = 0;               ///< impact speed of the trial
 };
 
 struct TermInfo {
@@ -58,7 +59,8 @@ struct TermInfo {
   X(viscous_drag)                \
   X(immersion_drag)              \
   X(bottom_stiffening)           \
-  X(cohesion)
+  X(cohesion)                    \
+  X(grain_drag)
 
 #define GRAVSWEEP_DECLARE_TERM(name) TermInfo name##_term();
 GRAVSWEEP_MODEL_TERMS(GRAVSWEEP_DECLARE_TERM)

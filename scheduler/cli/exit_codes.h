@@ -1,4 +1,4 @@
-// Exit codes of `gravsweep` (README.md), the CLI's front to scheduler/queue/exit_codes.h, and the
+// Exit codes of `gravsweep` (docs/reference.md), the CLI's front to scheduler/queue/exit_codes.h, and the
 // two ways a verb ends with one: an exception main() maps (UsageError, ConfigError, ...), or an
 // ExitWith for a verb that finished with an outcome other than success. A verb never calls
 // std::exit or _exit itself (forked children before exec aside): that would skip main's mapping.

@@ -68,7 +68,7 @@ void setup_model_collapse(CLI::App& model) {
       "The traces are processed in each drop's own scales (--time-scale froude, the default: the\n"
       "paper's 500 Hz and 2 ms hold at 1 g and D = 10 cm, scaled by sqrt(g/D)); --time-scale fixed is\n"
       "the paper's hertz and seconds at every gravity, --end-rule paper|speed|depth the end of the\n"
-      "collision (README, 'Processing').\n\n"
+      "collision (docs/reference.md, 'Processing').\n\n"
       "Examples:\n"
       "  gravsweep model collapse data/gravity_sweep/g9.81 data/gravity_sweep/g1.62 --plot collapse.png\n"
       "  gravsweep model collapse runs/gravity_sweep/sweep.db --where 'sweep~gravity_sweep_' --format csv\n"

@@ -189,9 +189,10 @@ void run_fit(const FitOptions& o) {
   else if (table)
     fmt::print("\nHeld-out errors ({}-fold grouped CV, whole trials held out), before and after:\n", o.folds);
   error_table(cm).print(o.in.format);
-  if (table && folds == results::kLeaveOneProjectileOut) {
-    fmt::print("\nEach projectile held out: mean signed error of its drops (predicted - measured, % of measured):\n");
-    projectile_table(c, cm).print("table");
+  if (folds == results::kLeaveOneProjectileOut) {
+    if (table)
+      fmt::print("\nEach projectile held out: mean signed error of its drops (predicted - measured, % of measured):\n");
+    projectile_table(c, cm).print(o.in.format);
   }
   if (table) explain_rises(cm);
   if (!o.save.empty()) save_law(o, spec, c);

@@ -1,5 +1,5 @@
 // Exit codes of `gravsweep` and of its worker processes, stable so that scripts can trust them
-// (documented in README.md). Here, below the CLI, because the queue records them too (a job's
+// (documented in docs/reference.md). Here, below the CLI, because the queue records them too (a job's
 // attempt: the code its error maps to) and forks processes; scheduler/cli/exit_codes.h is the
 // CLI's front and re-exports them.
 #pragma once

@@ -255,3 +255,50 @@ TEST(GravitySweep, AboveFroudeOneTheFiveLevelsCollapseAndTheStepHoldsAtThreeMetr
     EXPECT_NEAR(coarse / fine, 1.0, 0.005) << site.first << " m/s, seed " << site.second;
   }
 }
+
+namespace {
+
+/// Mean zstop (m) of a folder's drops at each design Froude number (rounded to 0.1), processed in
+/// the drops' own scales.
+std::map<double, double> zstop_by_froude(const std::vector<const char*>& folders) {
+  using namespace gravsweep::results;
+  std::map<double, std::vector<double>> z;
+  for (const char* f : folders) {
+    Campaign c = load_campaign((std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "data" / "gravity_sweep" / f).string());
+    reprocess_campaign(c, {"froude", ""});
+    for (const auto& t : c.trials) {
+      const double fr = t.processed.metrics.vc_m_s / std::sqrt(t.info.gravity_m_s2 * t.info.projectile_diameter_m);
+      z[std::round(fr * 10) / 10].push_back(t.processed.metrics.zstop_m);
+    }
+  }
+  std::map<double, double> mean;
+  for (const auto& [fr, v] : z) {
+    double s = 0;
+    for (double x : v) s += x;
+    mean[fr] = s / static_cast<double>(v.size());
+  }
+  return mean;
+}
+
+}  // namespace
+
+// Beds poured at the target gravity against the ramped beds (GRAVITY.md, "Beds poured at the
+// target gravity"): at Fr 1 and 5 the depths agree within 5 % at 0.1 and 0.01 m/s2; at Fr 0.5 and
+// 0.1 m/s2 the poured bed stops the projectile about 11 % shallower.
+TEST(GravitySweep, BedsPouredAtTheirGravityGiveTheRampedBedsDepthsAtFroudeOneAndAbove) {
+  const auto ramped_01 = zstop_by_froude({"g0.1", "g0.1_axis"}), poured_01 = zstop_by_froude({"g0.1_poured"});
+  const auto ramped_001 = zstop_by_froude({"g0.01", "g0.01_axis"}), poured_001 = zstop_by_froude({"g0.01_poured"});
+  ASSERT_EQ(poured_01.size(), 3u);
+  ASSERT_EQ(poured_001.size(), 2u) << "Fr 0.5 on the poured 0.01 m/s2 bed is refused by the at-rest check";
+  for (double fr : {1.0, 5.0}) {
+    const double d01 = poured_01.at(fr) / ramped_01.at(fr) - 1, d001 = poured_001.at(fr) / ramped_001.at(fr) - 1;
+    std::printf("Fr %.0f: poured / ramped - 1 = %+.1f %% at 0.1 m/s2, %+.1f %% at 0.01 m/s2\n", fr, 100 * d01,
+                100 * d001);
+    EXPECT_LT(std::abs(d01), 0.05);
+    EXPECT_LT(std::abs(d001), 0.05);
+  }
+  const double d05 = poured_01.at(0.5) / ramped_01.at(0.5) - 1;
+  std::printf("Fr 0.5 at 0.1 m/s2: %+.1f %%\n", 100 * d05);
+  EXPECT_LT(d05, -0.08);
+  EXPECT_GT(d05, -0.15);
+}

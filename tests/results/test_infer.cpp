@@ -44,7 +44,7 @@ SavedLaw known_law() {
 Prediction truth_prediction(const SavedLaw& law, const std::vector<double>& truth, const LawCase& c) {
   FittedModel m = law_model(law);
   for (std::size_t i = 0; i < truth.size(); ++i) m.coef[static_cast<Eigen::Index>(i)] = truth[i];
-  return predict(m, law_case_context(c));
+  return predict(m, law_case_context(law, c));
 }
 
 TEST(Infer, SyntheticDropsOfAKnownTruthAreCoveredByTheirIntervals) {

@@ -1,4 +1,4 @@
-// The documented exit codes (README.md, scheduler/cli/exit_codes.h) of the verbs that end with an
+// The documented exit codes (docs/reference.md, scheduler/cli/exit_codes.h) of the verbs that end with an
 // outcome other than success or a plain error: they leave through main() (cli::ExitWith), never by
 // std::exit in a callback, and what they printed before is still there. Real processes, real files.
 #include <gtest/gtest.h>
