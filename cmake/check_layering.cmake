@@ -13,7 +13,7 @@
 set(GRAVSWEEP_FOLDER_ORDER
     "engine:core,geometry,integrate,contact,rolling,neighbor,system,scenario"
     "results:processing,io,measurements,model,report"
-    "scheduler:queue,sweep,pipeline,cli")
+    "scheduler:queue,sweep,pipeline,serve,cli")
 
 # Appends to `problems` (in the caller) each include in <root>/<lib>/ that reaches a later folder
 # of the same library than the including file's.

@@ -23,7 +23,7 @@ constexpr SetupFn kVerbs[] = {
     &gravsweep::cli::setup_report,       &gravsweep::cli::setup_submit, &gravsweep::cli::setup_work,
     &gravsweep::cli::setup_status,       &gravsweep::cli::setup_resume, &gravsweep::cli::setup_results,
     &gravsweep::cli::setup_plot,         &gravsweep::cli::setup_export, &gravsweep::cli::setup_bench_queue,
-    &gravsweep::cli::setup_campaign,     &gravsweep::cli::setup_slurm,
+    &gravsweep::cli::setup_campaign,     &gravsweep::cli::setup_slurm,  &gravsweep::cli::setup_serve,
 };
 
 }  // namespace

@@ -97,50 +97,6 @@ std::string render_status(const queue::Status& s, const std::string& db, double 
   return out;
 }
 
-nlohmann::json status_json(const queue::Status& s) {
-  using nlohmann::json;
-  json j;
-  j["sweeps"] = json::array();
-  for (const auto& c : s.per_sweep)
-    j["sweeps"].push_back({{"sweep", c.sweep},
-                           {"kind", c.kind},
-                           {"waiting", c.waiting},
-                           {"queued", c.queued},
-                           {"running", c.running},
-                           {"failed", c.failed},
-                           {"done", c.done},
-                           {"dead", c.dead}});
-  j["running"] = json::array();
-  for (const auto& r : s.running)
-    j["running"].push_back({{"job_id", r.job_id},
-                            {"kind", r.kind},
-                            {"attempt", r.attempt},
-                            {"worker", r.owner},
-                            {"phase", r.phase},
-                            {"progress", r.progress},
-                            {"detail", r.detail},
-                            {"started_at", r.started_at},
-                            {"heartbeat_at", r.heartbeat_at},
-                            {"lease_expires", r.lease_expires},
-                            {"stale", r.stale}});
-  j["stale_leases"] = s.stale_leases;
-  j["released_attempts"] = s.released_attempts;
-  j["released_jobs"] = s.released_jobs;
-  j["stopped_by_releases"] = s.stopped_by_releases;
-  j["active_workers"] = s.active_workers;
-  j["eta_s"] = s.eta_s >= 0 ? json(s.eta_s) : json(nullptr);
-  j["runtimes"] = json::array();
-  for (const auto& r : s.runtimes)
-    j["runtimes"].push_back(
-        {{"kind", r.kind}, {"finished", r.finished}, {"median_runtime_s", r.median_s}, {"remaining", r.remaining}});
-  j["dead_recent"] = json::array();
-  for (const auto& [id, err] : s.recent_errors) j["dead_recent"].push_back({{"job_id", id}, {"error", err}});
-  j["bed_checksum_mismatches"] = json::array();
-  for (const auto& [id, err] : s.dependency_mismatches)
-    j["bed_checksum_mismatches"].push_back({{"drop_job_id", id}, {"error", err}});
-  return j;
-}
-
 void run_status(const StatusOptions& o) {
   db::Database db = queue::open_campaign(o.db, queue::OpenMode::read);
   if (o.watch_s > 0) queue::install_stop_signals();
@@ -149,7 +105,7 @@ void run_status(const StatusOptions& o) {
     const auto s = queue::status(db, static_cast<std::size_t>(o.max_running));
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (o.format == "json") {
-      auto j = status_json(s);
+      auto j = queue::status_json(s);
       j["query_s"] = secs;
       fmt::print("{}\n", j.dump(2));
     } else {

@@ -34,5 +34,6 @@ void setup_plot(CLI::App& app);
 void setup_export(CLI::App& app);
 void setup_campaign(CLI::App& app);
 void setup_slurm(CLI::App& app);
+void setup_serve(CLI::App& app);
 
 }  // namespace gravsweep::cli

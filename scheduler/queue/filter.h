@@ -18,6 +18,8 @@ struct ResultsQuery {
   std::string sweep;                 ///< empty: all sweeps
   std::string order_by;              ///< empty: insertion order
   long limit = -1;
+  long offset = 0;          ///< rows skipped first (a page of a long table)
+  bool descending = false;  ///< order_by from the largest value down
 };
 
 struct ResultsTable {
@@ -30,5 +32,9 @@ struct ResultsTable {
 /// (anything else throws, naming the column and the value), a text column with the value's text as
 /// typed, and `~` looks for the typed text in the column's text form.
 ResultsTable query_results(db::Database& db, const ResultsQuery& q);
+
+/// The number of rows `q` selects, limit and offset aside (the pages of a long table); the same
+/// checks and errors as query_results.
+std::int64_t count_results(db::Database& db, const ResultsQuery& q);
 
 }  // namespace gravsweep::queue

@@ -214,9 +214,17 @@ struct KindRuntime {
   double median_s = 0;
   std::int64_t remaining = 0;
 };
+/// A worker seen holding a lease: its jobs now and its latest heartbeat.
+struct WorkerSeen {
+  std::string owner;
+  std::int64_t jobs = 0;
+  double last_heartbeat_at = 0;
+  bool stale = false;  ///< every lease it holds has expired
+};
 struct Status {
   std::vector<StateCounts> per_sweep;
   std::vector<RunningJob> running;
+  std::vector<WorkerSeen> workers;  ///< every lease owner, running jobs not cut at max_running
   std::vector<KindRuntime> runtimes;
   std::int64_t stale_leases = 0;
   std::int64_t blocked = 0;              ///< dead because a dependency is dead (jobs.blocked_by)
@@ -231,6 +239,21 @@ struct Status {
   std::vector<std::pair<std::string, std::string>> dependency_mismatches;
 };
 Status status(db::Database& db, std::size_t max_running = 20);
+/// `status --format json` (and the /api/status of `serve`): the Status as one JSON object.
+nlohmann::json status_json(const Status& s);
+
+/// A failed job waiting for its retry, or a dead one, with the reason.
+struct TroubledJob {
+  std::string job_id, sweep, kind, state, error, blocked_by;
+  int attempts = 0, max_attempts = 0;
+  double finished_at = 0;  ///< 0: never finished (a failed job: the time of its last attempt's end)
+};
+struct TroubledPage {
+  std::int64_t total = 0;  ///< failed and dead jobs in all
+  std::vector<TroubledJob> jobs;
+};
+/// The failed and dead jobs, latest first, `limit` of them from `offset`.
+TroubledPage troubled_jobs(db::Database& db, std::int64_t offset, std::int64_t limit);
 
 // ---- results ----------------------------------------------------------------------------------
 /// Column names of the results table, in display order (fixed, parameters, metrics).

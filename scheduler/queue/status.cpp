@@ -61,6 +61,15 @@ Remaining count_states(Database& db, Status& s) {
   return remaining;
 }
 
+/// Counts `r` under its lease owner in `workers` (a few entries: one a worker process).
+void note_worker(std::vector<WorkerSeen>& workers, const RunningJob& r) {
+  auto w = std::find_if(workers.begin(), workers.end(), [&](const WorkerSeen& x) { return x.owner == r.owner; });
+  if (w == workers.end()) w = workers.insert(workers.end(), WorkerSeen{r.owner, 0, 0, true});
+  ++w->jobs;
+  w->last_heartbeat_at = std::max(w->last_heartbeat_at, r.heartbeat_at);
+  w->stale = w->stale && r.stale;
+}
+
 /// s.running (at most max_running live ones, every stale one), active workers, stale leases.
 void read_running(Database& db, Status& s, double now, std::size_t max_running) {
   Statement st(db,
@@ -84,6 +93,7 @@ void read_running(Database& db, Status& s, double now, std::size_t max_running) 
       ++s.stale_leases;
     else
       ++s.active_workers;
+    note_worker(s.workers, r);
     if (s.running.size() < max_running || r.stale) s.running.push_back(std::move(r));
   }
 }
@@ -250,6 +260,80 @@ Status status(Database& db, std::size_t max_running) {
   s.eta_s = eta_s(est, s, remaining);
   read_troubles(db, s);
   return s;
+}
+
+namespace {
+
+nlohmann::json running_json(const RunningJob& r) {
+  return {{"job_id", r.job_id},
+          {"kind", r.kind},
+          {"attempt", r.attempt},
+          {"worker", r.owner},
+          {"phase", r.phase},
+          {"progress", r.progress},
+          {"detail", r.detail},
+          {"started_at", r.started_at},
+          {"heartbeat_at", r.heartbeat_at},
+          {"lease_expires", r.lease_expires},
+          {"stale", r.stale}};
+}
+
+}  // namespace
+
+nlohmann::json status_json(const Status& s) {
+  using nlohmann::json;
+  json j;
+  j["sweeps"] = json::array();
+  for (const auto& c : s.per_sweep)
+    j["sweeps"].push_back({{"sweep", c.sweep},
+                           {"kind", c.kind},
+                           {"waiting", c.waiting},
+                           {"queued", c.queued},
+                           {"running", c.running},
+                           {"failed", c.failed},
+                           {"done", c.done},
+                           {"dead", c.dead}});
+  j["running"] = json::array();
+  for (const auto& r : s.running) j["running"].push_back(running_json(r));
+  j["workers"] = json::array();
+  for (const auto& w : s.workers)
+    j["workers"].push_back(
+        {{"worker", w.owner}, {"jobs", w.jobs}, {"last_heartbeat_at", w.last_heartbeat_at}, {"stale", w.stale}});
+  j["stale_leases"] = s.stale_leases;
+  j["released_attempts"] = s.released_attempts;
+  j["released_jobs"] = s.released_jobs;
+  j["stopped_by_releases"] = s.stopped_by_releases;
+  j["active_workers"] = s.active_workers;
+  j["eta_s"] = s.eta_s >= 0 ? json(s.eta_s) : json(nullptr);
+  j["runtimes"] = json::array();
+  for (const auto& r : s.runtimes)
+    j["runtimes"].push_back(
+        {{"kind", r.kind}, {"finished", r.finished}, {"median_runtime_s", r.median_s}, {"remaining", r.remaining}});
+  j["dead_recent"] = json::array();
+  for (const auto& [id, err] : s.recent_errors) j["dead_recent"].push_back({{"job_id", id}, {"error", err}});
+  j["bed_checksum_mismatches"] = json::array();
+  for (const auto& [id, err] : s.dependency_mismatches)
+    j["bed_checksum_mismatches"].push_back({{"drop_job_id", id}, {"error", err}});
+  return j;
+}
+
+TroubledPage troubled_jobs(Database& db, std::int64_t offset, std::int64_t limit) {
+  TroubledPage page;
+  Transaction tx(db, Transaction::Mode::deferred);  // the count and the page of one snapshot
+  {
+    Statement st(db, "SELECT count(*) FROM jobs WHERE state IN ('failed','dead')");  // index jobs_claim
+    st.step();
+    page.total = st.get_int(0);
+  }
+  Statement st(db,
+               "SELECT job_id, sweep_id, kind, state, coalesce(last_error,''), coalesce(blocked_by,''), attempts, "
+               "max_attempts, coalesce(finished_at,0) FROM jobs WHERE state IN ('failed','dead') "
+               "ORDER BY coalesce(finished_at,0) DESC, seq DESC LIMIT ? OFFSET ?");
+  st.bind(1, std::max<std::int64_t>(0, limit)).bind(2, std::max<std::int64_t>(0, offset));
+  while (st.step())
+    page.jobs.push_back({st.get_text(0), st.get_text(1), st.get_text(2), st.get_text(3), st.get_text(4), st.get_text(5),
+                         static_cast<int>(st.get_int(6)), static_cast<int>(st.get_int(7)), st.get_double(8)});
+  return page;
 }
 
 }  // namespace gravsweep::queue
