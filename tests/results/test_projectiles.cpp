@@ -6,11 +6,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "results/io/csv.h"
+#include "results/measurements/campaign.h"
 #include "results/model/model_spec.h"
 #include "results/model/synth.h"
 #include "results_helpers.h"
@@ -18,24 +21,24 @@
 namespace gravsweep::results {
 namespace {
 
-/// The `column` of each row of the table whose header starts with `key` in `model fit --format csv`
-/// (several tables, one after the other), by the row's first field.
+/// The `column` of each row of the table whose header starts with `key` in a verb's `--format csv`
+/// output (several tables one after the other: the fit's parameters, models and projectiles, or
+/// lolo's levels), by the row's first field (and second, for a projectile: "D,m").
 std::map<std::string, double> column_by_key(const std::string& csv, const std::string& column, const std::string& key) {
   std::istringstream in(csv);
-  std::string line;
-  std::vector<std::string> header;
+  gravsweep::results::CsvReader reader(in);
+  std::vector<std::string> header, f;
   std::map<std::string, double> out;
-  while (std::getline(in, line)) {
-    std::vector<std::string> f;
-    std::stringstream ss(line);
-    for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
-    if (!f.empty() && (f[0] == "parameter" || f[0] == "model" || f[0] == "projectile_diameter_m")) {
-      header = f[0] == key ? f : std::vector<std::string>{};  // the header of one of the fit's tables
+  int line = 0;
+  while (reader.next(f, line)) {
+    if (!f.empty() &&
+        (f[0] == "parameter" || f[0] == "model" || f[0] == "projectile_diameter_m" || f[0] == "held_out_g_m_s2")) {
+      header = f[0] == key ? f : std::vector<std::string>{};  // the header of one of the tables
       continue;
     }
     if (header.empty() || f.size() != header.size()) continue;
     for (std::size_t i = 0; i < f.size(); ++i)
-      if (header[i] == column) out[f[0] + (key == "model" ? "" : "," + f[1])] = std::stod(f[i]);
+      if (header[i] == column) out[f[0] + (key == "projectile_diameter_m" ? "," + f[1] : "")] = std::stod(f[i]);
   }
   return out;
 }
@@ -121,6 +124,46 @@ TEST(Projectiles, OnTheCommittedSweepAFiniteSizeDragPredictsBothDiameters) {
     std::printf("  D, m = %s: %+.1f %% (drag on D^2: %+.1f %%)\n", projectile.c_str(), err, on_area.at(projectile));
     EXPECT_LT(std::abs(err), 10.0) << projectile;
   }
+}
+
+// Gravity at fixed projectile: the finite-size law fitted on the 9.81 m/s2 drops alone (both
+// diameters) predicts the 10 cm sphere's three masses at 0.1 m/s2 (Fr 0.5, 1 and 2), and the
+// other way round, within the one-projectile law's targets in depth (`model lolo`, median |error|).
+TEST(Projectiles, TheFiniteSizeLawFittedAtOneGPredictsTheTenthOfAMetrePerSecondSquaredLevel) {
+  const std::string data = std::string(GRAVSWEEP_SOURCE_DIR) + "/data/projectile_sweep/";
+  const auto r = gravsweep::testing::run_gravsweep(
+      "model lolo '" + data + "g9.81_d10cm' '" + data + "g9.81_d5cm' '" + data +
+          "g0.1_axis_d10cm' --law area_scaled_base.phi+area_scaled_base.kappa_a_kg_m3+grain_drag --format csv",
+      true);
+  ASSERT_EQ(r.code, 0) << r.out;
+  const auto zstop = column_by_key(r.out, "zstop_median_err_pct", "held_out_g_m_s2");
+  ASSERT_EQ(zstop.size(), 2u) << r.out;
+  for (const auto& [level, err] : zstop) {
+    std::printf("held out %s m/s2: zstop median |error| %.1f %%\n", level.c_str(), err);
+    EXPECT_LT(err, 10.0) << level;
+  }
+}
+
+// The at-rest check is a gate, not a treatment (GRAVITY.md, Design): the same points at 0.1 m/s2
+// run under the whole-surface criterion and under the axis window give the same drops.
+TEST(Projectiles, ThePointsRunUnderBothAtRestCriteriaGiveTheSameDrops) {
+  using namespace gravsweep::results;
+  const auto dir = std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "data" / "projectile_sweep";
+  const Campaign whole = load_campaign((dir / "at_rest_whole_surface_g0.1_d10cm").string());
+  const Campaign axis = load_campaign((dir / "g0.1_axis_d10cm").string());
+  int matched = 0;
+  for (const auto& w : whole.trials)
+    for (const auto& a : axis.trials) {
+      // The same point: the same projectile, impact speed and site (trials.csv's lateral_offset_m).
+      if (a.info.attributes.at("lateral_offset_m") != w.info.attributes.at("lateral_offset_m") ||
+          a.info.projectile_mass_kg != w.info.projectile_mass_kg || a.info.impact_speed_m_s != w.info.impact_speed_m_s)
+        continue;
+      ++matched;
+      EXPECT_EQ(a.processed.metrics.zstop_m, w.processed.metrics.zstop_m) << w.info.trial_id;
+      EXPECT_EQ(a.processed.metrics.tstop_s, w.processed.metrics.tstop_s) << w.info.trial_id;
+    }
+  std::printf("%d of %zu points matched\n", matched, whole.trials.size());
+  EXPECT_EQ(matched, static_cast<int>(whole.trials.size()));
 }
 
 }  // namespace
