@@ -5,6 +5,9 @@
 // (results/model/infer.h).
 #include <fmt/format.h>
 
+#include <cmath>
+#include <nlohmann/json.hpp>
+
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
@@ -32,15 +35,23 @@ struct InferVerbOptions {
   std::string format = "table";
 };
 
+/// A value rounded to `digits` significant digits as a typed cell, or null (an empty cell in text
+/// and CSV) when `known` is false or the value is not finite.
+nlohmann::json rounded(double x, int digits, bool known = true) {
+  if (!known || !std::isfinite(x)) return nullptr;
+  return std::stod(num(x, digits));
+}
+
 results::Table constants_table(const results::Inference& r) {
   results::Table t({"constant", "campaign", "prior_lo", "prior_hi", "posterior_median", "posterior_lo", "posterior_hi",
                     "interval_shrink_pct", "constrained"});
   for (const auto& c : r.constants) {
-    // An unconstrained constant gets no number: the measurement says nothing the prior did not.
+    // An unconstrained constant gets no number (null in JSON): the measurement says nothing the
+    // prior did not.
     const bool say = c.constrained;
-    t.add({c.name, num(c.campaign, 4), num(c.prior_lo, 4), num(c.prior_hi, 4), say ? num(c.median, 4) : "",
-           say ? num(c.lo, 4) : "", say ? num(c.hi, 4) : "", num(100 * c.shrink, 3),
-           say ? "yes" : "no: one impact does not constrain it (posterior = prior)"});
+    t.add_values({c.name, rounded(c.campaign, 4), rounded(c.prior_lo, 4), rounded(c.prior_hi, 4),
+                  rounded(c.median, 4, say), rounded(c.lo, 4, say), rounded(c.hi, 4, say), rounded(100 * c.shrink, 3),
+                  say ? "yes" : "no: one impact does not constrain it (posterior = prior)"});
   }
   return t;
 }
