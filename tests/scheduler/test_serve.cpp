@@ -47,6 +47,52 @@ std::string campaign_state(const std::filesystem::path& db_path) {
          std::to_string(sql_int(db, "SELECT count(*) FROM attempts"));
 }
 
+/// After the worker of TheApiFollowsAWorkerAsItFinishesJobs: the views beyond the counts and rows.
+void check_levels_collapse_and_rank(httplib::Client& c) {
+  // The drops in Froude scaling: gravity and diameter from each drop's scenario.
+  const json col = get_json(c, "/api/collapse");
+  ASSERT_EQ(col.at("total"), 2) << col.dump();
+  const auto at = [&col](const char* name) {
+    const auto& cs = col.at("columns");
+    return static_cast<std::size_t>(std::find(cs.begin(), cs.end(), name) - cs.begin());
+  };
+  for (const auto& row : col.at("rows")) {
+    EXPECT_EQ(row[at("gravity_m_s2")], 9.81) << col.dump();
+    EXPECT_EQ(row[at("projectile_diameter_m")], 0.03) << col.dump();  // tiny_base's projectile
+    const double vc = row[at("vc_m_s")].get<double>();
+    EXPECT_NEAR(row[at("froude")].get<double>(), vc / std::sqrt(9.81 * 0.03), 1e-9);
+    EXPECT_GT(row[at("zstop_over_d")].get<double>(), 0);
+    EXPECT_GT(row[at("tstop_sqrt_g_over_d")].get<double>(), 0);
+    EXPECT_GT(row[at("apeak_over_g")].get<double>(), 0);
+  }
+  EXPECT_EQ(get_json(c, "/api/collapse?where=gravity_m_s2%3C1").at("total"), 0);
+  get_json(c, "/api/collapse?where=nope%3C1", 400);
+
+  // Per sweep, kind and gravity level: the four waits at g = 1..4, the dead one at 7, the drops.
+  const json lv = get_json(c, "/api/levels");
+  ASSERT_EQ(lv.at("levels").size(), 7u) << lv.dump();
+  std::map<std::string, json> by;
+  for (const auto& l : lv.at("levels"))
+    by[l.at("sweep").get<std::string>() + "/" + l.at("kind").get<std::string>() + "/" + l.at("gravity_m_s2").dump()] =
+        l;
+  EXPECT_EQ(by["wait/noop/4.0"].at("done"), 1) << lv.dump();
+  EXPECT_EQ(by["dies/noop/7.0"].at("dead"), 1) << lv.dump();
+  EXPECT_EQ(by["drops/drop/9.81"].at("done"), 2) << lv.dump();
+  EXPECT_EQ(by["drops/bed/9.81"].at("done"), 1) << lv.dump();
+  EXPECT_EQ(by["drops/drop/9.81"].at("eta_s"), 0) << lv.dump();
+  EXPECT_GT(by["drops/drop/9.81"].at("jobs_per_min").get<double>(), 0) << lv.dump();
+
+  // Two drops are too few for the model's verdict, and it says so.
+  json rank;
+  for (int i = 0; i < 100; ++i) {
+    rank = get_json(c, "/api/rank");
+    if (rank.at("state") != "computing" && rank.at("for").is_object() && rank.at("for").at("drops") == 2) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_EQ(rank.at("state"), "not enough drops") << rank.dump();
+  EXPECT_NE(rank.value("message", "").find("at least 6"), std::string::npos) << rank.dump();
+}
+
 }  // namespace
 
 TEST(Serve, TheApiFollowsAWorkerAsItFinishesJobs) {
@@ -110,48 +156,7 @@ TEST(Serve, TheApiFollowsAWorkerAsItFinishesJobs) {
   EXPECT_NE(bad.value("error", "").find("found column 'nope'"), std::string::npos) << bad.dump();
   get_json(c, "/api/results?limit=100000", 400);  // a JSON page is bounded
 
-  // The drops in Froude scaling: gravity and diameter from each drop's scenario.
-  const json col = get_json(c, "/api/collapse");
-  ASSERT_EQ(col.at("total"), 2) << col.dump();
-  const auto at = [&col](const char* name) {
-    const auto& cs = col.at("columns");
-    return static_cast<std::size_t>(std::find(cs.begin(), cs.end(), name) - cs.begin());
-  };
-  for (const auto& row : col.at("rows")) {
-    EXPECT_EQ(row[at("gravity_m_s2")], 9.81) << col.dump();
-    EXPECT_EQ(row[at("projectile_diameter_m")], 0.03) << col.dump();  // tiny_base's projectile
-    const double vc = row[at("vc_m_s")].get<double>();
-    EXPECT_NEAR(row[at("froude")].get<double>(), vc / std::sqrt(9.81 * 0.03), 1e-9);
-    EXPECT_GT(row[at("zstop_over_d")].get<double>(), 0);
-    EXPECT_GT(row[at("tstop_sqrt_g_over_d")].get<double>(), 0);
-    EXPECT_GT(row[at("apeak_over_g")].get<double>(), 0);
-  }
-  EXPECT_EQ(get_json(c, "/api/collapse?where=gravity_m_s2%3C1").at("total"), 0);
-  get_json(c, "/api/collapse?where=nope%3C1", 400);
-
-  // Per sweep, kind and gravity level: the four waits at g = 1..4, the dead one at 7, the drops.
-  const json lv = get_json(c, "/api/levels");
-  ASSERT_EQ(lv.at("levels").size(), 7u) << lv.dump();
-  std::map<std::string, json> by;
-  for (const auto& l : lv.at("levels"))
-    by[l.at("sweep").get<std::string>() + "/" + l.at("kind").get<std::string>() + "/" + l.at("gravity_m_s2").dump()] =
-        l;
-  EXPECT_EQ(by["wait/noop/4.0"].at("done"), 1) << lv.dump();
-  EXPECT_EQ(by["dies/noop/7.0"].at("dead"), 1) << lv.dump();
-  EXPECT_EQ(by["drops/drop/9.81"].at("done"), 2) << lv.dump();
-  EXPECT_EQ(by["drops/bed/9.81"].at("done"), 1) << lv.dump();
-  EXPECT_EQ(by["drops/drop/9.81"].at("eta_s"), 0) << lv.dump();
-  EXPECT_GT(by["drops/drop/9.81"].at("jobs_per_min").get<double>(), 0) << lv.dump();
-
-  // Two drops are too few for the model's verdict, and it says so.
-  json rank;
-  for (int i = 0; i < 100; ++i) {
-    rank = get_json(c, "/api/rank");
-    if (rank.at("state") != "computing" && rank.at("for").is_object() && rank.at("for").at("drops") == 2) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  EXPECT_EQ(rank.at("state"), "not enough drops") << rank.dump();
-  EXPECT_NE(rank.value("message", "").find("at least 6"), std::string::npos) << rank.dump();
+  check_levels_collapse_and_rank(c);
 
   // Failed and dead jobs, with the reason.
   const json f = get_json(c, "/api/failed");
