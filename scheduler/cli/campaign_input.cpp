@@ -8,6 +8,7 @@
 
 #include "db/database.h"
 #include "scheduler/cli/exit_codes.h"
+#include "scheduler/pipeline/drop_campaign.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/filter.h"
 #include "scheduler/queue/queue.h"
@@ -32,30 +33,14 @@ CampaignInput load_queue_campaign(const std::string& path, db::Database& db, con
                                   const std::string& files, const results::ProcessingChoice& processing) {
   CampaignInput in;
   in.kind = "campaign database (submit/work)";
-  queue::ResultsQuery q;
-  q.where = where;
-  q.columns = {"job_id", "kind", "trace_path"};
-  queue::ResultsTable t;
+  pipeline::DropRefs drops;
   try {
-    t = queue::query_results(db, q);
+    drops = pipeline::finished_drops(db, queue::CampaignPaths(path, files), where);
   } catch (const std::invalid_argument& e) {
     throw UsageError(fmt::format("{}: {}", path, e.what()));
   }
-  const queue::CampaignPaths paths(path, files);
-  std::vector<results::DemTraceRef> refs;
-  for (const auto& r : t.rows) {
-    if (r[1] != "drop" || !r[2].is_string()) continue;
-    const std::string job = r[0].get<std::string>();
-    refs.push_back({job, job, paths.abs(r[2].get<std::string>())});
-  }
-  {
-    db::Statement st(
-        db, "SELECT state, count(*) FROM jobs WHERE kind='drop' AND state != 'done' GROUP BY state ORDER BY state");
-    while (st.step())
-      in.note += fmt::format("{}{} drop jobs {}", in.note.empty() ? "" : ", ", st.get_int(1), st.get_text(0));
-    if (!in.note.empty()) in.note += " (not finished: not trials yet; `gravsweep work` runs them)";
-  }
-  in.campaign = results::load_dem_campaign(path, refs, processing);
+  in.note = std::move(drops.note);
+  in.campaign = results::load_dem_campaign(path, drops.refs, processing);
   results::refuse_unphysical(path, in);
   return in;
 }

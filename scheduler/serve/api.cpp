@@ -141,12 +141,6 @@ bool is_job_id(const std::string& id) {
          std::all_of(id.begin(), id.end(), [](char c) { return std::isxdigit(static_cast<unsigned char>(c)); });
 }
 
-/// The HDF5 library of Debian is built without its thread-safety option: one trace read at a time.
-std::mutex& hdf5_mutex() {
-  static std::mutex m;
-  return m;
-}
-
 /// Every `stride`-th sample of `v`, the last one kept.
 json thinned(const std::vector<double>& v, std::size_t stride) {
   json a = json::array();
@@ -215,6 +209,11 @@ Reply guarded(F&& f) {
 }
 
 }  // namespace
+
+std::mutex& hdf5_mutex() {
+  static std::mutex m;
+  return m;
+}
 
 Reply error_reply(int status, const std::string& what) {
   Reply r = json_reply({{"error", what}});

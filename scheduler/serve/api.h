@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <string>
 
@@ -33,6 +34,10 @@ inline constexpr std::int64_t kMaxCsvRows = 200000;  ///< one CSV download
 inline constexpr std::int64_t kDefaultTracePoints = 2000;
 inline constexpr std::int64_t kMaxTracePoints = 20000;
 
+/// Debian's HDF5 library is built without its thread-safety option: every trace read of the
+/// process (a drop's trace, the traces behind the model verdict) holds this lock.
+std::mutex& hdf5_mutex();
+
 /// A reply of status `status` with {"error": what}.
 Reply error_reply(int status, const std::string& what);
 
@@ -47,6 +52,11 @@ Reply results_reply(db::Database& db, const Params& params);
 
 /// /api/failed: the failed and dead jobs with their reasons, latest first; offset, limit.
 Reply failed_reply(db::Database& db, const Params& params);
+
+/// /api/collapse: the drops the filter `where` keeps (the first kMaxPageRows) in Froude scaling:
+/// gravity and projectile diameter from each drop's scenario, Fr = vc / sqrt(g D), zstop / D,
+/// tstop sqrt(g / D), apeak / g (collapse.cpp).
+Reply collapse_reply(db::Database& db, const Params& params);
 
 /// /api/drop/ID: the job's results row and, for a drop, its trace (time, acceleration, depth,
 /// speed) thinned to at most `points` samples, read from the trace file under the files root

@@ -17,7 +17,9 @@
 #include "scheduler/queue/queue.h"
 #include "scheduler/queue/stop.h"
 #include "scheduler/serve/api.h"
+#include "scheduler/serve/levels.h"
 #include "scheduler/serve/page_html.h"
+#include "scheduler/serve/rank.h"
 
 namespace gravsweep::serve {
 
@@ -122,8 +124,9 @@ std::string host_of(const std::string& header) {
   return header.substr(0, header.find(':'));
 }
 
-void add_routes(httplib::Server& svr, Connections& pool, StatusCache& status, const ServeOptions& o,
-                const std::optional<queue::CampaignPaths>& paths) {
+void add_routes(httplib::Server& svr, Connections& pool, StatusCache& status, LevelCounts& levels,
+                const ServeOptions& o, const std::optional<queue::CampaignPaths>& paths,
+                const std::optional<RankWatch>& rank) {
   svr.Get("/", [](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-store");
     res.set_content(page_html(), "text/html; charset=utf-8");
@@ -131,15 +134,24 @@ void add_routes(httplib::Server& svr, Connections& pool, StatusCache& status, co
   svr.Get("/api/status", with_db(pool, [&status, name = o.db](db::Database& db, const httplib::Request&) {
             return status.get(db, name);
           }));
+  svr.Get("/api/levels",
+          with_db(pool, [&levels](db::Database& db, const httplib::Request&) { return levels.reply(db); }));
   svr.Get("/api/results", with_db(pool, [](db::Database& db, const httplib::Request& req) {
             return results_reply(db, params_of(req));
           }));
   svr.Get("/api/failed", with_db(pool, [](db::Database& db, const httplib::Request& req) {
             return failed_reply(db, params_of(req));
           }));
+  svr.Get("/api/collapse", with_db(pool, [](db::Database& db, const httplib::Request& req) {
+            return collapse_reply(db, params_of(req));
+          }));
   svr.Get(R"(/api/drop/([^/]+))", with_db(pool, [&paths](db::Database& db, const httplib::Request& req) {
             return drop_reply(db, paths ? &*paths : nullptr, req.matches[1].str(), params_of(req));
           }));
+  // The verdict is computed by its own thread (rank.h): a request only copies the latest answer.
+  svr.Get("/api/rank", [&rank](const httplib::Request&, httplib::Response& res) {
+    send(res, rank ? rank->reply() : error_reply(503, "the model verdict is not watched yet"));
+  });
   // Read-only: every other method is refused, whatever the path, before any body is read. Served
   // on loopback, a request must also name a loopback host: a web page elsewhere that points one of
   // its own host names at 127.0.0.1 (DNS rebinding) gets nothing.
@@ -192,7 +204,9 @@ void serve(const ServeOptions& o, const std::function<void(const std::string& ur
   // A browser keeps connections open; a short keep-alive frees their threads for others.
   svr.set_keep_alive_timeout(2);
   StatusCache status;
-  add_routes(svr, pool, status, o, paths);
+  LevelCounts levels;
+  std::optional<RankWatch> rank;  // started once the port is bound
+  add_routes(svr, pool, status, levels, o, paths, rank);
   errno = 0;
   int port = o.port;
   if (o.port == 0) {
@@ -209,6 +223,7 @@ void serve(const ServeOptions& o, const std::function<void(const std::string& ur
     throw ConfigError(fmt::format("cannot listen on {}:{}: {}; {}", o.bind, o.port,
                                   err ? std::strerror(err) : "the address cannot be resolved or bound", hint));
   }
+  rank.emplace(o.db, o.files, paths);
   queue::install_stop_signals();
   std::thread watcher([&svr] {
     while (!queue::stop_requested().load()) std::this_thread::sleep_for(std::chrono::milliseconds(100));

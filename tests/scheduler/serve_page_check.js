@@ -1,6 +1,7 @@
 // The page of `gravsweep serve` in a real browser (Debian's chromium driven by playwright-core,
 // which downloads no browser of its own): it loads, its done count changes while a worker runs,
-// a click on a drop draws the drop's trace on the canvas, and no script error occurs. Writes a
+// a click on a drop draws the drop's trace on the canvas, the Froude collapse is drawn, the model's
+// verdict appears once enough drops have finished, and no script error occurs. Writes a
 // screenshot and prints one JSON line of what it saw (times in ms).
 //
 //   node serve_page_check.js URL SCREENSHOT READY_FILE DROP_JOB_ID   # the test (test_serve_browser.cpp)
@@ -68,8 +69,18 @@ async function main() {
   await page.selectOption("#fig-y", "zstop_m").catch(() => {});
   await page.waitForSelector("#figure-canvas[data-drawn]", { timeout: 60000 });
   const figureInk = await inkedPixels(page, "figure-canvas");
+  // The Froude collapse of the finished drops, and the model's verdict once enough have finished.
+  await page.waitForSelector("#collapse-canvas[data-drawn]", { timeout: 120000 });
+  const collapseInk = await inkedPixels(page, "collapse-canvas");
+  if (collapseInk < 500) fail(`the collapse canvas is nearly blank (${collapseInk} pixels drawn)`);
+  const collapseDrops = Number(await page.getAttribute("#collapse-canvas", "data-drawn"));
+  await page.waitForSelector('#rank-verdict[data-state="ready"]', { timeout: 600000 });
+  const verdict = await page.textContent("#rank-verdict");
+  const rankRows = await page.locator("#rank tbody tr").count();
+  const levelRows = await page.locator("#levels tbody tr").count();
   await page.screenshot({ path: shot, fullPage: true });
-  console.log(JSON.stringify({ statusMs, loadMs, first, later, traceInk, figureInk, errors }));
+  console.log(JSON.stringify({ statusMs, loadMs, first, later, traceInk, figureInk, collapseInk, collapseDrops,
+                               verdict, rankRows, levelRows, errors }));
   await browser.close();
   if (errors.length) fail("script errors: " + errors.join("; "));
 }

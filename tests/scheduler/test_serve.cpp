@@ -8,6 +8,9 @@
 #include <sys/socket.h>
 
 #include <nlohmann/json.hpp>
+#include <algorithm>
+#include <cmath>
+#include <map>
 #include <set>
 
 #include "serve_test_helpers.h"
@@ -42,6 +45,52 @@ std::string campaign_state(const std::filesystem::path& db_path) {
   while (st.step()) out += st.get_text(0) + st.get_text(1) + st.get_text(2) + st.get_text(3) + ";";
   return out + std::to_string(sql_int(db, "SELECT count(*) FROM results")) +
          std::to_string(sql_int(db, "SELECT count(*) FROM attempts"));
+}
+
+/// After the worker of TheApiFollowsAWorkerAsItFinishesJobs: the views beyond the counts and rows.
+void check_levels_collapse_and_rank(httplib::Client& c) {
+  // The drops in Froude scaling: gravity and diameter from each drop's scenario.
+  const json col = get_json(c, "/api/collapse");
+  ASSERT_EQ(col.at("total"), 2) << col.dump();
+  const auto at = [&col](const char* name) {
+    const auto& cs = col.at("columns");
+    return static_cast<std::size_t>(std::find(cs.begin(), cs.end(), name) - cs.begin());
+  };
+  for (const auto& row : col.at("rows")) {
+    EXPECT_EQ(row[at("gravity_m_s2")], 9.81) << col.dump();
+    EXPECT_EQ(row[at("projectile_diameter_m")], 0.03) << col.dump();  // tiny_base's projectile
+    const double vc = row[at("vc_m_s")].get<double>();
+    EXPECT_NEAR(row[at("froude")].get<double>(), vc / std::sqrt(9.81 * 0.03), 1e-9);
+    EXPECT_GT(row[at("zstop_over_d")].get<double>(), 0);
+    EXPECT_GT(row[at("tstop_sqrt_g_over_d")].get<double>(), 0);
+    EXPECT_GT(row[at("apeak_over_g")].get<double>(), 0);
+  }
+  EXPECT_EQ(get_json(c, "/api/collapse?where=gravity_m_s2%3C1").at("total"), 0);
+  get_json(c, "/api/collapse?where=nope%3C1", 400);
+
+  // Per sweep, kind and gravity level: the four waits at g = 1..4, the dead one at 7, the drops.
+  const json lv = get_json(c, "/api/levels");
+  ASSERT_EQ(lv.at("levels").size(), 7u) << lv.dump();
+  std::map<std::string, json> by;
+  for (const auto& l : lv.at("levels"))
+    by[l.at("sweep").get<std::string>() + "/" + l.at("kind").get<std::string>() + "/" + l.at("gravity_m_s2").dump()] =
+        l;
+  EXPECT_EQ(by["wait/noop/4.0"].at("done"), 1) << lv.dump();
+  EXPECT_EQ(by["dies/noop/7.0"].at("dead"), 1) << lv.dump();
+  EXPECT_EQ(by["drops/drop/9.81"].at("done"), 2) << lv.dump();
+  EXPECT_EQ(by["drops/bed/9.81"].at("done"), 1) << lv.dump();
+  EXPECT_EQ(by["drops/drop/9.81"].at("eta_s"), 0) << lv.dump();
+  EXPECT_GT(by["drops/drop/9.81"].at("jobs_per_min").get<double>(), 0) << lv.dump();
+
+  // Two drops are too few for the model's verdict, and it says so.
+  json rank;
+  for (int i = 0; i < 100; ++i) {
+    rank = get_json(c, "/api/rank");
+    if (rank.at("state") != "computing" && rank.at("for").is_object() && rank.at("for").at("drops") == 2) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_EQ(rank.at("state"), "not enough drops") << rank.dump();
+  EXPECT_NE(rank.value("message", "").find("at least 6"), std::string::npos) << rank.dump();
 }
 
 }  // namespace
@@ -107,6 +156,8 @@ TEST(Serve, TheApiFollowsAWorkerAsItFinishesJobs) {
   EXPECT_NE(bad.value("error", "").find("found column 'nope'"), std::string::npos) << bad.dump();
   get_json(c, "/api/results?limit=100000", 400);  // a JSON page is bounded
 
+  check_levels_collapse_and_rank(c);
+
   // Failed and dead jobs, with the reason.
   const json f = get_json(c, "/api/failed");
   ASSERT_EQ(f.at("total"), 1) << f.dump();
@@ -169,6 +220,49 @@ TEST(Serve, TheApiFollowsAWorkerAsItFinishesJobs) {
   EXPECT_EQ(serve.stop(), 0) << read_file(serve.log);
 }
 
+// The verdict of `model rank` follows the finished drops: computed in the background for the
+// campaign's state, never while a request waits, and the same as the verb's.
+TEST(Serve, TheModelVerdictIsComputedAgainWhenDropsFinish) {
+  TempDir d;
+  ASSERT_TRUE(make_serve_campaign(d.path, 1, 0, {0.4, 0.5, 0.6}, {9.81, 3.71}));  // 6 drops at two levels
+  ServeProcess serve(d.path);
+  ASSERT_GT(serve.port, 0);
+  httplib::Client c("127.0.0.1", serve.port);
+  c.set_read_timeout(30);
+  json r = get_json(c, "/api/rank");
+  EXPECT_TRUE(r.at("state") == "computing" || r.at("state") == "not enough drops") << r.dump();
+  EXPECT_EQ(r.at("min_drops"), 6);
+  const pid_t w =
+      start_cli({"work", "--db", (d.path / "c.db").string(), "--threads", "1", "--poll", "0.05"}, d.path / "w.log");
+  EXPECT_EQ(wait_child(w, 600), 4) << "a dead job: work exits 4\n" << read_file(d.path / "w.log");
+  double slowest = 0;
+  std::set<std::string> states;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(300);
+  while (std::chrono::steady_clock::now() < end) {
+    const auto t0 = std::chrono::steady_clock::now();
+    r = get_json(c, "/api/rank");
+    slowest = std::max(slowest, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    states.insert(r.at("state").get<std::string>());
+    if (r.at("state") != "computing" && r.at("for").is_object() && r.at("for").at("drops") == 6) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_EQ(r.at("state"), "ready") << r.dump(1);
+  EXPECT_LT(slowest, 1.0) << "a request never waits for the computation";
+  EXPECT_EQ(r.at("trials"), 6) << r.dump();
+  EXPECT_GT(r.at("computed_at").get<double>(), 0);
+  ASSERT_EQ(r.at("ranking").at("columns")[2], "term");
+  EXPECT_FALSE(r.at("ranking").at("rows").empty()) << r.dump();
+  // The verb on the same campaign says the same.
+  const auto verb = run_cli({"model", "rank", "c.db"}, d.path);
+  ASSERT_EQ(verb.code, 0) << verb.err;
+  EXPECT_NE(verb.out.find("Verdict: " + r.at("verdict").get<std::string>()), std::string::npos) << verb.out << "\n"
+                                                                                                << r.dump();
+  // Nothing changed since: the same answer, not computed again.
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  EXPECT_EQ(get_json(c, "/api/rank").at("computed_at"), r.at("computed_at"));
+  EXPECT_EQ(serve.stop(), 0) << read_file(serve.log);
+}
+
 TEST(Serve, ABadDatabaseOrABusyPortIsRefusedNamingIt) {
   TempDir d;
   auto r = run_cli({"serve", "--db", "missing.db", "--port", "0"}, d.path);
@@ -209,4 +303,6 @@ TEST(Serve, HelpTeachesWithExamples) {
   EXPECT_NE(r.out.find("Examples:"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("gravsweep serve --db campaign.db"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("/api/status"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("/api/rank"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Froude"), std::string::npos) << r.out;
 }

@@ -1,8 +1,8 @@
 // The page of `gravsweep serve` in a real browser: Debian's chromium, headless, driven by
 // playwright-core from npm (deploy/node/, installed by deploy/install-deps.sh) through
 // serve_page_check.js. The page loads, its done count changes while a worker finishes jobs, a
-// click on a drop draws its trace. Skipped, saying why, only without chromium or node; a missing
-// playwright-core is a failure that names the command that installs it.
+// click on a drop draws its trace, the Froude collapse is drawn and the model's verdict appears. Skipped, saying why,
+// only without chromium or node; a missing playwright-core is a failure that names the command that installs it.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -54,8 +54,9 @@ TEST(ServeBrowser, ThePageFollowsAWorkerAndDrawsADropOnAClick) {
   ASSERT_TRUE(fs::exists(GRAVSWEEP_SOURCE_DIR "/deploy/node/node_modules/playwright-core"))
       << "playwright-core missing: run deploy/install-deps.sh (npm ci in deploy/node)";
   TempDir d;
-  // Six no-op jobs of a second each first, then two beds and four drops at two gravity levels.
-  ASSERT_TRUE(make_serve_campaign(d.path, 6, 1.0, {0.4, 0.6}, {9.81, 3.71}));
+  // Six no-op jobs of a second each first, then two beds and six drops at two gravity levels (the
+  // fewest `model rank` gives a verdict on).
+  ASSERT_TRUE(make_serve_campaign(d.path, 6, 1.0, {0.4, 0.5, 0.6}, {9.81, 3.71}));
   std::string drop;
   {
     db::Database db((d.path / "c.db").string());
@@ -80,6 +81,12 @@ TEST(ServeBrowser, ThePageFollowsAWorkerAndDrawsADropOnAClick) {
   ASSERT_TRUE(seen.is_object()) << read_file(d.path / "page.out");
   EXPECT_GT(seen.at("later").get<int>(), seen.at("first").get<int>()) << seen.dump();
   EXPECT_GT(seen.at("traceInk").get<int>(), 500) << seen.dump();
+  EXPECT_GT(seen.at("collapseInk").get<int>(), 500) << seen.dump();
+  EXPECT_GE(seen.at("collapseDrops").get<int>(), 1) << seen.dump();
+  EXPECT_EQ(seen.at("verdict").get<std::string>().rfind("Verdict: ", 0), 0u) << seen.dump();
+  EXPECT_GT(seen.at("verdict").get<std::string>().size(), 20u) << seen.dump();
+  EXPECT_GT(seen.at("rankRows").get<int>(), 0) << seen.dump();
+  EXPECT_EQ(seen.at("levelRows").get<int>(), 6 + 1 + 2 + 2) << seen.dump();  // waits, dies, beds, drops
   EXPECT_TRUE(seen.at("errors").empty()) << seen.dump();
   EXPECT_GT(fs::file_size(shot), 10000u) << shot;
   std::printf("page seen: %s; screenshot %s\n", seen.dump().c_str(), shot.c_str());
