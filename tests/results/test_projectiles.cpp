@@ -166,5 +166,35 @@ TEST(Projectiles, ThePointsRunUnderBothAtRestCriteriaGiveTheSameDrops) {
   EXPECT_EQ(matched, static_cast<int>(whole.trials.size()));
 }
 
+// Where Froude scaling breaks (GRAVITY.md, "Beyond one projectile"): the 5 cm sphere of 62.5 g at
+// Fr 0.5 stops at less than half of its 9.81 m/s2 zstop/D at 0.1 m/s2, within half a grain of the
+// surface, while at Fr 2 the two levels agree within 10 %.
+TEST(Projectiles, ASmallLightProjectileAtLowGravityStopsShallowerThanFroudeScalingSays) {
+  using namespace gravsweep::results;
+  const auto dir = std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "data" / "projectile_sweep";
+  // Mean zstop/D of the lightest 5 cm sphere's drops at Froude number `fr` in folder `f`.
+  auto z_over_d = [&](const char* f, double fr) {
+    Campaign c = load_campaign((dir / f).string());
+    reprocess_campaign(c, {"froude", ""});
+    double s = 0;
+    int n = 0;
+    for (const auto& t : c.trials) {
+      const double D = t.info.projectile_diameter_m;
+      const double trial_fr = t.processed.metrics.vc_m_s / std::sqrt(t.info.gravity_m_s2 * D);
+      if (t.info.projectile_mass_kg < 0.07 && std::abs(trial_fr - fr) < 0.05 * fr)
+        s += t.processed.metrics.zstop_m / D, ++n;
+    }
+    EXPECT_EQ(n, 2) << f << " Fr " << fr;
+    return s / n;
+  };
+  const double low_1g = z_over_d("g9.81_d5cm", 0.5), low_01 = z_over_d("g0.1_axis_d5cm", 0.5);
+  const double high_1g = z_over_d("g9.81_d5cm", 2.0), high_01 = z_over_d("g0.1_axis_d5cm", 2.0);
+  std::printf("5 cm, 62.5 g: zstop/D at Fr 0.5 %.3f (9.81) -> %.3f (0.1); at Fr 2 %.3f -> %.3f\n", low_1g, low_01,
+              high_1g, high_01);
+  EXPECT_LT(low_01, 0.5 * low_1g);
+  EXPECT_LT(low_01 * 0.05, 0.005) << "within half a grain diameter of the surface";
+  EXPECT_NEAR(high_01 / high_1g, 1.0, 0.1);
+}
+
 }  // namespace
 }  // namespace gravsweep::results
