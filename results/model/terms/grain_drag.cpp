@@ -24,8 +24,9 @@ TermInfo grain_drag_term() {
   t.features = [](const TermContext& c, double* out) {
     out[0] = c.grain_diameter_m * c.diameter_m * c.v_m_s * c.v_m_s;
   };
-  // Twice the 10 cm sphere's c_a: the 5 cm sphere's drag per unit of area is 1.8 times the 10 cm one's.
-  t.typical = [](double, double, double) { return std::vector<double>{2.0 * 1450.0}; };
+  // The projectile sweep's fit (GRAVITY.md): c_g = 23,580 kg/m3, at D = 10 cm and d = 1 cm the
+  // drag of c_a = c_g d / D = 2358 kg/m3 on D^2.
+  t.typical = [](double, double, double) { return std::vector<double>{23580.0}; };
   return t;
 }
 
