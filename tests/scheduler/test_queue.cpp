@@ -405,7 +405,9 @@ TEST_P(QueueTest, EtaOfASweepWithNothingFinishedComesFromItsRunningJobsProgress)
   EXPECT_LT(s.eta_s, 3.0);
 }
 
-TEST_P(QueueTest, StatusIsFastOnAHundredThousandJobs) {
+// How fast `status` is on 100,000 jobs is a benchmark (`gravsweep bench-queue --status-jobs 100000`,
+// BENCHMARKS.md), never a timed test: a loaded CI host took 1.6 s where a quiet one takes 40 ms.
+TEST_P(QueueTest, StatusCountsAHundredThousandJobs) {
   json doc = {{"sweep", "big"},
               {"job", "noop"},
               {"base", {{"i", 0}}},
@@ -420,16 +422,14 @@ TEST_P(QueueTest, StatusIsFastOnAHundredThousandJobs) {
       ASSERT_TRUE(complete(db, *c, done_for(*c)));
     }
   }
-  const auto t0 = std::chrono::steady_clock::now();
   const auto s = status(db);
-  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ASSERT_EQ(s.per_sweep.size(), 1u);
   EXPECT_EQ(s.per_sweep[0].queued, 99997);
   EXPECT_EQ(s.per_sweep[0].done, 2);
   EXPECT_EQ(s.per_sweep[0].running, 1);
   EXPECT_GT(s.eta_s, 0);
-  // Measured about 10 ms; the bound only catches a query that scans and sorts the table.
-  EXPECT_LT(secs, 1.0) << "status took " << secs << " s on 100,000 jobs";
+  ASSERT_EQ(s.running.size(), 1u);
+  EXPECT_EQ(s.running[0].job_id, sql_text(db, "SELECT job_id FROM jobs WHERE state='running'"));
 }
 
 TEST_P(QueueTest, ABedThatRunsAloneGetsThePoolsThreads) {
