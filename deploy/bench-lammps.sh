@@ -115,8 +115,8 @@ run             \${steps}
 EOF
 
 # --- interleaved runs ---
-gs_ns() {  # gravsweep ns per particle-step for one thread count
-  "$gravsweep" bench --bed "$bed" --steps "$steps" --threads "$1" |
+gs_ns() {  # gravsweep ns per particle-step for one thread count (its whole output kept for the host report)
+  "$gravsweep" bench --bed "$bed" --steps "$steps" --threads "$1" | tee "$work/gravsweep.$1.out" |
     awk '$1 == "file" {print $4}'
 }
 lmp_ns() {  # LAMMPS ns per particle-step from the last "Loop time" line
@@ -139,3 +139,7 @@ printf '%-28s %10s %10s\n' "ns per particle-step" "1 core" "2 cores"
 printf '%-28s %10.1f %10.1f\n' "gravsweep (bench --bed)" "$mg1" "$mg2"
 printf '%-28s %10.1f %10.1f\n' "LAMMPS (serial; mpirun -np 2)" "$ml1" "$ml2"
 printf '%-28s %9.2fx %9.2fx\n' "ratio LAMMPS / gravsweep" "$(awk "BEGIN {print $ml1 / $mg1}")" "$(awk "BEGIN {print $ml2 / $mg2}")"
+printf '%-28s %10s %9.2fx\n' "2-thread speed-up" "gravsweep" "$(awk "BEGIN {print $mg1 / $mg2}")"
+printf '%-28s %10s %9.2fx\n' "" "LAMMPS" "$(awk "BEGIN {print $ml1 / $ml2}")"
+echo "gravsweep's last round, 2 threads: $(awk '$1 == "file" {printf "force region %s %% of the step, barrier waits %s %% of its thread-time", $8, $9}' "$work/gravsweep.2.out")"
+grep '^host' "$work/gravsweep.2.out" || true

@@ -57,6 +57,7 @@ struct ForceContext {
   /// after the force sums (one parallel region a step), its findings merged into *check.
   const Integrator* finish = nullptr;
   StepCheck* check = nullptr;
+  RegionTiming* timing = nullptr;  ///< System::set_region_timing: where the region's time goes
   // Outputs.
   StepStats stats{};
   OverlapFailure failure{};
@@ -379,6 +380,7 @@ inline std::size_t first_row(const VerletList& list, std::size_t n, int k, int n
 struct alignas(64) ThreadTally {
   long long contacts = 0, wall_contacts = 0;
   double energy_J = 0;
+  double busy_s = 0;  ///< thread-seconds of work (ForceContext::timing set)
   OverlapFailure worst;
   StepFindings found;
 };
@@ -411,12 +413,17 @@ void force_loop(ForceContext& c) {
   // One tally per thread, combined in thread order after the region (no lock in the region). A
   // team smaller than asked leaves tallies untouched: zeros, which add nothing to the combination.
   std::vector<ThreadTally> tally(static_cast<std::size_t>(std::max(1, c.threads)));
+  const bool timed = c.timing != nullptr;
+  const double region_start_s = timed ? omp_get_wtime() : 0;
+  int team = 1;
 
 #pragma omp parallel num_threads(c.threads)
   {
     const int t = omp_get_thread_num();
     const int nt = omp_get_num_threads();
     ThreadTally& mine = tally[static_cast<std::size_t>(t)];
+    const double work_start_s = timed ? omp_get_wtime() : 0;
+    if (t == 0) team = nt;
     thread_local std::vector<std::size_t> first;  // first row of each thread, and n
     first.resize(static_cast<std::size_t>(nt) + 1);
     for (int k = 0; k <= nt; ++k) first[static_cast<std::size_t>(k)] = first_row(c.nlist, n, k, nt);
@@ -444,10 +451,12 @@ void force_loop(ForceContext& c) {
         pair_loop_scalar<Law, Rolling, false>(c, rows, F, T, mine.contacts, mine.energy_J, mine.worst);
     }
     wall_loop<Law, Rolling>(c, rows, F, T, mine.wall_contacts, mine.energy_J, mine.worst);
-    // Sum the thread buffers in a fixed order and add gravity (same parallel region), each thread
-    // on an even share of the particles; then finish the step on that same share (no barrier:
-    // a particle's update reads only its own sums).
+    if (timed) mine.busy_s = omp_get_wtime() - work_start_s;
+      // Sum the thread buffers in a fixed order and add gravity (same parallel region), each thread
+      // on an even share of the particles; then finish the step on that same share (no barrier:
+      // a particle's update reads only its own sums).
 #pragma omp barrier
+    const double sums_start_s = timed ? omp_get_wtime() : 0;
     const auto [lo, hi] = even_share(n, t, nt);
     StepFindings& found = mine.found;
     for (std::size_t b = lo; b < hi; b += kFinishBlock) {
@@ -466,6 +475,13 @@ void force_loop(ForceContext& c) {
       // The block's sums are still in L1 when the integrator reads them back.
       if (c.finish != nullptr) c.finish->end_range(p, c.dt_s, *c.check, b, e, found);
     }
+    if (timed) mine.busy_s += omp_get_wtime() - sums_start_s;
+  }
+  if (timed) {
+    c.timing->wall_s += omp_get_wtime() - region_start_s;
+    for (const ThreadTally& x : tally) c.timing->busy_s += x.busy_s;
+    c.timing->threads = team;
+    ++c.timing->regions;
   }
   c.stats = StepStats{};
   for (const ThreadTally& x : tally) {

@@ -210,7 +210,8 @@ void System::force_pass(bool displacement_checked, StepCheck* finish) {
                    threads(),
                    config_.pair_filter_min_pairs,
                    finish != nullptr ? integrator_.get() : nullptr,
-                   finish};
+                   finish,
+                   region_timing_};
   force_fn_(ctx);
   stats_ = ctx.stats;
   have_forces_ = true;

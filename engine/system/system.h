@@ -113,6 +113,9 @@ class System {
   /// twice the fastest particle's speed instead (max_particle_speed_m_s).
   [[nodiscard]] double max_approach_speed_m_s(double interval_s) const;
   [[nodiscard]] const StepStats& stats() const { return stats_; }
+  /// Adds the force regions' timing to *timing from now on (nullptr: stops; the default). For
+  /// benchmarks: two clock reads per thread and region.
+  void set_region_timing(RegionTiming* timing) { region_timing_ = timing; }
   [[nodiscard]] const PairTable& pair_table() const { return pairs_; }
   [[nodiscard]] const VerletList& neighbor_list() const { return nlist_; }
   [[nodiscard]] int threads() const;
@@ -143,6 +146,7 @@ class System {
   std::vector<std::vector<Vec3>> thread_force_, thread_torque_;
   std::vector<int> contact_count_;
   StepStats stats_;
+  RegionTiming* region_timing_ = nullptr;
   double time_s_ = 0;
   long long step_ = 0;
   bool initialized_ = false;

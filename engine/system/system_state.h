@@ -19,6 +19,19 @@ struct Domain {
   Vec3 lo_m, hi_m;
 };
 
+/// Where the threads' time in the force region goes, summed over the regions run while a
+/// System::set_region_timing target is set (`gravsweep bench`): the region's wall time, the
+/// thread-seconds of work in it (pair and wall loops, then the sums and the end of step), and the
+/// team size. 1 - busy_s / (threads * wall_s) is the share spent waiting at its barriers (the
+/// one between the loops and the sums, and the region's end) and forking the team.
+struct RegionTiming {
+  double wall_s = 0;
+  double busy_s = 0;
+  int threads = 0;
+  long long regions = 0;
+  [[nodiscard]] double wait_share() const { return wall_s > 0 ? 1 - busy_s / (threads * wall_s) : 0; }
+};
+
 /// Per-step counters from the force evaluation.
 struct StepStats {
   long long contacts = 0;       ///< touching particle-particle pairs

@@ -12,6 +12,7 @@
 #include "scheduler/cli/exit_codes.h"
 #include "scheduler/cli/verbs.h"
 #include "scheduler/pipeline/build_version.h"
+#include "scheduler/pipeline/job_kinds.h"
 
 namespace {
 
@@ -52,6 +53,7 @@ int main(int argc, char** argv) {
       "Run `gravsweep <verb> --help` for each verb, with an example.",
       "gravsweep"};
   app.require_subcommand(1);
+  pipeline::register_job_kinds();  // the sweep kinds (a spec's "job") and their runners
   app.set_version_flag("--version", std::string(pipeline::build_version()));
   for (SetupFn setup : kVerbs) setup(app);
   try {

@@ -16,6 +16,7 @@
 #include "results/io/bed_file.h"
 #include "scheduler/pipeline/impact_job.h"
 #include "scheduler/cli/bench_checkpoint.h"
+#include "scheduler/cli/bench_host.h"
 #include "scheduler/cli/progress.h"
 #include "scheduler/cli/verbs.h"
 
@@ -47,6 +48,8 @@ struct BenchRow {
   double contacts_per_particle;
   double bytes_per_particle;
   double neighbour_builds;
+  double force_region_share;  ///< of the timed wall time, in the force region (pairs, walls, sums, end of step)
+  double wait_share;          ///< of the force region's thread-time, waiting at its barriers (RegionTiming)
 };
 
 /// Times `steps` steps of a copy of the bed with `threads` threads.
@@ -61,12 +64,15 @@ BenchRow time_bed(const System& bed, const std::string& label, const BenchOption
   sys.advance(50);  // warm-up: caches, first neighbour list
   const long long builds0 = sys.neighbor_list().builds();
   double contacts = 0;
+  RegionTiming timing;
+  sys.set_region_timing(&timing);
   const auto t0 = std::chrono::steady_clock::now();
   for (int s = 0; s < o.steps; ++s) {
     sys.step();
     contacts += static_cast<double>(2 * sys.stats().contacts + sys.stats().wall_contacts);
   }
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  sys.set_region_timing(nullptr);
   const double n = static_cast<double>(sys.particles.size());
   if (!o.checkpoint_dir.empty() && threads == o.threads.front())
     print_checkpoint_cost(sys, o.checkpoint_dir, o.checkpoint_samples);
@@ -76,7 +82,9 @@ BenchRow time_bed(const System& bed, const std::string& label, const BenchOption
                   1e9 * secs / (n * o.steps),
                   contacts / (o.steps * n),  // each pair counts for both grains, a wall contact for one
                   sys.bytes_per_particle(),
-                  static_cast<double>(sys.neighbor_list().builds() - builds0)};
+                  static_cast<double>(sys.neighbor_list().builds() - builds0),
+                  timing.wall_s / secs,
+                  timing.wait_share()};
 }
 
 std::unique_ptr<System> make_bed(double container_diameter_m, const BenchOptions& o, ProgressBar& bar,
@@ -143,6 +151,7 @@ std::unique_ptr<System> make_tiled_bed(const System& base, double target, const 
 }
 
 void run_bench(const BenchOptions& o) {
+  const HostReport host = measure_host(o.threads);  // before the beds: the timed runs follow it
   ProgressBar bar;
   std::vector<BenchRow> rows;
   std::unique_ptr<System> base;
@@ -167,11 +176,17 @@ void run_bench(const BenchOptions& o) {
       for (int t : o.threads) rows.push_back(time_bed(*wide, label, o, t));
     }
   }
-  fmt::print("\n{:<18} {:>9} {:>8} {:>22} {:>22} {:>20} {:>16}\n", "bed", "grains", "threads", "ns_per_particle_step",
-             "contacts_per_particle", "bytes_per_particle", "nlist_rebuilds");
+  fmt::print("\n{:<18} {:>9} {:>8} {:>22} {:>22} {:>20} {:>16} {:>18} {:>18}\n", "bed", "grains", "threads",
+             "ns_per_particle_step", "contacts_per_particle", "bytes_per_particle", "nlist_rebuilds",
+             "force_region_pct", "barrier_wait_pct");
   for (const auto& r : rows)
-    fmt::print("{:<18} {:>9} {:>8} {:>22.1f} {:>22.2f} {:>20.0f} {:>16.0f}\n", r.bed, r.grains, r.threads,
-               r.ns_per_particle_step, r.contacts_per_particle, r.bytes_per_particle, r.neighbour_builds);
+    fmt::print("{:<18} {:>9} {:>8} {:>22.1f} {:>22.2f} {:>20.0f} {:>16.0f} {:>18.1f} {:>18.1f}\n", r.bed, r.grains,
+               r.threads, r.ns_per_particle_step, r.contacts_per_particle, r.bytes_per_particle, r.neighbour_builds,
+               100 * r.force_region_share, 100 * r.wait_share);
+  print_host(host);
+  fmt::print(
+      "force_region_pct: the step's wall time in the force region (pair and wall loops, force sums, end of step);\n"
+      "barrier_wait_pct: the force region's thread-time spent waiting at its barriers or forking the team.\n");
   fmt::print("\n{} steps at dt = {} s, Table 1 Chrono set (hertz + sunday rolling, mu_r = 0.09).\n", o.steps, o.dt_s);
   // The barrier wait of the threads moves the 2-thread figure by 10 % (main.cpp, BENCHMARKS.md).
   const char* policy = std::getenv("OMP_WAIT_POLICY");
@@ -189,9 +204,12 @@ void setup_bench(CLI::App& app) {
       "Time the engine on the paper's bed: prepares a settled bed (31.5 cm cylinder, grains\n"
       "1 +/- 0.05 cm, 10 cm fill, about 8,000 grains, Table 1 Chrono parameters), then times\n"
       "--steps steps at dt = 1 us with each thread count and prints ns per particle-step,\n"
-      "contacts per particle and bytes per particle.\n\n"
+      "contacts per particle, bytes per particle, the share of the step in the force region and\n"
+      "the share of that region's thread-time spent waiting at barriers; then the host: CPU\n"
+      "model, hardware threads, load and the memory bandwidth of a STREAM-like triad with each\n"
+      "thread count (measured first, about a second).\n\n"
       "Example:\n"
-      "  gravsweep bench --threads 1,2              # the issue's figures\n"
+      "  gravsweep bench --threads 1,2              # 1 and 2 threads on the paper's bed\n"
       "  gravsweep bench --bed runs/1g/bed.h5       # time a bed prepared by `gravsweep run`\n"
       "  gravsweep bench --scaling --steps 300      # also about 64,000 and 512,000 grains\n"
       "  gravsweep bench --bed BED --threads 1 --checkpoint-dir /shared/x  # a drop checkpoint's cost\n\n"

@@ -78,7 +78,7 @@ double make_campaign(const std::string& db_path, long n) {
       {"base", {{"i", 0}}},
       {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"range", {{"start", 0}, {"stop", n - 1}, {"step", 1}}}}}}};
   const auto spec = sweep::parse_spec(doc, "<bench-queue>", ".");
-  const auto jobs = sweep::expand(spec, {});
+  const auto jobs = sweep::expand(spec);
   const auto t0 = Clock::now();
   db::Database db(db_path);
   queue::ensure_schema(db);

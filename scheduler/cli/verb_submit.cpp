@@ -13,13 +13,14 @@
 #include "scheduler/cli/progress.h"
 #include "scheduler/cli/campaign_options.h"
 #include "scheduler/cli/verbs.h"
-#include "scheduler/pipeline/impact_runners.h"
+#include "scheduler/pipeline/scenario_defaults.h"
 #include "scheduler/pipeline/scenario_spec.h"
 #include "scheduler/queue/campaign.h"
 #include "db/where.h"
 #include "scheduler/queue/queue.h"
 #include "scheduler/sweep/impact_kinds.h"
 #include "scheduler/sweep/spec.h"
+#include "scheduler/sweep/sweep_kind.h"
 
 namespace gravsweep::cli {
 
@@ -33,31 +34,40 @@ struct SubmitOptions {
   bool dry_run = false;
 };
 
-/// `--where` on the swept parameters: drops (or noop jobs) that fail a condition are not
-/// submitted, nor any bed that no kept drop needs. Returns how many points were left out.
+/// The jobs other planned jobs wait for (an impact sweep's beds): shared by points, not points.
+std::set<std::string> shared_jobs(const std::vector<queue::PlannedJob>& jobs) {
+  std::set<std::string> ids;
+  for (const auto& j : jobs) ids.insert(j.deps.begin(), j.deps.end());
+  return ids;
+}
+
+/// `--where` on the swept parameters: the points' jobs (drops, noop jobs) that fail a condition are
+/// not submitted, nor any shared job (a bed) that no kept job needs. Returns how many points were
+/// left out.
 std::size_t keep_matching(const std::string& path, std::vector<queue::PlannedJob>& jobs,
                           const std::vector<std::string>& where) {
   if (where.empty()) return 0;
+  const std::set<std::string> shared = shared_jobs(jobs);
   std::vector<queue::PlannedJob> kept;
-  std::set<std::string> beds_needed;
+  std::set<std::string> shared_needed;
   std::size_t left_out = 0;
   try {
     for (const auto& w : where) db::parse_where(w);
     for (auto& j : jobs) {
-      if (j.kind == sweep::bed_kind()) continue;
+      if (shared.count(j.job_id)) continue;
       if (!db::row_matches(j.params, where)) {
         ++left_out;
         continue;
       }
-      beds_needed.insert(j.deps.begin(), j.deps.end());
+      shared_needed.insert(j.deps.begin(), j.deps.end());
       kept.push_back(std::move(j));
     }
   } catch (const std::invalid_argument& e) {
     throw UsageError(fmt::format("{}: {} (the sweep's axis columns)", path, e.what()));
   }
   std::vector<queue::PlannedJob> out;
-  for (auto& j : jobs)  // beds first, in their planned order, as expand() gives them
-    if (j.kind == sweep::bed_kind() && beds_needed.count(j.job_id)) out.push_back(std::move(j));
+  for (auto& j : jobs)  // shared jobs first, in their planned order, as expand() gives them
+    if (shared.count(j.job_id) && shared_needed.count(j.job_id)) out.push_back(std::move(j));
   for (auto& j : kept) out.push_back(std::move(j));
   jobs = std::move(out);
   return left_out;
@@ -72,7 +82,7 @@ std::vector<queue::PlannedJob> expand_with_progress(const sweep::SweepSpec& spec
     std::fprintf(stderr, "sweep %s: expanding and validating %zu points (about %.2g GB and %s estimated)\n",
                  spec.name.c_str(), spec.points(), c.memory_bytes / 1e9, format_duration(c.seconds).c_str());
   }
-  auto jobs = sweep::expand(spec, pipeline::impact_point_check(), [&](std::size_t done, std::size_t total) {
+  auto jobs = sweep::expand(spec, [&](std::size_t done, std::size_t total) {
     bar.update("expand", static_cast<double>(done) / static_cast<double>(total),
                fmt::format("{} of {} points validated", done, total));
   });
@@ -86,11 +96,34 @@ struct Planned {
   std::vector<queue::PlannedJob> jobs;
 };
 
-/// "B bed, N drop" (or noop): the planned jobs by kind, as `submit` prints them.
+/// Says how many of the sweep's jobs run differently under the current defaults version than a
+/// submit before versions existed would have run them (their stored point names its version only
+/// then: pipeline/scenario_defaults.h), and how to keep the old defaults and ids.
+void note_versioned_defaults(const Planned& p) {
+  const std::set<std::string> shared = shared_jobs(p.jobs);
+  const auto n = std::count_if(p.jobs.begin(), p.jobs.end(), [&](const queue::PlannedJob& j) {
+    return !shared.count(j.job_id) && j.scenario_json.find("\"defaults_version\"") != std::string::npos;
+  });
+  if (n == 0) return;
+  fmt::print(
+      "sweep {}: {} job{} take the adaptive step of defaults version {} (0.001-0.1 m/s2 without /time_step; "
+      "docs/queue.md, \"Defaults versions\"), so their ids differ from a submit of this spec by a build before it; "
+      "\"defaults_version\": 1 in the base keeps the fixed step and those ids\n",
+      p.spec.name, n, n == 1 ? "" : "s", pipeline::kCurrentDefaultsVersion);
+}
+
+/// "2 bed, 12 drop" (or "12 noop"): the planned jobs by kind, in planned order, as `submit` prints them.
 std::string jobs_by_kind(const Planned& p) {
-  const auto beds = static_cast<std::size_t>(
-      std::count_if(p.jobs.begin(), p.jobs.end(), [](const auto& j) { return j.kind == sweep::bed_kind(); }));
-  return fmt::format("{} bed, {} {}", beds, p.jobs.size() - beds, p.spec.job_kind == "noop" ? "noop" : "drop");
+  std::vector<std::pair<queue::JobKind, std::size_t>> counts;
+  for (const auto& j : p.jobs) {
+    auto it = std::find_if(counts.begin(), counts.end(), [&](const auto& c) { return c.first == j.kind; });
+    if (it == counts.end()) it = counts.insert(counts.end(), {j.kind, 0});
+    ++it->second;
+  }
+  std::string out;
+  for (const auto& [kind, n] : counts)
+    out += fmt::format("{}{} {}", out.empty() ? "" : ", ", n, queue::kind_name(kind));
+  return out.empty() ? "no jobs" : out;
 }
 
 /// The dry run's memory line: the largest estimate (pipeline::job_memory_bytes) of the sweep's bed
@@ -119,6 +152,7 @@ void run_submit(const SubmitOptions& o) {
       p.jobs = expand_with_progress(p.spec);
       if (const std::size_t n = keep_matching(path, p.jobs, o.where))
         fmt::print("sweep {}: --where leaves out {} of {} points\n", p.spec.name, n, p.spec.points());
+      note_versioned_defaults(p);
       planned.push_back(std::move(p));
     } catch (const sweep::SpecError& e) {
       throw UsageError(e.what());
@@ -143,6 +177,13 @@ void run_submit(const SubmitOptions& o) {
 
 }  // namespace
 
+/// The registered job kinds, one line each ("job" of a sweep spec: what it plans).
+std::string kinds_help() {
+  std::string out = "Job kinds (a spec's \"job\"):\n";
+  for (const sweep::SweepKind* k : sweep::sweep_kinds()) out += fmt::format("  {:<8} {}\n", k->name, k->summary);
+  return out;
+}
+
 void setup_submit(CLI::App& app) {
   auto opt = std::make_shared<SubmitOptions>();
   auto* sub = app.add_subcommand(
@@ -153,13 +194,15 @@ void setup_submit(CLI::App& app) {
       "depend on one bed-preparation job. A malformed spec is refused (exit 2) with the JSON pointer,\n"
       "the value found and the type expected, and nothing is written. A sweep of 20,000 points or more\n"
       "shows its expansion's progress with an ETA on stderr; one whose expansion would need more than\n"
-      "half this machine's memory or 30 minutes is refused (exit 2) with both estimates: split it.\n\n"
-      "Examples:\n"
-      "  gravsweep submit examples/sweep_tiny.json --db campaign.db\n"
-      "  gravsweep submit a.json b.json --db campaign.db      # a campaign may hold several sweeps\n"
-      "  gravsweep submit spec.json --dry-run                 # validate and count, write nothing\n"
-      "  gravsweep submit spec.json --where 'projectile_seed>=2' --db campaign.db\n"
-      "                                  # only part of the sweep (its axis columns; beds it needs)");
+      "half this machine's memory or 30 minutes is refused (exit 2) with both estimates: split it.\n"
+      "A new scenario takes the current defaults version (docs/queue.md, \"Defaults versions\").\n\n" +
+          kinds_help() +
+          "\nExamples:\n"
+          "  gravsweep submit examples/sweep_tiny.json --db campaign.db\n"
+          "  gravsweep submit a.json b.json --db campaign.db      # a campaign may hold several sweeps\n"
+          "  gravsweep submit spec.json --dry-run                 # validate and count, write nothing\n"
+          "  gravsweep submit spec.json --where 'projectile_seed>=2' --db campaign.db\n"
+          "                                  # only part of the sweep (its axis columns; beds it needs)");
   sub->add_option("specs", opt->specs, "sweep spec files (JSON)")->required()->check(CLI::ExistingFile);
   add_campaign_options(sub, opt->db, &opt->files, "campaign database (created if missing)");
   sub->add_option("--where", opt->where,

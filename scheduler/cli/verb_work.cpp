@@ -20,7 +20,7 @@
 #include "scheduler/pipeline/job_checkpoint.h"
 #include "scheduler/sweep/spec.h"
 #include "scheduler/queue/stop.h"
-#include "scheduler/pipeline/impact_runners.h"
+#include "scheduler/sweep/sweep_kind.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
 #include "scheduler/queue/spawn.h"
@@ -218,7 +218,7 @@ int run_work(const WorkOptions& o) {
   w.checkpoint_interval_s = o.checkpoint_interval_s;
   w.max_memory_bytes =
       o.max_memory_mb > 0 ? o.max_memory_mb * 1024 * 1024 : kDefaultMemoryShare * sweep::machine_memory_bytes();
-  const auto rep = queue::run_worker(w, pipeline::all_runners());
+  const auto rep = queue::run_worker(w, sweep::registered_runners());
   if (!o.quiet)
     fmt::print(stderr,
                "worker {}: {} done, {} failed (will retry), {} dead, {} released, {} fenced out, {} expired leases "

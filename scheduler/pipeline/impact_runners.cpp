@@ -5,6 +5,7 @@
 #include "engine/core/error.h"
 #include "scheduler/pipeline/bed_cache.h"
 #include "scheduler/pipeline/impact_job.h"
+#include "scheduler/pipeline/scenario_defaults.h"
 #include "scheduler/pipeline/scenario_spec.h"
 #include "scheduler/queue/stop.h"
 #include "scheduler/sweep/impact_kinds.h"
@@ -49,55 +50,65 @@ void check_memory(const RunContext& ctx) {
 }  // namespace
 
 sweep::PointCheckFn impact_point_check() {
-  return [](const nlohmann::json& scenario) {
-    nlohmann::json validated = validate_scenario(scenario);
+  return [](const nlohmann::json& point) {
+    nlohmann::json validated = validate_scenario(with_current_defaults(point));  // a new spec: today's defaults
     nlohmann::json key = bed_key_of_validated(validated);
-    return sweep::CheckedPoint{stored_scenario(std::move(validated), scenario).dump(), std::move(key)};
+    // The point as the job keeps it names its defaults version only where the version changes
+    // what it runs: a worker of an older build then runs every other job as before.
+    nlohmann::json as_written = id_point(with_current_defaults(point), validated);
+    if (!as_written.contains("defaults_version")) validated.erase("defaults_version");
+    std::string stored = stored_scenario(std::move(validated), as_written).dump();
+    return sweep::CheckedPoint{std::move(stored), std::move(key), std::move(as_written)};
   };
 }
 
-void add_impact_runners(RunnerTable& table) {
-  table[sweep::bed_kind()] = [](const RunContext& ctx) {
-    check_memory(ctx);
-    RunOutput out;
-    if (!ctx.bed_cache.empty()) {
-      if (auto cached = take_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.claim.scenario, ctx.output_tmp)) {
-        out.report = *cached;
-        return out;
-      }
+namespace {
+
+RunOutput run_bed(const RunContext& ctx) {
+  check_memory(ctx);
+  RunOutput out;
+  if (!ctx.bed_cache.empty()) {
+    if (auto cached = take_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.claim.scenario, ctx.output_tmp)) {
+      out.report = *cached;
+      return out;
     }
-    auto r =
-        run_bed_job(ctx.claim.scenario, ctx.output_tmp, ctx.threads, ctx.progress, ctx.stop, checkpointing_of(ctx));
-    if (r.bed_path != ctx.output_tmp && !r.bed_path.empty()) std::filesystem::rename(r.bed_path, ctx.output_tmp);
-    if (!ctx.bed_cache.empty()) store_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.output_tmp);
-    out.report = r.report;
-    return out;
-  };
-  table[sweep::drop_kind()] = [](const RunContext& ctx) {
-    if (ctx.dependency_output.empty())
-      throw std::runtime_error(fmt::format("drop job {} has no prepared bed", ctx.claim.job_id));
-    check_memory(ctx);
-    auto r = run_drop_job(ctx.claim.scenario, ctx.dependency_output, ctx.output_tmp, ctx.threads, ctx.progress,
-                          ctx.stop, checkpointing_of(ctx));
-    if (r.trace_path != ctx.output_tmp && !r.trace_path.empty()) std::filesystem::rename(r.trace_path, ctx.output_tmp);
-    if (!r.snapshot_path.empty()) {
-      // Grain snapshots (/output/snapshot_interval_s > 0): <campaign>.files/snapshots/, a folder that
-      // `resume` leaves alone (they are for viewing; no job refers to them).
-      const auto dir = ctx.output_tmp.parent_path().parent_path() / "snapshots";
-      std::filesystem::create_directories(dir);
-      for (const auto& f : {r.snapshot_path, r.snapshot_xdmf}) std::filesystem::rename(f, dir / f.filename());
-    }
-    RunOutput out;
-    out.metrics = r.metrics;
-    return out;
-  };
+  }
+  auto r = run_bed_job(ctx.claim.scenario, ctx.output_tmp, ctx.threads, ctx.progress, ctx.stop, checkpointing_of(ctx));
+  if (r.bed_path != ctx.output_tmp && !r.bed_path.empty()) std::filesystem::rename(r.bed_path, ctx.output_tmp);
+  if (!ctx.bed_cache.empty()) store_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.output_tmp);
+  out.report = r.report;
+  return out;
 }
 
-RunnerTable all_runners() {
-  RunnerTable t;
-  t[queue::noop_kind()] = queue::noop_runner();
-  add_impact_runners(t);
-  return t;
+RunOutput run_drop(const RunContext& ctx) {
+  if (ctx.dependency_output.empty())
+    throw std::runtime_error(fmt::format("drop job {} has no prepared bed", ctx.claim.job_id));
+  check_memory(ctx);
+  auto r = run_drop_job(ctx.claim.scenario, ctx.dependency_output, ctx.output_tmp, ctx.threads, ctx.progress, ctx.stop,
+                        checkpointing_of(ctx));
+  if (r.trace_path != ctx.output_tmp && !r.trace_path.empty()) std::filesystem::rename(r.trace_path, ctx.output_tmp);
+  if (!r.snapshot_path.empty()) {
+    // Grain snapshots (/output/snapshot_interval_s > 0): <campaign>.files/snapshots/, a folder that
+    // `resume` leaves alone (they are for viewing; no job refers to them).
+    const auto dir = ctx.output_tmp.parent_path().parent_path() / "snapshots";
+    std::filesystem::create_directories(dir);
+    for (const auto& f : {r.snapshot_path, r.snapshot_xdmf}) std::filesystem::rename(f, dir / f.filename());
+  }
+  RunOutput out;
+  out.metrics = r.metrics;
+  return out;
+}
+
+}  // namespace
+
+sweep::SweepKind impact_sweep_kind() {
+  sweep::SweepKind k;
+  k.name = "impact";
+  k.summary = "a drop per point on the engine, waiting for a prepared bed per bed key";
+  k.check_base = sweep::base_checker(impact_point_check());
+  k.plan_point = sweep::shared_input_planner(impact_point_check(), sweep::drop_kind(), sweep::bed_kind());
+  k.runners = {{sweep::bed_kind(), run_bed}, {sweep::drop_kind(), run_drop}};
+  return k;
 }
 
 }  // namespace gravsweep::pipeline

@@ -22,6 +22,7 @@
 #include "spec/schemas.h"
 #include "spec/sha256.h"
 #include "scheduler/pipeline/build_version.h"
+#include "scheduler/pipeline/scenario_defaults.h"
 
 // Typed JSON (nlohmann's from_json, found by argument-dependent lookup) for the engine's material
 // types, read from a scenario the schema has validated (schemas/scenario.schema.json: /materials,
@@ -382,7 +383,8 @@ json validate_scenario(const json& scenario, const std::string& source) {
   json s = scenario;
   spec::Problems problems;
   spec::validator(spec::Schema::scenario).collect(s, problems.list());  // types, ranges, unknown and missing fields
-  Checks ck(s, problems);  // then the rules across fields, on the sound fields
+  fill_versioned_defaults(s);  // the defaults of the scenario's version that depend on other fields
+  Checks ck(s, problems);      // then the rules across fields, on the sound fields
   check_names(ck);
   check_geometry(ck);
   check_size_and_steps(ck);
@@ -423,7 +425,7 @@ json job_scenario(const json& stored) {
 }
 
 json load_scenario(const std::filesystem::path& path) {
-  return validate_scenario(spec::read_spec_file(path, spec::Schema::scenario), path.string());
+  return validate_scenario(with_current_defaults(spec::read_spec_file(path, spec::Schema::scenario)), path.string());
 }
 
 std::uint64_t site_seed(const json& s) {

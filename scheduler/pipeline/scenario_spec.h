@@ -61,7 +61,8 @@ double job_memory_bytes(const nlohmann::json& validated);
 /// times) in this process: once per distinct set of the fields they read, not once per scenario.
 std::size_t engine_check_runs();
 
-/// Reads a scenario file (JSON) and validates it; parse errors name the file, line and column.
+/// Reads a scenario file (JSON) and validates it; parse errors name the file, line and column. A
+/// file that names no /defaults_version takes the current defaults (scenario_defaults.h).
 nlohmann::json load_scenario(const std::filesystem::path& path);
 
 /// The drop's stop criterion from a validated /stop: each quantity absolute when given, else in

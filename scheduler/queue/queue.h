@@ -68,7 +68,7 @@ struct SubmitReport {
 /// one from a spec (sweep::record).
 struct SweepRecord {
   std::string name;       ///< unique within a campaign
-  std::string job_kind;   ///< "impact" or "noop"
+  std::string job_kind;   ///< the sweep kind's name (sweep/sweep_kind.h: "impact", "noop", ...)
   nlohmann::json source;  ///< the spec as read, stored canonical and hashed
   int max_attempts = 3;
   /// Each swept parameter's results column and every value it takes (the column's SQL type fits them all).

@@ -191,65 +191,6 @@ void remove_tmp_of(const fs::path& tmp_dir, const std::string& prefix) {
 
 }  // namespace
 
-void fsync_path(const fs::path& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY);
-  if (fd < 0) return;
-  ::fsync(fd);
-  ::close(fd);
-}
-
-void write_file_synced(const fs::path& path, const std::string& text) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  if (fd < 0) throw std::runtime_error(fmt::format("cannot create '{}': {}", path.string(), std::strerror(errno)));
-  std::size_t off = 0;
-  while (off < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + off, text.size() - off);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const int err = errno;
-      ::close(fd);
-      throw std::runtime_error(fmt::format("cannot write '{}': {}", path.string(), std::strerror(err)));
-    }
-    off += static_cast<std::size_t>(n);
-  }
-  // A full disk may show only here (delayed allocation): the data is not safe until fsync says so.
-  if (::fsync(fd) != 0) {
-    const int err = errno;
-    ::close(fd);
-    throw std::runtime_error(fmt::format("cannot write '{}' (fsync): {}", path.string(), std::strerror(err)));
-  }
-  if (::close(fd) != 0)
-    throw std::runtime_error(fmt::format("cannot write '{}' (close): {}", path.string(), std::strerror(errno)));
-}
-
-Runner noop_runner() {
-  return [](const RunContext& ctx) {
-    const json& s = ctx.claim.scenario;
-    const double sleep_s = s.value("sleep_s", 0.0);
-    const int fail_attempts = s.value("fail_attempts", 0);
-    ctx.progress("noop", 0.0, "");
-    if (sleep_s > 0) {
-      const auto t0 = std::chrono::steady_clock::now();
-      for (;;) {
-        const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        if (el >= sleep_s) break;
-        if (ctx.stop && ctx.stop->load()) throw std::runtime_error("noop job stopped");
-        ctx.progress("noop", el / sleep_s, fmt::format("{:.2f}/{:.2f} s", el, sleep_s));
-        std::this_thread::sleep_for(std::chrono::milliseconds(10));
-      }
-    }
-    if (ctx.claim.attempt <= fail_attempts)
-      throw std::runtime_error(
-          fmt::format("noop job asked to fail on attempt {} (fail_attempts={})", ctx.claim.attempt, fail_attempts));
-    // A write error (a full disk, no file descriptor left) fails the attempt with its errno.
-    write_file_synced(ctx.output_tmp, json{{"job_id", ctx.claim.job_id}, {"attempt", ctx.claim.attempt}}.dump());
-    RunOutput out;
-    out.metrics["noop_value"] = s.contains("value") ? s["value"] : json(0);
-    out.metrics["sleep_s"] = sleep_s;
-    return out;
-  };
-}
-
 namespace {
 
 /// What one attempt of a job came to, before it is recorded.

@@ -48,10 +48,6 @@ struct RunOutput {
 using Runner = std::function<RunOutput(const RunContext&)>;
 using RunnerTable = std::map<JobKind, Runner>;
 
-/// "noop" jobs, for the scheduler's own benchmark and tests: scenario fields sleep_s (default 0),
-/// fail_attempts (attempts up to this number throw), value (echoed as metric noop_value).
-Runner noop_runner();
-
 struct WorkerOptions {
   std::filesystem::path db_path;  ///< an SQLite file or a postgresql:// URL
   std::filesystem::path files;    ///< the files root (empty: beside the SQLite file)

@@ -1,5 +1,5 @@
 #include "scheduler/sweep/spec.h"
-#include "scheduler/sweep/impact_kinds.h"
+#include "scheduler/sweep/sweep_kind.h"
 
 #include "spec/problems.h"
 
@@ -25,8 +25,9 @@ using nlohmann::json;
 //  1. schemas/sweep.schema.json (spec/schemas.h): types, names, ranges, unknown and missing
 //     fields, exactly one of values/range/count, unique values;
 //  2. below, what a schema cannot say: the base scenario file, pointers present in the base, values
-//     of the base field's type, range and repeat expansion, zip lengths, a field swept twice, the
-//     no-op job's fields. An axis the schema already found bad is not checked again.
+//     of the base field's type, range and repeat expansion, zip lengths, a field swept twice; the
+//     kind's own checks (the sweep's "job", sweep_kind.h) come at expansion. An axis the schema
+//     already found bad is not checked again.
 
 namespace {
 
@@ -44,20 +45,6 @@ bool is_int(const json& v) {
 }
 
 using spec::Problems;
-
-/// Problems of a no-op job's scenario: (pointer, found, expected). sleep_s and fail_attempts are
-/// what the no-op runner reads; anything else is carried along (an axis may sweep any field).
-std::vector<SpecProblem> noop_problems(const json& s, const std::string& ptr) {
-  std::vector<SpecProblem> out;
-  if (!s.is_object()) return {{ptr, show(s), "an object (the no-op job's scenario)"}};
-  if (s.contains("sleep_s") &&
-      (!s["sleep_s"].is_number() || !(s["sleep_s"].get<double>() >= 0) || s["sleep_s"].get<double>() > 86400))
-    out.push_back({join(ptr, "sleep_s"), show(s["sleep_s"]), "a number of seconds between 0 and 86400"});
-  if (s.contains("fail_attempts") &&
-      (!is_int(s["fail_attempts"]) || s["fail_attempts"].get<double>() < 0 || s["fail_attempts"].get<double>() > 100))
-    out.push_back({join(ptr, "fail_attempts"), show(s["fail_attempts"]), "an integer between 0 and 100"});
-  return out;
-}
 
 /// The kind a swept value must share with the base field: its JSON type, numbers all alike (10 and
 /// 9.81 are both numbers).
@@ -344,8 +331,6 @@ SweepSpec parse_spec(const json& doc_in, const std::string& file, const std::fil
   if (base) {
     try {
       spec.base = queue::canonicalize(*base);
-      if (spec.job_kind == "noop")
-        for (auto& p : noop_problems(spec.base, "/base")) ck.list().push_back(std::move(p));
     } catch (const queue::CanonicalError& e) {
       ck.add_text("/base", e.what(), "finite numbers only");
       base.reset();
@@ -367,37 +352,6 @@ SweepSpec load_spec(const std::filesystem::path& path) {
 
 namespace {
 
-/// The problems of a sweep's points, one per field and reason (at most kMaxListed), each
-/// counting the other points that have it.
-class PointProblems {
- public:
-  static constexpr std::size_t kMaxListed = 20;
-  /// A problem of the point `params`; `same` finds an earlier one it repeats.
-  template <class Same>
-  void add(SpecProblem p, const json& params, const Same& same) {
-    const auto it = std::find_if(problems_.begin(), problems_.end(), same);
-    if (it != problems_.end()) {
-      ++repeats_[static_cast<std::size_t>(it - problems_.begin())];
-    } else if (problems_.size() < kMaxListed) {
-      p.found += " at point " + params.dump();
-      problems_.push_back(std::move(p));
-      repeats_.push_back(0);
-    }
-  }
-  [[nodiscard]] bool empty() const { return problems_.empty(); }
-  void throw_if_any(const std::string& file) {
-    for (std::size_t i = 0; i < problems_.size(); ++i)
-      if (repeats_[i] > 0)
-        problems_[i].found +=
-            fmt::format(" (and {} more point{} with this problem)", repeats_[i], repeats_[i] == 1 ? "" : "s");
-    if (!problems_.empty()) throw SpecError::sweep_spec(file, problems_);
-  }
-
- private:
-  std::vector<SpecProblem> problems_;
-  std::vector<std::size_t> repeats_;
-};
-
 /// The scenario of point p as written (the base with its swept values: its mixed-radix digits,
 /// last group fastest) into `scenario`, and its job with the swept values.
 queue::PlannedJob point_job(const SweepSpec& spec, std::size_t p, json& scenario) {
@@ -417,71 +371,6 @@ queue::PlannedJob point_job(const SweepSpec& spec, std::size_t p, json& scenario
   return job;
 }
 
-/// A problem of a base field no axis replaces is reported once, at its pointer under /base (a
-/// swept field is checked at each point instead: its base value may be a placeholder).
-void check_base(const SweepSpec& spec, const PointCheckFn& check) {
-  auto swept = [&](const std::string& pointer) {
-    for (const auto& g : spec.groups)
-      for (const auto& ax : g.axes)
-        if (pointer == ax.pointer || pointer.rfind(ax.pointer + "/", 0) == 0 || ax.pointer.rfind(pointer + "/", 0) == 0)
-          return true;
-    return false;
-  };
-  std::vector<SpecProblem> problems;
-  try {
-    (void)check(spec.base);
-  } catch (const SpecError& e) {
-    for (const auto& p : e.problems())
-      if (!swept(p.pointer)) problems.push_back({"/base" + p.pointer, p.found, p.expected});
-    if (!problems.empty()) throw SpecError::sweep_spec(spec.file.empty() ? spec.name : spec.file, problems);
-  } catch (const std::exception&) {
-    // Not checkable alone (e.g. a field every axis sets): the points report it.
-  }
-}
-
-/// A drop's scenario checked; nothing (its problems added) when the point is invalid.
-std::optional<CheckedPoint> check_point(const PointCheckFn& check, const json& scenario, const queue::PlannedJob& job,
-                                        PointProblems& problems) {
-  try {
-    if (!check) throw std::runtime_error("no scenario check (the impact pipeline is not built in)");
-    return check(scenario);
-  } catch (const SpecError& e) {
-    // The base was sound, so these are problems of swept values.
-    for (const auto& sp : e.problems())
-      problems.add({"/base" + sp.pointer, sp.found, sp.expected}, job.params, [&](const SpecProblem& p) {
-        return p.pointer == "/base" + sp.pointer && p.expected == sp.expected;
-      });
-  } catch (const std::exception& e) {
-    // One problem per distinct message: a bad base field fails every point the same way.
-    const std::string expected = std::string("a valid scenario: ") + e.what();
-    problems.add({"/base", "the scenario", expected}, job.params,
-                 [&](const SpecProblem& p) { return p.expected == expected; });
-  }
-  return std::nullopt;
-}
-
-/// Adds the drop `job` to its bed (the bed job made at its first drop); parameters that differ
-/// between drops of one bed are not bed parameters (null, dropped at the end).
-void add_to_bed(const SweepSpec& spec, const json& key, queue::PlannedJob& job, std::vector<queue::PlannedJob>& beds,
-                std::map<std::string, std::size_t>& bed_index) {
-  const std::string bed_id = queue::job_id(queue::kind_name(bed_kind()), key);
-  auto [it, inserted] = bed_index.emplace(bed_id, beds.size());
-  if (inserted) {
-    queue::PlannedJob bed;
-    bed.kind = bed_kind();
-    bed.job_id = bed_id;
-    bed.scenario_json = job.scenario_json;  // any scenario with this key prepares the same bed
-    bed.params = job.params;
-    bed.priority = spec.priority + 1;  // beds first: drops wait for them
-    beds.push_back(std::move(bed));
-  } else {
-    auto& bp = beds[it->second].params;
-    for (auto pit = job.params.begin(); pit != job.params.end(); ++pit)
-      if (bp.contains(pit.key()) && bp[pit.key()] != pit.value()) bp[pit.key()] = nullptr;
-  }
-  job.deps.push_back(bed_id);
-}
-
 }  // namespace
 
 queue::SweepRecord record(const SweepSpec& spec) {
@@ -491,46 +380,26 @@ queue::SweepRecord record(const SweepSpec& spec) {
   return r;
 }
 
-std::vector<queue::PlannedJob> expand(const SweepSpec& spec, const PointCheckFn& check,
-                                      const ExpandProgress& progress) {
-  std::vector<queue::PlannedJob> beds, drops;
-  std::map<std::string, std::size_t> bed_index;
+std::vector<queue::PlannedJob> expand(const SweepSpec& spec, const SweepKind& kind, const ExpandProgress& progress) {
+  const std::string file = spec.file.empty() ? spec.name : spec.file;
+  if (kind.check_base) {
+    auto problems = kind.check_base(spec);
+    if (!problems.empty()) throw SpecError::sweep_spec(file, problems);
+  }
+  Plan plan;
   const std::size_t n = spec.points();
-  const bool noop = spec.job_kind == "noop";
-  PointProblems problems;
-  if (!noop && check) check_base(spec, check);
-  drops.reserve(n);
   for (std::size_t p = 0; p < n; ++p) {
     if (progress && p % kExpandProgressEvery == 0) progress(p, n);
     json scenario;
     queue::PlannedJob job = point_job(spec, p, scenario);
-    if (noop) {
-      for (auto& np : noop_problems(scenario, "/base"))
-        problems.add(std::move(np), job.params, [](const SpecProblem&) { return false; });
-      job.kind = queue::noop_kind();
-      job.job_id = queue::job_id(queue::kind_name(job.kind), scenario);
-      job.scenario_json = queue::canonical_json(scenario);
-      drops.push_back(std::move(job));
-      continue;
-    }
-    job.kind = drop_kind();
-    job.job_id = queue::job_id(queue::kind_name(job.kind), scenario);
-    auto checked = check_point(check, scenario, job, problems);
-    if (!checked) continue;
-    job.scenario_json = std::move(checked->scenario_json);
-    add_to_bed(spec, checked->bed_key, job, beds, bed_index);
-    drops.push_back(std::move(job));
+    kind.plan_point(spec, scenario, std::move(job), plan);
   }
   if (progress) progress(n, n);
-  problems.throw_if_any(spec.file.empty() ? spec.name : spec.file);
-  for (auto& b : beds) {  // drop the parameters that vary within the bed
-    json kept = json::object();
-    for (auto it = b.params.begin(); it != b.params.end(); ++it)
-      if (!it.value().is_null()) kept[it.key()] = it.value();
-    b.params = kept;
-  }
-  beds.insert(beds.end(), std::make_move_iterator(drops.begin()), std::make_move_iterator(drops.end()));
-  return beds;
+  return plan.finish(file);
+}
+
+std::vector<queue::PlannedJob> expand(const SweepSpec& spec, const ExpandProgress& progress) {
+  return expand(spec, sweep_kind(spec.job_kind, spec.file.empty() ? spec.name : spec.file), progress);
 }
 
 }  // namespace gravsweep::sweep

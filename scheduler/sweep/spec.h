@@ -1,12 +1,14 @@
 // Sweep specs (schemas/sweep.schema.json): a base scenario plus axes that set scenario fields
 // addressed by JSON pointer, as value lists, ranges or zipped groups, with repeats (seeds or
-// offsets). expand() turns a spec into content-addressed jobs: one `drop` job per point and one
-// `bed` job per distinct bed key, which the drops that share the bed depend on.
+// offsets). expand() turns a spec into content-addressed jobs by its kind's planner
+// (sweep_kind.h): for an impact sweep one `drop` job per point and one `bed` job per distinct bed
+// key, which the drops that share the bed depend on.
 //
 // Validation never stops at the first problem: the schema (spec/schemas.h) and then the checks
 // across fields (spec.cpp) each report every problem, and SpecError (spec::SpecError, made by
 // SpecError::sweep_spec) lists them all with the file, the JSON pointer, the value found and what
-// was expected.
+// was expected. The kind's own checks (its base check, then every point's) come at expand(), and
+// list all of theirs in the same way.
 #pragma once
 #include <nlohmann/json.hpp>
 
@@ -45,7 +47,7 @@ struct AxisGroup {
 
 struct SweepSpec {
   std::string name;                 ///< sweep name (unique within a campaign)
-  std::string job_kind = "impact";  ///< "impact" (bed + drop jobs) or "noop" (scheduler benchmark)
+  std::string job_kind = "impact";  ///< a registered SweepKind's name (sweep_kind.h): "impact", "noop", ...
   nlohmann::json base;              ///< canonical base scenario
   std::vector<AxisGroup> groups;    ///< product over groups, first group slowest; repeats last
   int max_attempts = 3;
@@ -71,6 +73,7 @@ queue::SweepRecord record(const SweepSpec& spec);
 struct CheckedPoint {
   std::string scenario_json;  ///< the text the jobs store (PlannedJob::scenario_json)
   nlohmann::json bed_key;
+  nlohmann::json id_point;  ///< what the drop's id is computed from (null: the point as written)
 };
 /// Checks a point's scenario; throws SpecError naming its problems.
 using PointCheckFn = std::function<CheckedPoint(const nlohmann::json& scenario)>;
@@ -80,12 +83,15 @@ using PointCheckFn = std::function<CheckedPoint(const nlohmann::json& scenario)>
 using ExpandProgress = std::function<void(std::size_t done, std::size_t total)>;
 inline constexpr std::size_t kExpandProgressEvery = 1000;
 
-/// Expands the spec. Bed jobs come first (in order of first use), then drops in product order.
-/// `check` is required for impact sweeps: each point is checked once, here, and its jobs store
-/// the checked scenario (their ids are those of the point's scenario as written). Errors from
-/// check (invalid scenario) become SpecError naming the point.
-std::vector<queue::PlannedJob> expand(const SweepSpec& spec, const PointCheckFn& check,
+struct SweepKind;  // sweep_kind.h
+/// Expands the spec by its kind's planner (sweep_kind.h): each point is checked once, here, and
+/// its jobs store the checked scenario. Shared jobs (an impact sweep's beds) come first, in order
+/// of first use, then the points' jobs in product order. Problems of the base or of points
+/// (invalid scenarios) throw one SpecError naming each field and point.
+std::vector<queue::PlannedJob> expand(const SweepSpec& spec, const SweepKind& kind,
                                       const ExpandProgress& progress = {});
+/// The same by the registered kind the spec names (its "job").
+std::vector<queue::PlannedJob> expand(const SweepSpec& spec, const ExpandProgress& progress = {});
 
 /// What expanding and validating a sweep takes, estimated from its points and the size of its
 /// scenario before any of it is done: memory held by its planned jobs (each point's scenario as a

@@ -12,6 +12,7 @@
 #include "scheduler/queue/queue.h"
 #include "scheduler/sweep/impact_kinds.h"
 #include "scheduler/sweep/spec.h"
+#include "scheduler/sweep/sweep_kind.h"
 #include "campaign_store.h"
 #include "scheduler_test_helpers.h"
 
@@ -34,7 +35,7 @@ sweep::SweepSpec noop_spec(const std::string& name, std::vector<double> gs, int 
   return sweep::parse_spec(doc, "test", ".");
 }
 
-sweep::CheckedPoint bed_key(const json& s) { return {s.dump(), {{"g", s["g"]}}}; }
+sweep::CheckedPoint bed_key(const json& s) { return {s.dump(), {{"g", s["g"]}}, {}}; }
 
 /// An impact-shaped sweep (bed + drop jobs) for the dependency logic; no job is run here.
 sweep::SweepSpec impact_spec() {
@@ -64,8 +65,13 @@ struct QueueTest : ::testing::TestWithParam<test::Store> {
     while (st.step()) out += (out.empty() ? "" : ",") + st.get_text(0);
     return out;
   }
+  /// An impact sweep planned on the bed key `key` (a drop per point, a bed per key), or a sweep of
+  /// its registered kind (noop) without one.
   SubmitReport submit_spec(const sweep::SweepSpec& s, const sweep::PointCheckFn& key = {}) {
-    return submit(db, sweep::record(s), sweep::expand(s, key));
+    if (!key) return submit(db, sweep::record(s), sweep::expand(s));
+    const sweep::SweepKind kind{
+        "impact", "test", {}, sweep::shared_input_planner(key, sweep::drop_kind(), sweep::bed_kind()), {}};
+    return submit(db, sweep::record(s), sweep::expand(s, kind));
   }
   Completion done_for(const Claim& c, double value = 1.0) {
     Completion d;

@@ -22,6 +22,12 @@ using nlohmann::json;
 
 namespace {
 
+/// The impact kind as `submit` plans it.
+const gravsweep::sweep::SweepKind& impact() {
+  static const auto kind = gravsweep::pipeline::impact_sweep_kind();
+  return kind;
+}
+
 /// examples/sweep_tiny.json with `speeds` impact speeds times `repeats` seeds at one gravity.
 json tiny_sweep(long speeds, long repeats) {
   std::ifstream in(std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "examples" / "sweep_tiny.json");
@@ -38,7 +44,7 @@ json tiny_sweep(long speeds, long repeats) {
 TEST(SweepScale, EngineChecksRunOncePerDistinctSetupNotPerPoint) {
   const SweepSpec spec = parse_spec(tiny_sweep(50, 40), "big.json", GRAVSWEEP_SOURCE_DIR "/examples");
   const std::size_t before = pipeline::engine_check_runs();
-  const auto jobs = expand(spec, pipeline::impact_point_check());
+  const auto jobs = expand(spec, impact());
   EXPECT_EQ(jobs.size(), 2001u);  // one bed, 2,000 drops
   // Speeds and seeds are not read by the engine's checks: one run for the whole sweep (two with
   // the base checked alone first), not 2,000.
@@ -59,7 +65,7 @@ TEST(SweepScale, AnEngineProblemIsStillFoundAtEveryPointThatHasIt) {
   s["axes"].push_back({{"name", "dt_s"}, {"pointer", "/dt_s"}, {"values", {1e-5, 1e-2}}});
   const SweepSpec spec = parse_spec(s, "big.json", GRAVSWEEP_SOURCE_DIR "/examples");
   try {
-    expand(spec, pipeline::impact_point_check());
+    expand(spec, impact());
     FAIL() << "a time step the contact law refuses was accepted";
   } catch (const SpecError& e) {
     const std::string what = e.what();

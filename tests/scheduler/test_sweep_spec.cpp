@@ -6,7 +6,9 @@
 #include <set>
 
 #include "scheduler/queue/canonical.h"
+#include "scheduler/sweep/impact_kinds.h"
 #include "scheduler/sweep/spec.h"
+#include "scheduler/sweep/sweep_kind.h"
 #include "scheduler_test_helpers.h"
 
 using namespace gravsweep::sweep;
@@ -21,7 +23,13 @@ SweepSpec parse(const json& doc) { return parse_spec(doc, "spec.json", "."); }
 
 /// Bed key of the test: beds differ by gravity, fill and seed (not by speed).
 CheckedPoint test_bed_key(const json& s) {
-  return {s.dump(), {{"g", s["g"]}, {"fill_m", s["fill_m"]}, {"seed", s["seed"]}}};
+  return {s.dump(), {{"g", s["g"]}, {"fill_m", s["fill_m"]}, {"seed", s["seed"]}}, {}};
+}
+
+/// The impact kind's shape (a drop per point, a bed per key) on the test's bed key.
+const SweepKind& test_impact() {
+  static const SweepKind k{"impact", "test", {}, shared_input_planner(test_bed_key, drop_kind(), bed_kind()), {}};
+  return k;
 }
 
 std::vector<SpecProblem> problems_of(const json& doc) {
@@ -60,7 +68,7 @@ TEST(SweepSpec, ProductOfListsRangesZipsAndRepeats) {
   // The range is 0.1, 0.2, 0.3 exactly as literals, not 0.30000000000000004.
   ASSERT_EQ(spec.groups[1].axes[0].values.size(), 3u);
   EXPECT_EQ(gravsweep::queue::canonical_json(spec.groups[1].axes[0].values[2]), "0.3");
-  const auto jobs = expand(spec, test_bed_key);
+  const auto jobs = expand(spec, test_impact());
   std::size_t beds = 0, drops = 0;
   std::set<std::string> ids;
   for (const auto& j : jobs) {
@@ -89,12 +97,12 @@ TEST(SweepSpec, ProductOfListsRangesZipsAndRepeats) {
 
 TEST(SweepSpec, ExpansionIsDeterministicAndExtensionKeepsIds) {
   json doc = {{"sweep", "s"}, {"base", kBase}, {"axes", {{{"pointer", "/g"}, {"values", {9.81, 1.62}}}}}};
-  const auto a = expand(parse(doc), test_bed_key);
-  const auto b = expand(parse(doc), test_bed_key);
+  const auto a = expand(parse(doc), test_impact());
+  const auto b = expand(parse(doc), test_impact());
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].job_id, b[i].job_id);
   doc["axes"][0]["values"].push_back(3.71);
-  const auto c = expand(parse(doc), test_bed_key);
+  const auto c = expand(parse(doc), test_impact());
   std::set<std::string> old_ids;
   for (const auto& j : a) old_ids.insert(j.job_id);
   std::size_t fresh = 0;
