@@ -141,5 +141,5 @@ printf '%-28s %10.1f %10.1f\n' "LAMMPS (serial; mpirun -np 2)" "$ml1" "$ml2"
 printf '%-28s %9.2fx %9.2fx\n' "ratio LAMMPS / gravsweep" "$(awk "BEGIN {print $ml1 / $mg1}")" "$(awk "BEGIN {print $ml2 / $mg2}")"
 printf '%-28s %10s %9.2fx\n' "2-thread speed-up" "gravsweep" "$(awk "BEGIN {print $mg1 / $mg2}")"
 printf '%-28s %10s %9.2fx\n' "" "LAMMPS" "$(awk "BEGIN {print $ml1 / $ml2}")"
-echo "gravsweep's last round, 2 threads: $(awk '$1 == "file" {printf "force region %s %% of the step, barrier waits %s %% of its thread-time", $8, $9}' "$work/gravsweep.2.out")"
+echo "gravsweep's last round, 2 threads: $(awk '$1 == "file" {printf "force region %s %% of the step, barrier waits %s %% of its thread-time (%s %% after the pair loops)", $8, $9, $10}' "$work/gravsweep.2.out")"
 grep '^host' "$work/gravsweep.2.out" || true

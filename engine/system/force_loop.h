@@ -380,7 +380,8 @@ inline std::size_t first_row(const VerletList& list, std::size_t n, int k, int n
 struct alignas(64) ThreadTally {
   long long contacts = 0, wall_contacts = 0;
   double energy_J = 0;
-  double busy_s = 0;  ///< thread-seconds of work (ForceContext::timing set)
+  double busy_s = 0;          ///< thread-seconds of work (ForceContext::timing set)
+  double pair_barrier_s = 0;  ///< seconds waiting at the barrier after the loops (the same)
   OverlapFailure worst;
   StepFindings found;
 };
@@ -457,6 +458,7 @@ void force_loop(ForceContext& c) {
       // a particle's update reads only its own sums).
 #pragma omp barrier
     const double sums_start_s = timed ? omp_get_wtime() : 0;
+    if (timed) mine.pair_barrier_s = sums_start_s - work_start_s - mine.busy_s;
     const auto [lo, hi] = even_share(n, t, nt);
     StepFindings& found = mine.found;
     for (std::size_t b = lo; b < hi; b += kFinishBlock) {
@@ -479,7 +481,10 @@ void force_loop(ForceContext& c) {
   }
   if (timed) {
     c.timing->wall_s += omp_get_wtime() - region_start_s;
-    for (const ThreadTally& x : tally) c.timing->busy_s += x.busy_s;
+    for (const ThreadTally& x : tally) {
+      c.timing->busy_s += x.busy_s;
+      c.timing->pair_barrier_wait_s += x.pair_barrier_s;
+    }
     c.timing->threads = team;
     ++c.timing->regions;
   }

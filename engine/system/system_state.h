@@ -27,6 +27,7 @@ struct Domain {
 struct RegionTiming {
   double wall_s = 0;
   double busy_s = 0;
+  double pair_barrier_wait_s = 0;  ///< thread-seconds at the barrier after the pair and wall loops
   int threads = 0;
   long long regions = 0;
   [[nodiscard]] double wait_share() const { return wall_s > 0 ? 1 - busy_s / (threads * wall_s) : 0; }

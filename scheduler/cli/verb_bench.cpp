@@ -50,6 +50,7 @@ struct BenchRow {
   double neighbour_builds;
   double force_region_share;  ///< of the timed wall time, in the force region (pairs, walls, sums, end of step)
   double wait_share;          ///< of the force region's thread-time, waiting at its barriers (RegionTiming)
+  double pair_barrier_share;  ///< of it, at the barrier after the pair and wall loops (their imbalance)
 };
 
 /// Times `steps` steps of a copy of the bed with `threads` threads.
@@ -84,7 +85,8 @@ BenchRow time_bed(const System& bed, const std::string& label, const BenchOption
                   sys.bytes_per_particle(),
                   static_cast<double>(sys.neighbor_list().builds() - builds0),
                   timing.wall_s / secs,
-                  timing.wait_share()};
+                  timing.wait_share(),
+                  timing.wall_s > 0 ? timing.pair_barrier_wait_s / (timing.threads * timing.wall_s) : 0};
 }
 
 std::unique_ptr<System> make_bed(double container_diameter_m, const BenchOptions& o, ProgressBar& bar,
@@ -176,17 +178,18 @@ void run_bench(const BenchOptions& o) {
       for (int t : o.threads) rows.push_back(time_bed(*wide, label, o, t));
     }
   }
-  fmt::print("\n{:<18} {:>9} {:>8} {:>22} {:>22} {:>20} {:>16} {:>18} {:>18}\n", "bed", "grains", "threads",
+  fmt::print("\n{:<18} {:>9} {:>8} {:>22} {:>22} {:>20} {:>16} {:>18} {:>18} {:>18}\n", "bed", "grains", "threads",
              "ns_per_particle_step", "contacts_per_particle", "bytes_per_particle", "nlist_rebuilds",
-             "force_region_pct", "barrier_wait_pct");
+             "force_region_pct", "barrier_wait_pct", "pair_barrier_pct");
   for (const auto& r : rows)
-    fmt::print("{:<18} {:>9} {:>8} {:>22.1f} {:>22.2f} {:>20.0f} {:>16.0f} {:>18.1f} {:>18.1f}\n", r.bed, r.grains,
-               r.threads, r.ns_per_particle_step, r.contacts_per_particle, r.bytes_per_particle, r.neighbour_builds,
-               100 * r.force_region_share, 100 * r.wait_share);
+    fmt::print("{:<18} {:>9} {:>8} {:>22.1f} {:>22.2f} {:>20.0f} {:>16.0f} {:>18.1f} {:>18.1f} {:>18.1f}\n", r.bed,
+               r.grains, r.threads, r.ns_per_particle_step, r.contacts_per_particle, r.bytes_per_particle,
+               r.neighbour_builds, 100 * r.force_region_share, 100 * r.wait_share, 100 * r.pair_barrier_share);
   print_host(host);
   fmt::print(
       "force_region_pct: the step's wall time in the force region (pair and wall loops, force sums, end of step);\n"
-      "barrier_wait_pct: the force region's thread-time spent waiting at its barriers or forking the team.\n");
+      "barrier_wait_pct: the force region's thread-time spent waiting at its barriers or forking the team;\n"
+      "pair_barrier_pct: the part of it at the barrier after the pair and wall loops (their imbalance).\n");
   fmt::print("\n{} steps at dt = {} s, Table 1 Chrono set (hertz + sunday rolling, mu_r = 0.09).\n", o.steps, o.dt_s);
   // The barrier wait of the threads moves the 2-thread figure by 10 % (main.cpp, BENCHMARKS.md).
   const char* policy = std::getenv("OMP_WAIT_POLICY");
