@@ -382,6 +382,7 @@ struct alignas(64) ThreadTally {
   double energy_J = 0;
   double busy_s = 0;          ///< thread-seconds of work (ForceContext::timing set)
   double pair_barrier_s = 0;  ///< seconds waiting at the barrier after the loops (the same)
+  double pair_loops_s = 0;    ///< seconds of the pair and wall loops (the same)
   OverlapFailure worst;
   StepFindings found;
 };
@@ -452,7 +453,7 @@ void force_loop(ForceContext& c) {
         pair_loop_scalar<Law, Rolling, false>(c, rows, F, T, mine.contacts, mine.energy_J, mine.worst);
     }
     wall_loop<Law, Rolling>(c, rows, F, T, mine.wall_contacts, mine.energy_J, mine.worst);
-    if (timed) mine.busy_s = omp_get_wtime() - work_start_s;
+    if (timed) mine.busy_s = mine.pair_loops_s = omp_get_wtime() - work_start_s;
       // Sum the thread buffers in a fixed order and add gravity (same parallel region), each thread
       // on an even share of the particles; then finish the step on that same share (no barrier:
       // a particle's update reads only its own sums).
@@ -481,9 +482,10 @@ void force_loop(ForceContext& c) {
   }
   if (timed) {
     c.timing->wall_s += omp_get_wtime() - region_start_s;
-    for (const ThreadTally& x : tally) {
-      c.timing->busy_s += x.busy_s;
-      c.timing->pair_barrier_wait_s += x.pair_barrier_s;
+    for (std::size_t t = 0; t < tally.size(); ++t) {
+      c.timing->busy_s += tally[t].busy_s;
+      c.timing->pair_barrier_wait_s += tally[t].pair_barrier_s;
+      if (t < c.timing->pair_loops_s.size()) c.timing->pair_loops_s[t] += tally[t].pair_loops_s;
     }
     c.timing->threads = team;
     ++c.timing->regions;

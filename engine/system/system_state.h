@@ -4,6 +4,7 @@
 // the run continues bit for bit as if it had never stopped (same thread count). The engine
 // writes no file: results/io/checkpoint_file.h stores this struct in HDF5.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -28,6 +29,9 @@ struct RegionTiming {
   double wall_s = 0;
   double busy_s = 0;
   double pair_barrier_wait_s = 0;  ///< thread-seconds at the barrier after the pair and wall loops
+  /// Seconds of the pair and wall loops per thread (the first kTimedThreads): which one waits.
+  static constexpr int kTimedThreads = 8;
+  std::array<double, kTimedThreads> pair_loops_s{};
   int threads = 0;
   long long regions = 0;
   [[nodiscard]] double wait_share() const { return wall_s > 0 ? 1 - busy_s / (threads * wall_s) : 0; }

@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -48,10 +49,19 @@ struct BenchRow {
   double contacts_per_particle;
   double bytes_per_particle;
   double neighbour_builds;
-  double force_region_share;  ///< of the timed wall time, in the force region (pairs, walls, sums, end of step)
-  double wait_share;          ///< of the force region's thread-time, waiting at its barriers (RegionTiming)
-  double pair_barrier_share;  ///< of it, at the barrier after the pair and wall loops (their imbalance)
+  double force_region_share;          ///< of the timed wall time, in the force region (pairs, walls, sums, end of step)
+  double wait_share;                  ///< of the force region's thread-time, waiting at its barriers (RegionTiming)
+  double pair_barrier_share;          ///< of it, at the barrier after the pair and wall loops (their imbalance)
+  std::vector<double> pair_loops_us;  ///< per thread, microseconds of pair and wall loops a step
 };
+
+/// Microseconds a step each thread spent in the pair and wall loops.
+std::vector<double> per_thread_us(const RegionTiming& t, int steps) {
+  std::vector<double> us;
+  for (int k = 0; k < std::min(t.threads, RegionTiming::kTimedThreads); ++k)
+    us.push_back(1e6 * t.pair_loops_s[static_cast<std::size_t>(k)] / steps);
+  return us;
+}
 
 /// Times `steps` steps of a copy of the bed with `threads` threads.
 BenchRow time_bed(const System& bed, const std::string& label, const BenchOptions& o, int threads) {
@@ -86,7 +96,8 @@ BenchRow time_bed(const System& bed, const std::string& label, const BenchOption
                   static_cast<double>(sys.neighbor_list().builds() - builds0),
                   timing.wall_s / secs,
                   timing.wait_share(),
-                  timing.wall_s > 0 ? timing.pair_barrier_wait_s / (timing.threads * timing.wall_s) : 0};
+                  timing.wall_s > 0 ? timing.pair_barrier_wait_s / (timing.threads * timing.wall_s) : 0,
+                  per_thread_us(timing, o.steps)};
 }
 
 std::unique_ptr<System> make_bed(double container_diameter_m, const BenchOptions& o, ProgressBar& bar,
@@ -185,6 +196,13 @@ void run_bench(const BenchOptions& o) {
     fmt::print("{:<18} {:>9} {:>8} {:>22.1f} {:>22.2f} {:>20.0f} {:>16.0f} {:>18.1f} {:>18.1f} {:>18.1f}\n", r.bed,
                r.grains, r.threads, r.ns_per_particle_step, r.contacts_per_particle, r.bytes_per_particle,
                r.neighbour_builds, 100 * r.force_region_share, 100 * r.wait_share, 100 * r.pair_barrier_share);
+  for (const auto& r : rows) {
+    if (r.pair_loops_us.size() < 2) continue;
+    std::string per;
+    for (std::size_t k = 0; k < r.pair_loops_us.size(); ++k)
+      per += fmt::format("{}thread {} {:.1f}", k ? ", " : "", k, r.pair_loops_us[k]);
+    fmt::print("pair and wall loops a step, {} grains, {} threads (us): {}\n", r.grains, r.threads, per);
+  }
   print_host(host);
   fmt::print(
       "force_region_pct: the step's wall time in the force region (pair and wall loops, force sums, end of step);\n"

@@ -31,7 +31,6 @@ using nlohmann::json;
 
 namespace {
 
-std::string show(const json& v) { return spec::shown_value(v); }
 std::string join(const std::string& ptr, const std::string& token) { return spec::pointer_child(ptr, token); }
 std::string join(const std::string& ptr, std::size_t i) { return ptr + "/" + std::to_string(i); }
 

@@ -123,8 +123,11 @@ TEST(DefaultsVersion, ALowGravitySweepWithoutAStepGetsNewIdsAndPinningVersionOne
       EXPECT_EQ(j.job_id, queue::job_id(queue::kind_name(j.kind), as_written));
       EXPECT_FALSE(stored.contains("time_step"));
     }
-  for (const auto& j : sweep::expand(current, impact()))
-    if (j.kind == sweep::drop_kind()) EXPECT_TRUE(json::parse(j.scenario_json).contains("time_step"));
+  for (const auto& j : sweep::expand(current, impact())) {
+    if (j.kind == sweep::drop_kind()) {
+      EXPECT_TRUE(json::parse(j.scenario_json).contains("time_step"));
+    }
+  }
 }
 
 TEST(DefaultsVersion, AJobNamesItsVersionOnlyWhereItChangesWhatItRuns) {
