@@ -380,9 +380,9 @@ inline std::size_t first_row(const VerletList& list, std::size_t n, int k, int n
 struct alignas(64) ThreadTally {
   long long contacts = 0, wall_contacts = 0;
   double energy_J = 0;
-  double busy_s = 0;          ///< thread-seconds of work (ForceContext::timing set)
-  double pair_barrier_s = 0;  ///< seconds waiting at the barrier after the loops (the same)
-  double pair_loops_s = 0;    ///< seconds of the pair and wall loops (the same)
+  // ForceContext::timing set: seconds of the pair and wall loops, of waiting at the barrier after
+  // them, and of the sums and end of step.
+  double pair_loops_s = 0, pair_barrier_s = 0, sums_s = 0;
   OverlapFailure worst;
   StepFindings found;
 };
@@ -453,13 +453,12 @@ void force_loop(ForceContext& c) {
         pair_loop_scalar<Law, Rolling, false>(c, rows, F, T, mine.contacts, mine.energy_J, mine.worst);
     }
     wall_loop<Law, Rolling>(c, rows, F, T, mine.wall_contacts, mine.energy_J, mine.worst);
-    if (timed) mine.busy_s = mine.pair_loops_s = omp_get_wtime() - work_start_s;
-      // Sum the thread buffers in a fixed order and add gravity (same parallel region), each thread
-      // on an even share of the particles; then finish the step on that same share (no barrier:
-      // a particle's update reads only its own sums).
+    const double loops_end_s = timed ? omp_get_wtime() : 0;
+    // Sum the thread buffers in a fixed order and add gravity (same parallel region), each thread
+    // on an even share of the particles; then finish the step on that same share (no barrier:
+    // a particle's update reads only its own sums).
 #pragma omp barrier
     const double sums_start_s = timed ? omp_get_wtime() : 0;
-    if (timed) mine.pair_barrier_s = sums_start_s - work_start_s - mine.busy_s;
     const auto [lo, hi] = even_share(n, t, nt);
     StepFindings& found = mine.found;
     for (std::size_t b = lo; b < hi; b += kFinishBlock) {
@@ -478,12 +477,16 @@ void force_loop(ForceContext& c) {
       // The block's sums are still in L1 when the integrator reads them back.
       if (c.finish != nullptr) c.finish->end_range(p, c.dt_s, *c.check, b, e, found);
     }
-    if (timed) mine.busy_s += omp_get_wtime() - sums_start_s;
+    if (timed) {
+      mine.pair_loops_s = loops_end_s - work_start_s;
+      mine.pair_barrier_s = sums_start_s - loops_end_s;
+      mine.sums_s = omp_get_wtime() - sums_start_s;
+    }
   }
   if (timed) {
     c.timing->wall_s += omp_get_wtime() - region_start_s;
     for (std::size_t t = 0; t < tally.size(); ++t) {
-      c.timing->busy_s += tally[t].busy_s;
+      c.timing->busy_s += tally[t].pair_loops_s + tally[t].sums_s;
       c.timing->pair_barrier_wait_s += tally[t].pair_barrier_s;
       if (t < c.timing->pair_loops_s.size()) c.timing->pair_loops_s[t] += tally[t].pair_loops_s;
     }

@@ -51,11 +51,12 @@ void check_memory(const RunContext& ctx) {
 
 sweep::PointCheckFn impact_point_check() {
   return [](const nlohmann::json& point) {
-    nlohmann::json validated = validate_scenario(with_current_defaults(point));  // a new spec: today's defaults
+    const nlohmann::json current = with_current_defaults(point);  // a new spec: today's defaults
+    nlohmann::json validated = validate_scenario(current);
     nlohmann::json key = bed_key_of_validated(validated);
     // The point as the job keeps it names its defaults version only where the version changes
     // what it runs: a worker of an older build then runs every other job as before.
-    nlohmann::json as_written = id_point(with_current_defaults(point), validated);
+    nlohmann::json as_written = id_point(current, validated);
     if (!as_written.contains("defaults_version")) validated.erase("defaults_version");
     std::string stored = stored_scenario(std::move(validated), as_written).dump();
     return sweep::CheckedPoint{std::move(stored), std::move(key), std::move(as_written)};
