@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "results/io/bed_file.h"
+#include "results/io/job_reports.h"
 #include "results/io/trace_file.h"
 #include "results/measurements/campaign.h"
 #include "results/measurements/trial.h"
@@ -144,8 +145,7 @@ std::vector<std::string> trial_row(const std::string& job, const std::string& sw
   ti.bulk_density_kg_m3 = NAN;
   if (bed && !bed->report_json.empty()) {
     const json r = json::parse(bed->report_json, nullptr, false);
-    if (r.is_object() && r.contains("bulk_density_kg_m3") && r["bulk_density_kg_m3"].is_number())
-      ti.bulk_density_kg_m3 = r["bulk_density_kg_m3"];
+    if (r.is_object()) ti.bulk_density_kg_m3 = results::bed_summary_of_json(r, "bed report").bulk_density_kg_m3;
   }
   std::vector<std::string> row;
   for (const auto& f : results::trial_fields()) row.push_back(f.number ? num(ti.*f.number) : ti.*f.text);

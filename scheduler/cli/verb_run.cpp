@@ -28,14 +28,13 @@ namespace {
 /// and which criterion it left unmet by how much (the report's speeds are those at the end of the
 /// relax; `settled` needs the criteria met in both phases; beds written before settle_end and
 /// relax_end were reported were always ended by the criteria or the time cap).
-std::string settling_outcome(const nlohmann::json& report, const SettleCriteria& criteria) {
-  const double rms = report.at("rms_speed_m_s").get<double>(), fastest = report.at("max_speed_m_s").get<double>();
+std::string settling_outcome(const results::BedSummary& report, const SettleCriteria& criteria) {
+  const double rms = report.rms_speed_m_s, fastest = report.max_speed_m_s;
   const double rms_max = criteria.rms_speed_m_s, fastest_max = criteria.max_speed_m_s;
-  if (report.at("settled").get<bool>())
+  if (report.settled)
     return fmt::format("settled to the criteria (rms {:.1e} m/s <= {:g}, fastest {:.1e} m/s <= {:g})", rms, rms_max,
                        fastest, fastest_max);
-  auto ended_by = [&](const char* phase_key) {
-    const std::string end = report.value(phase_key, std::string("time_cap"));
+  auto ended_by = [&](const std::string& end) {
     return end == "plateau" ? fmt::format(
                                   "at the creep floor (the RMS speed fell by less than {:.0f} % in "
                                   "/bed/settle/plateau_window_s = {:g} s)",
@@ -53,13 +52,11 @@ std::string settling_outcome(const nlohmann::json& report, const SettleCriteria&
     return fmt::format(
         "settling stopped {} before the criteria held; after the relax they hold (rms {:.1e} m/s "
         "<= {:g}, fastest {:.1e} m/s <= {:g})",
-        ended_by("settle_end"), rms, rms_max, fastest, fastest_max);
-  const std::string pour_end = report.value("settle_end", std::string("time_cap"));
-  const bool pour_ended_otherwise =
-      pour_end != "criteria" && pour_end != report.value("relax_end", std::string("time_cap"));
+        ended_by(report.settle_end), rms, rms_max, fastest, fastest_max);
+  const bool pour_ended_otherwise = report.settle_end != "criteria" && report.settle_end != report.relax_end;
   return fmt::format(
-      "settling stopped {} ({}){}", ended_by("relax_end"), unmet,
-      pour_ended_otherwise ? "; the pour's settling before flattening ended " + ended_by("settle_end") : "");
+      "settling stopped {} ({}){}", ended_by(report.relax_end), unmet,
+      pour_ended_otherwise ? "; the pour's settling before flattening ended " + ended_by(report.settle_end) : "");
 }
 
 struct RunOptions {
@@ -120,7 +117,7 @@ void print_metrics(const nlohmann::json& m, const nlohmann::json& bed_report) {
   fmt::print("{:<28} {:>14}\n", "rebound",
              m["rebound"].is_boolean() ? (m["rebound"].get<bool>() ? "yes" : "no") : "n/a");
   fmt::print("{:<28} {:>14}\n", "max_depth_cm", num(m["max_depth_m"], 100, "{:.3f}"));
-  fmt::print("{:<28} {:>14}\n", "final_depth_cm", num(m["final_depth_m"], 100, "{:.3f}"));
+  fmt::print("{:<28} {:>14}\n", "final_depth_below_surface_cm", num(m["final_depth_below_surface_m"], 100, "{:.3f}"));
   fmt::print("{:<28} {:>14}\n", "duration_to_rest_ms", num(m["duration_to_rest_s"], 1000, "{:.1f}"));
   fmt::print("{:<28} {:>14}\n", "simulated_time_s", num(m["simulated_time_s"], 1, "{:.4f}"));
   fmt::print("{:<28} {:>14}\n", "stopped_at_rest", m.value("stopped", false) ? "yes" : "no (time cap)");
@@ -160,13 +157,12 @@ void run_impact(const RunOptions& o) {
       const auto b = pipeline::run_bed_job(scenario, bed_path, o.threads, progress, &queue::stop_requested());
       bar.finish();
       pipeline::write_bed_checksum(bed_path);
-      bed_report = b.report;
+      bed_report = results::to_json(b.report);
       fmt::print(
           "bed: {} grains kept of {} poured, surface at {:.2f} cm, bulk density {:.0f} kg/m3, {}, prepared in {}\n",
-          b.report["grains_kept"].get<long>(), b.report["grains_placed"].get<long>(),
-          100 * b.report["surface_height_m"].get<double>(), b.report["bulk_density_kg_m3"].get<double>(),
+          b.report.grains_kept, b.report.grains_placed, 100 * b.report.surface_height_m, b.report.bulk_density_kg_m3,
           settling_outcome(b.report, pipeline::scenario_params(scenario).bed.settle),
-          format_duration(b.report["wall_time_s"].get<double>()));
+          format_duration(b.report.wall_time_s));
     } else {
       bed_path = o.bed;
       fmt::print("bed: reusing {}\n", bed_path.string());

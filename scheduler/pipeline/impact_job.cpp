@@ -12,6 +12,8 @@
 #include "engine/scenario/impact.h"
 #include "engine/scenario/paper_params.h"
 #include "results/io/bed_file.h"
+#include "results/io/engine_records.h"
+#include "results/io/job_reports.h"
 #include "results/io/snapshot_file.h"
 #include "results/io/trace_file.h"
 #include "results/measurements/campaign.h"
@@ -39,19 +41,6 @@ void check_stop(const std::atomic<bool>* stop, const char* what) {
 std::string first_difference(const json& a, const json& b) {
   const json patch = json::diff(a, b);
   return patch.empty() ? std::string() : patch[0].value("path", std::string("/"));
-}
-
-/// The state of one point set for a snapshot (results/io/snapshot_file.h).
-void gather_points(const Particles& p, const std::vector<int>& contacts, std::size_t begin, std::size_t end,
-                   results::SnapshotPoints& out) {
-  for (std::size_t i = begin; i < end; ++i) {
-    for (int k = 0; k < 3; ++k) {
-      out.position_m.push_back(p.position_m[i][k]);
-      out.velocity_m_s.push_back(p.velocity_m_s[i][k]);
-      out.omega_rad_s.push_back(p.omega_rad_s[i][k]);
-    }
-    out.contacts.push_back(contacts[i]);
-  }
 }
 
 /// The slowest impact a bed in this state is at rest for under the criterion's fractions.
@@ -126,58 +115,43 @@ namespace {
 BedJobResult write_prepared_bed(const System& sys, const BedReport& rep, const ScenarioParams& p, const json& s,
                                 const std::filesystem::path& bed_out, double wall_s, JobCheckpointer& ckpt,
                                 const std::atomic<bool>* stop) {
-  results::BedData b;
-  const auto& pt = sys.particles;
-  for (std::size_t i = 0; i < pt.size(); ++i) {
-    if (pt.size_class[i] != SizeClass::grain) continue;
-    for (int k = 0; k < 3; ++k) {
-      b.position_m.push_back(pt.position_m[i][k]);
-      b.velocity_m_s.push_back(pt.velocity_m_s[i][k]);
-      b.omega_rad_s.push_back(pt.omega_rad_s[i][k]);
-    }
-    b.radius_m.push_back(pt.radius_m[i]);
-    b.mass_kg.push_back(pt.mass_kg[i]);
-    b.material.push_back(pt.material[i]);
-  }
-  double wall_h = 0;
-  for (const auto& w : sys.walls)
-    if (w.kind == WallKind::cylinder) wall_h = w.height_m;
+  results::BedData b = results::bed_grains_of(sys);
   const BedRestState rest = bed_rest_state(sys, rep.surface_height_m, p.bed.grains.diameter_m);
   b.container_diameter_m = p.bed.container.diameter_m;
-  b.wall_height_m = wall_h;
   b.fill_height_m = p.bed.fill_height_m;
   b.surface_height_m = rep.surface_height_m;
   b.gravity_m_s2 = p.gravity_m_s2;
-  b.time_s = sys.time_s();
   b.code_version = pipeline::build_version();
   b.bed_key_json = bed_key_of_validated(s).dump();
   b.scenario_json = s.dump();
-  json report{{"grains_placed", rep.grains_placed},
-              {"grains_kept", rep.grains_kept},
-              {"settled", rep.settled},
-              {"settle_end", to_string(rep.settle_end)},
-              {"relax_end", to_string(rep.relax_end)},
-              {"settle_time_s", rep.settle_time_s},
-              {"relax_time_s", rep.relax_time_s},
-              {"quench_time_s", rep.quench_time_s},
-              {"surface_relax_s", rep.surface_relax_s},
-              {"rms_speed_m_s", rest.rms_speed_m_s},
-              {"max_speed_m_s", rest.max_speed_m_s},
-              {"max_surface_speed_m_s", rest.max_surface_speed_m_s},
-              {"surface_grains", rest.surface_grains},
-              {"at_rest_for_impacts_above_m_s", slowest_impact_at_rest_m_s(rest, p.at_rest)},
-              {"surface_height_m", rep.surface_height_m},
-              {"bulk_density_kg_m3", rep.bulk_density_kg_m3},
-              {"steps", sys.step_count()},
-              {"dt_s", sys.config().dt_s},
-              {"threads", sys.threads()},
-              {"wall_time_s", wall_s}};
-  ckpt.add_metrics(report);
-  b.report_json = report.dump();
+  results::BedSummary r;
+  r.grains_placed = static_cast<long long>(rep.grains_placed);
+  r.grains_kept = static_cast<long long>(rep.grains_kept);
+  r.settled = rep.settled;
+  r.settle_end = to_string(rep.settle_end);
+  r.relax_end = to_string(rep.relax_end);
+  r.settle_time_s = rep.settle_time_s;
+  r.relax_time_s = rep.relax_time_s;
+  r.quench_time_s = rep.quench_time_s;
+  r.surface_relax_s = rep.surface_relax_s;
+  r.rms_speed_m_s = rest.rms_speed_m_s;
+  r.max_speed_m_s = rest.max_speed_m_s;
+  r.max_surface_speed_m_s = rest.max_surface_speed_m_s;
+  r.surface_grains = static_cast<long long>(rest.surface_grains);
+  if (const double v = slowest_impact_at_rest_m_s(rest, p.at_rest); std::isfinite(v))
+    r.at_rest_for_impacts_above_m_s = v;
+  r.surface_height_m = rep.surface_height_m;
+  r.bulk_density_kg_m3 = rep.bulk_density_kg_m3;
+  r.steps = sys.step_count();
+  r.dt_s = sys.config().dt_s;
+  r.threads = sys.threads();
+  r.wall_time_s = wall_s;
+  results::set_checkpoint_counts(r, ckpt.counts());
+  b.report_json = results::to_json(r).dump();
   check_stop(stop, "bed preparation");
   results::write_bed(bed_out, b);
   ckpt.finished();
-  return BedJobResult{bed_out, report};
+  return BedJobResult{bed_out, r};
 }
 }  // namespace
 
@@ -275,19 +249,6 @@ void require_bed_key(const results::BedData& bed, const json& scenario, const st
                   want.contains(at) ? want[at].dump() : "nothing"));
 }
 
-void load_bed(System& sys, const results::BedData& bed) {
-  for (std::size_t i = 0; i < bed.size(); ++i) {
-    const Vec3 x(bed.position_m[3 * i], bed.position_m[3 * i + 1], bed.position_m[3 * i + 2]);
-    const ParticleIndex k = sys.particles.add(x, bed.radius_m[i], bed.mass_kg[i], bed.material[i], SizeClass::grain);
-    sys.particles.set_velocity(k,
-                               Vec3(bed.velocity_m_s[3 * i], bed.velocity_m_s[3 * i + 1], bed.velocity_m_s[3 * i + 2]),
-                               Vec3(bed.omega_rad_s[3 * i], bed.omega_rad_s[3 * i + 1], bed.omega_rad_s[3 * i + 2]));
-  }
-  ContainerSpec cs;
-  cs.diameter_m = bed.container_diameter_m;
-  add_container_walls(sys, cs, bed.wall_height_m, kWallMaterial);
-}
-
 namespace {
 
 /// The drop's grain snapshots (/output/snapshot_interval_s > 0; none otherwise): the grains keep
@@ -301,12 +262,7 @@ DropSnapshots snapshot_hooks(const ScenarioParams& p, const results::BedData& be
                                                 0.5 * p.projectile.diameter_m, p.snapshot_interval_s, build_version());
   ds.interval_s = p.snapshot_interval_s;
   ds.write = [w = snaps.get()](const System& sy, ParticleIndex ip, double t_s) {
-    const std::vector<int> c = sy.contact_counts();
-    results::Snapshot sn;
-    sn.t_s = t_s;
-    gather_points(sy.particles, c, 0, ip, sn.grains);
-    gather_points(sy.particles, c, ip, ip + 1, sn.projectile);
-    w->append(sn);
+    w->append(results::snapshot_of(sy, ip, t_s));
   };
   return ds;
 }
@@ -315,30 +271,13 @@ DropSnapshots snapshot_hooks(const ScenarioParams& p, const results::BedData& be
 /// key and file, code version).
 results::TraceData trace_of(const DropResult& dr, const ScenarioParams& p, const json& validated,
                             const results::BedData& bed, const std::filesystem::path& bed_in) {
-  results::TraceData td;
-  for (const auto& smp : dr.samples) {
-    td.t_s.push_back(smp.t_s);
-    td.depth_m.push_back(smp.depth_m);
-    td.velocity_down_m_s.push_back(smp.velocity_down_m_s);
-    td.accel_up_m_s2.push_back(smp.accel_up_m_s2);
-    for (int k = 0; k < 3; ++k) {
-      td.omega_rad_s.push_back(smp.omega_rad_s[k]);
-      td.position_m.push_back(smp.position_m[k]);
-    }
-    td.contacts.push_back(smp.contacts);
-    td.grain_kinetic_energy_J.push_back(smp.grain_kinetic_energy_J);
-  }
-  const double sample_dt = dr.samples.size() > 1 ? dr.samples[1].t_s - dr.samples[0].t_s : 1.0 / p.sample_rate_hz;
-  td.sample_rate_hz = 1.0 / sample_dt;
+  results::TraceData td = results::trace_columns_of(dr, p.sample_rate_hz);
   td.dt_s = p.drop_config.dt_s;
   td.gravity_m_s2 = p.gravity_m_s2;
   td.surface_height_m = bed.surface_height_m;
-  td.release_height_m = dr.release_height_m;
-  td.release_speed_m_s = dr.release_speed_m_s;
   td.projectile_diameter_m = p.projectile.diameter_m;
   td.projectile_mass_kg = p.projectile.mass_kg;
   td.grain_diameter_m = p.bed.grains.diameter_m;
-  td.stopped = dr.stopped;
   td.scenario_json = validated.dump();
   td.bed_key_json = bed_key_of_validated(validated).dump();
   td.bed_file = std::filesystem::absolute(bed_in).string();
@@ -362,34 +301,6 @@ json paper_metrics(const results::TraceData& td, const std::filesystem::path& tr
   }
 }
 
-/// The DEM side's own figures beside the paper's metrics: depths, rest, steps, the run's setup.
-void add_dem_metrics(json& m, const results::TraceData& td, const DropResult& dr, const ScenarioParams& p,
-                     const results::BedData& bed) {
-  double max_depth = -1e300;
-  for (double z : td.depth_m) max_depth = std::max(max_depth, z);
-  m["max_depth_m"] = max_depth;
-  m["final_depth_m"] = td.depth_m.empty() ? 0.0 : td.depth_m.back();
-  m["first_contact_s"] = dr.first_contact_s ? json(*dr.first_contact_s) : json(nullptr);
-  m["stopped"] = dr.stopped;
-  m["grains_spilled_over_rim"] = dr.grains_spilled;  // low-gravity ejecta removed (impact.h)
-  // Sect. 2.2's stop criterion (speed < stop.speed_m_s after contact): when the projectile came to
-  // rest, and how long after the collision start (a DEM-side duration next to the paper's tstop).
-  m["rest_time_s"] = dr.rest_s ? json(*dr.rest_s) : json(nullptr);
-  m["duration_to_rest_s"] =
-      dr.rest_s && m["t_start_s"].is_number() ? json(*dr.rest_s - m["t_start_s"].get<double>()) : json(nullptr);
-  m["simulated_time_s"] = td.t_s.empty() ? 0.0 : td.t_s.back();
-  m["steps"] = dr.steps;
-  m["dt_s"] = td.dt_s;
-  m["sample_rate_hz"] = td.sample_rate_hz;
-  m["gravity_m_s2"] = p.gravity_m_s2;
-  m["grains"] = bed.size();
-  m["surface_height_m"] = bed.surface_height_m;
-  m["release_speed_m_s"] = dr.release_speed_m_s;
-  m["release_height_above_surface_m"] = dr.release_height_m - bed.surface_height_m;
-  m["first_touch_height_above_surface_m"] = dr.first_touch_height_m - bed.surface_height_m;
-  m["lateral_offset_m"] = std::hypot(p.projectile.lateral_offset_x_m, p.projectile.lateral_offset_y_m);
-}
-
 }  // namespace
 
 DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& bed_in,
@@ -405,7 +316,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
 
   // Rebuild the bed in a fresh system: bit-exact state, no contact history (as after any restart).
   System sys(p.drop_config);
-  load_bed(sys, bed);
+  results::load_bed(sys, bed);
   require_at_rest(sys, bed, p, bed_in);
 
   std::unique_ptr<results::SnapshotWriter> snaps;
@@ -426,10 +337,14 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
 
   results::TraceData td = trace_of(dr, p, s, bed, bed_in);
   json m = paper_metrics(td, trace_out);
-  add_dem_metrics(m, td, dr, p, bed);
-  m["threads"] = sys.threads();
-  m["wall_time_s"] = wall_s;
-  ckpt.add_metrics(m);
+  const std::optional<double> t_start =
+      m["t_start_s"].is_number() ? std::optional<double>(m["t_start_s"].get<double>()) : std::nullopt;
+  results::DemFigures dem = results::dem_figures_of(
+      td, dr, bed, t_start, std::hypot(p.projectile.lateral_offset_x_m, p.projectile.lateral_offset_y_m));
+  dem.threads = sys.threads();
+  dem.wall_time_s = wall_s;
+  results::set_checkpoint_counts(dem, ckpt.counts());
+  results::merge_disjoint(m, results::to_json(dem));
   td.metrics_json = m.dump();
   check_stop(stop, "drop");
   DropJobResult out{trace_out, m, {}, {}};

@@ -12,6 +12,7 @@
 
 #include "engine/system/system.h"
 #include "results/io/bed_file.h"
+#include "results/io/job_reports.h"
 #include "scheduler/pipeline/job_checkpoint.h"
 #include "spec/json_schema.h"
 
@@ -28,8 +29,7 @@ class Interrupted : public std::runtime_error {
 
 struct BedJobResult {
   std::filesystem::path bed_path;
-  nlohmann::json
-      report;  ///< grains_placed, grains_kept, settled, surface_height_m, bulk_density_kg_m3, wall_time_s, ...
+  results::BedSummary report;  ///< the preparation's report, as bed.h5's `report` holds it
 };
 
 struct DropJobResult {
@@ -84,9 +84,5 @@ results::BedData read_user_bed(const std::filesystem::path& bed, std::string* un
 /// was prepared for another bed key than `scenario`'s (as validate_scenario() returns it).
 void require_bed_key(const results::BedData& bed, const nlohmann::json& scenario,
                      const std::filesystem::path& bed_path);
-
-/// Puts a saved bed (grains, bit-exact state, no contact history) and its container walls into
-/// `sys`, whose config holds the contact parameters.
-void load_bed(System& sys, const results::BedData& bed);
 
 }  // namespace gravsweep::pipeline

@@ -77,7 +77,7 @@ RunOutput run_bed(const RunContext& ctx) {
   auto r = run_bed_job(ctx.claim.scenario, ctx.output_tmp, ctx.threads, ctx.progress, ctx.stop, checkpointing_of(ctx));
   if (r.bed_path != ctx.output_tmp && !r.bed_path.empty()) std::filesystem::rename(r.bed_path, ctx.output_tmp);
   if (!ctx.bed_cache.empty()) store_cached_bed(ctx.bed_cache, ctx.claim.job_id, ctx.output_tmp);
-  out.report = r.report;
+  out.report = results::to_json(r.report);
   return out;
 }
 

@@ -183,10 +183,12 @@ std::string JobCheckpointer::detail(const std::string& run_detail) const {
 
 double JobCheckpointer::prior_wall_time_s() const { return resume_ ? resume_->wall_time_s : 0.0; }
 
-void JobCheckpointer::add_metrics(json& m) const {
-  m["checkpoint_resumes"] = resume_ ? resume_->resumes + 1 : 0;
-  m["resumed_at_s"] = resume_ && resume_->position_s > 0 ? json(resume_->position_s) : json(nullptr);
-  m["checkpoints_written"] = written_;
+results::CheckpointCounts JobCheckpointer::counts() const {
+  results::CheckpointCounts c;
+  c.resumes = resume_ ? resume_->resumes + 1 : 0;
+  if (resume_ && resume_->position_s > 0) c.resumed_at_s = resume_->position_s;
+  c.written = written_;
+  return c;
 }
 
 }  // namespace gravsweep::pipeline

@@ -11,6 +11,7 @@
 // a resumed drop is bit-identical whatever the interval, so the interval must not enter the job
 // id or the bed key, which hash the scenario.
 #pragma once
+#include "results/io/job_reports.h"
 #include <atomic>
 #include <chrono>
 #include <filesystem>
@@ -79,8 +80,9 @@ class JobCheckpointer {
   [[nodiscard]] std::string detail(const std::string& run_detail) const;
   /// Wall time of the earlier attempts up to the checkpoint continued from (0: none).
   [[nodiscard]] double prior_wall_time_s() const;
-  /// checkpoint_resumes, resumed_at_s, checkpoints_written for the job's metrics or report.
-  void add_metrics(nlohmann::json& m) const;
+  /// How the checkpoint served this job (resumes, where the last one started, checkpoints
+  /// written), for the job's report.
+  [[nodiscard]] results::CheckpointCounts counts() const;
 
  private:
   Checkpointing cfg_;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "results/io/bed_file.h"
+#include "results/io/job_reports.h"
 #include "results/io/checkpoint_file.h"
 #include "scenario_helpers.h"
 #include "scheduler/pipeline/impact_job.h"
@@ -46,7 +47,8 @@ class BedJobCheckpoint : public ::testing::Test {
       if (ph == phase && f >= fraction) stop.store(true);
     };
     try {
-      return pipeline::run_bed_job(test::tiny_scenario(), out, 1, progress, &stop, checkpointing()).report;
+      return results::to_json(
+          pipeline::run_bed_job(test::tiny_scenario(), out, 1, progress, &stop, checkpointing()).report);
     } catch (const pipeline::Interrupted& e) {
       EXPECT_NE(std::string(e.what()).find(ckpt().string()), std::string::npos) << e.what();
       return std::nullopt;

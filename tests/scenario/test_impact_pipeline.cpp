@@ -15,6 +15,7 @@
 #include "engine/core/error.h"
 #include "engine/scenario/paper_params.h"
 #include "results/io/bed_file.h"
+#include "results/io/job_reports.h"
 #include "results/io/trace_file.h"
 #include "scenario_helpers.h"
 #include "scheduler/pipeline/impact_job.h"
@@ -61,7 +62,7 @@ pipeline::BedJobResult* ImpactPipeline::bed_ = nullptr;
 pipeline::DropJobResult* ImpactPipeline::drop_ = nullptr;
 
 TEST_F(ImpactPipeline, BedIsPreparedFlattenedAndSaved) {
-  const json& r = bed_->report;
+  const json r = results::to_json(bed_->report);
   ASSERT_TRUE(std::filesystem::exists(bed_->bed_path));
   EXPECT_GT(r["grains_placed"].get<int>(), 150);
   EXPECT_LT(r["grains_kept"].get<int>(), r["grains_placed"].get<int>());  // flattening removed some
@@ -99,7 +100,7 @@ TEST_F(ImpactPipeline, DropIsRecordedAndMeasured) {
   // zstop only has to lie between the start and the deepest point.)
   EXPECT_GT(m["max_depth_m"].get<double>(), 0.005);
   EXPECT_LT(m["max_depth_m"].get<double>(), 0.05);
-  EXPECT_GT(m["final_depth_m"].get<double>(), 0.005);
+  EXPECT_GT(m["final_depth_below_surface_m"].get<double>(), 0.005);
   EXPECT_GT(m["zstop_m"].get<double>(), -0.01);
   // zstop is measured from the collision start, the engine's max_depth_m from the bed's mean
   // surface: zstop_surface_m (zstop + the start's depth) is the engine's figure.
@@ -112,7 +113,10 @@ TEST_F(ImpactPipeline, DropIsRecordedAndMeasured) {
   EXPECT_GT(m["apeak_m_s2"].get<double>(), -9.81);
   EXPECT_TRUE(m["stopped"].get<bool>());
   EXPECT_GT(m["duration_to_rest_s"].get<double>(), 0.0);
-  EXPECT_NEAR(m["final_depth_m"].get<double>(), tr.depth_m.back(), 1e-15);
+  // The DEM's final depth is the trace's last depth below the surface; the processed record's
+  // final_depth_m (from the collision start) stays beside it, not replaced by it.
+  EXPECT_NEAR(m["final_depth_below_surface_m"].get<double>(), tr.depth_m.back(), 1e-15);
+  EXPECT_NEAR(m["final_depth_m"].get<double>(), tr.depth_m.back() - m["start_depth_m"].get<double>(), 1e-9);
   EXPECT_GT(m["wall_time_s"].get<double>(), 0.0);
   EXPECT_TRUE(phases_->count("drop"));
   // Energy went into the grains.

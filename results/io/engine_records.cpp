@@ -1,0 +1,118 @@
+// Engine state <-> file records (see engine_records.h).
+#include "results/io/engine_records.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "engine/scenario/bed.h"
+#include "engine/scenario/paper_params.h"
+
+namespace gravsweep::results {
+
+namespace {
+
+/// Appends a Vec3 as three values of a row-major (N, 3) column.
+void push3(std::vector<double>& out, const Vec3& v) {
+  for (int k = 0; k < 3; ++k) out.push_back(v[k]);
+}
+
+Vec3 row3(const std::vector<double>& a, std::size_t i) { return Vec3(a[3 * i], a[3 * i + 1], a[3 * i + 2]); }
+
+/// The state of particles [begin, end) as a snapshot's point set.
+void gather_points(const Particles& p, const std::vector<int>& contacts, std::size_t begin, std::size_t end,
+                   SnapshotPoints& out) {
+  for (std::size_t i = begin; i < end; ++i) {
+    push3(out.position_m, p.position_m[i]);
+    push3(out.velocity_m_s, p.velocity_m_s[i]);
+    push3(out.omega_rad_s, p.omega_rad_s[i]);
+    out.contacts.push_back(contacts[i]);
+  }
+}
+
+}  // namespace
+
+BedData bed_grains_of(const System& sys) {
+  BedData b;
+  const auto& pt = sys.particles;
+  for (std::size_t i = 0; i < pt.size(); ++i) {
+    if (pt.size_class[i] != SizeClass::grain) continue;
+    push3(b.position_m, pt.position_m[i]);
+    push3(b.velocity_m_s, pt.velocity_m_s[i]);
+    push3(b.omega_rad_s, pt.omega_rad_s[i]);
+    b.radius_m.push_back(pt.radius_m[i]);
+    b.mass_kg.push_back(pt.mass_kg[i]);
+    b.material.push_back(pt.material[i]);
+  }
+  for (const auto& w : sys.walls)
+    if (w.kind == WallKind::cylinder) b.wall_height_m = w.height_m;
+  b.time_s = sys.time_s();
+  return b;
+}
+
+void load_bed(System& sys, const BedData& bed) {
+  for (std::size_t i = 0; i < bed.size(); ++i) {
+    const ParticleIndex k =
+        sys.particles.add(row3(bed.position_m, i), bed.radius_m[i], bed.mass_kg[i], bed.material[i], SizeClass::grain);
+    sys.particles.set_velocity(k, row3(bed.velocity_m_s, i), row3(bed.omega_rad_s, i));
+  }
+  ContainerSpec cs;
+  cs.diameter_m = bed.container_diameter_m;
+  add_container_walls(sys, cs, bed.wall_height_m, kWallMaterial);
+}
+
+TraceData trace_columns_of(const DropResult& dr, double nominal_rate_hz) {
+  TraceData td;
+  for (const auto& smp : dr.samples) {
+    td.t_s.push_back(smp.t_s);
+    td.depth_m.push_back(smp.depth_m);
+    td.velocity_down_m_s.push_back(smp.velocity_down_m_s);
+    td.accel_up_m_s2.push_back(smp.accel_up_m_s2);
+    push3(td.omega_rad_s, smp.omega_rad_s);
+    push3(td.position_m, smp.position_m);
+    td.contacts.push_back(smp.contacts);
+    td.grain_kinetic_energy_J.push_back(smp.grain_kinetic_energy_J);
+  }
+  const double sample_dt = dr.samples.size() > 1 ? dr.samples[1].t_s - dr.samples[0].t_s : 1.0 / nominal_rate_hz;
+  td.sample_rate_hz = 1.0 / sample_dt;
+  td.release_height_m = dr.release_height_m;
+  td.release_speed_m_s = dr.release_speed_m_s;
+  td.stopped = dr.stopped;
+  return td;
+}
+
+Snapshot snapshot_of(const System& sys, ParticleIndex projectile, double t_s) {
+  const std::vector<int> c = sys.contact_counts();
+  Snapshot sn;
+  sn.t_s = t_s;
+  gather_points(sys.particles, c, 0, projectile, sn.grains);
+  gather_points(sys.particles, c, projectile, projectile + 1, sn.projectile);
+  return sn;
+}
+
+DemFigures dem_figures_of(const TraceData& td, const DropResult& dr, const BedData& bed,
+                          std::optional<double> t_start_s, double lateral_offset_m) {
+  DemFigures d;
+  d.max_depth_m = td.depth_m.empty() ? 0.0 : *std::max_element(td.depth_m.begin(), td.depth_m.end());
+  d.final_depth_below_surface_m = td.depth_m.empty() ? 0.0 : td.depth_m.back();
+  d.first_contact_s = dr.first_contact_s;
+  d.stopped = dr.stopped;
+  d.grains_spilled_over_rim = static_cast<long long>(dr.grains_spilled);
+  // Sect. 2.2's stop criterion (speed < stop.speed_m_s after contact): when the projectile came to
+  // rest, and how long after the collision start (a DEM-side duration next to the paper's tstop).
+  d.rest_time_s = dr.rest_s;
+  if (dr.rest_s && t_start_s) d.duration_to_rest_s = *dr.rest_s - *t_start_s;
+  d.simulated_time_s = td.t_s.empty() ? 0.0 : td.t_s.back();
+  d.steps = dr.steps;
+  d.dt_s = td.dt_s;
+  d.sample_rate_hz = td.sample_rate_hz;
+  d.gravity_m_s2 = td.gravity_m_s2;
+  d.grains = static_cast<long long>(bed.size());
+  d.surface_height_m = bed.surface_height_m;
+  d.release_speed_m_s = dr.release_speed_m_s;
+  d.release_height_above_surface_m = dr.release_height_m - bed.surface_height_m;
+  d.first_touch_height_above_surface_m = dr.first_touch_height_m - bed.surface_height_m;
+  d.lateral_offset_m = lateral_offset_m;
+  return d;
+}
+
+}  // namespace gravsweep::results

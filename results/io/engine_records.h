@@ -1,0 +1,39 @@
+// The engine's state and a drop's result as the records of results/io's files, and back: the one
+// place where engine arrays (engine frame: z up, the container's floor at z = 0) become a bed file's
+// grains, a trace's columns or a snapshot's points. The scheduler's jobs call these and add the
+// facts a file carries beyond the engine's state (scenario, keys, versions).
+#pragma once
+#include <cstddef>
+#include <optional>
+
+#include "engine/scenario/impact.h"
+#include "engine/system/system.h"
+#include "results/io/bed_file.h"
+#include "results/io/job_reports.h"
+#include "results/io/snapshot_file.h"
+#include "results/io/trace_file.h"
+
+namespace gravsweep::results {
+
+/// The grains of `sys` (its projectile and walls left out), the cylinder wall's height and the
+/// simulated time, as a bed file's record; the facts of the preparation are the caller's.
+BedData bed_grains_of(const System& sys);
+
+/// Puts a saved bed (grains, bit-exact state, no contact history) and its container walls into
+/// `sys`, whose config holds the contact parameters.
+void load_bed(System& sys, const BedData& bed);
+
+/// The drop's samples as trace columns, with its release facts and stop flag; the sample rate is
+/// the samples' own (`nominal_rate_hz` for a trace of one sample).
+TraceData trace_columns_of(const DropResult& dr, double nominal_rate_hz);
+
+/// One grain snapshot: every particle before `projectile` as a grain (the bed's order), the
+/// projectile as its own point set.
+Snapshot snapshot_of(const System& sys, ParticleIndex projectile, double t_s);
+
+/// The DEM figures of a drop from its trace (depths below the bed's surface), its result and the
+/// bed; `t_start_s` is the paper's collision start (none: duration_to_rest_s is absent).
+DemFigures dem_figures_of(const TraceData& td, const DropResult& dr, const BedData& bed,
+                          std::optional<double> t_start_s, double lateral_offset_m);
+
+}  // namespace gravsweep::results
