@@ -33,6 +33,11 @@ void widen(LawRange& r, double x) {
   r.hi = std::isnan(r.hi) ? x : std::max(r.hi, x);
 }
 
+/// A bed field a trial may leave at 0 (not recorded): only recorded values widen the range.
+void widen_recorded(LawRange& r, double x) {
+  if (x > 0) widen(r, x);
+}
+
 /// The constants refitted on resamples of whole drops, drawn within each gravity level.
 std::vector<std::vector<double>> bootstrap_constants(const ModelSpec& law, const Campaign& c, int resamples,
                                                      unsigned seed) {
@@ -127,6 +132,8 @@ SavedLaw make_saved_law(const ModelSpec& law, const Campaign& c, int resamples, 
     widen(s.diameter_m, t.info.projectile_diameter_m);
     widen(s.mass_kg, t.info.projectile_mass_kg);
     widen(s.grain_diameter_m, t.info.grain_diameter_m);
+    widen_recorded(s.bulk_density_kg_m3, t.info.bulk_density_kg_m3);
+    widen_recorded(s.fill_height_m, t.info.fill_height_m);
   }
   s.trials = static_cast<int>(c.trials.size());
   s.levels = static_cast<int>(c.gravity_levels().size());
@@ -155,6 +162,19 @@ namespace {
 
 json range_json(const LawRange& r) { return json{{"min", r.lo}, {"max", r.hi}}; }
 
+/// The ranges; the bed's only when recorded (a law from trials without them, or read from an
+/// older file, has none, and the file then has no such field).
+json ranges_json(const SavedLaw& s) {
+  json r{{"gravity_m_s2", range_json(s.gravity_m_s2)},
+         {"impact_froude", range_json(s.froude)},
+         {"projectile_diameter_m", range_json(s.diameter_m)},
+         {"projectile_mass_kg", range_json(s.mass_kg)},
+         {"grain_diameter_m", range_json(s.grain_diameter_m)}};
+  if (std::isfinite(s.bulk_density_kg_m3.lo)) r["bulk_density_kg_m3"] = range_json(s.bulk_density_kg_m3);
+  if (std::isfinite(s.fill_height_m.lo)) r["fill_height_m"] = range_json(s.fill_height_m);
+  return r;
+}
+
 json form_error_json(const std::vector<LawFormError>& f) {
   json a = json::array();
   for (const auto& e : f)
@@ -173,6 +193,7 @@ class LawReader {
   [[noreturn]] void fail(const std::string& pointer, const std::string& what) const {
     throw ConfigError(fmt::format("{}: {}: {}", path_.string(), pointer, what));
   }
+  bool has(const std::string& pointer) const { return j_.contains(json::json_pointer(pointer)); }
   const json& at(const std::string& pointer) const {
     const json::json_pointer p(pointer);
     if (!j_.contains(p)) fail(pointer, "missing");
@@ -206,6 +227,8 @@ class LawReader {
     if (r.lo > r.hi) fail(pointer, fmt::format("min {} above max {}", r.lo, r.hi));
     return r;
   }
+  /// A range a version-1 file may lack (written before it was recorded): NaN when absent.
+  LawRange optional_range(const std::string& pointer) const { return has(pointer) ? range(pointer) : LawRange{}; }
 
  private:
   std::filesystem::path path_;
@@ -223,12 +246,7 @@ void write_law(const std::filesystem::path& path, const SavedLaw& s) {
                {"covariance", s.covariance},
                {"bootstrap", s.bootstrap},
                {"form_error", {{"source", s.form_error_source}, {"by_froude", form_error_json(s.form_error)}}},
-               {"ranges",
-                {{"gravity_m_s2", range_json(s.gravity_m_s2)},
-                 {"impact_froude", range_json(s.froude)},
-                 {"projectile_diameter_m", range_json(s.diameter_m)},
-                 {"projectile_mass_kg", range_json(s.mass_kg)},
-                 {"grain_diameter_m", range_json(s.grain_diameter_m)}}},
+               {"ranges", ranges_json(s)},
                {"trials", s.trials},
                {"levels", s.levels},
                {"code_version", s.code_version},
@@ -294,6 +312,8 @@ SavedLaw read_law(const std::filesystem::path& path) {
   s.diameter_m = r.range("/ranges/projectile_diameter_m");
   s.mass_kg = r.range("/ranges/projectile_mass_kg");
   s.grain_diameter_m = r.range("/ranges/grain_diameter_m");
+  s.bulk_density_kg_m3 = r.optional_range("/ranges/bulk_density_kg_m3");
+  s.fill_height_m = r.optional_range("/ranges/fill_height_m");
   s.trials = static_cast<int>(r.number("/trials"));
   s.levels = static_cast<int>(r.number("/levels"));
   s.code_version = r.text("/code_version");

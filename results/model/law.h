@@ -50,6 +50,10 @@ struct SavedLaw {
   std::vector<LawFormError> form_error;         ///< ascending Fr
   std::string form_error_source;                ///< "leave one gravity level out" or "in sample"
   LawRange gravity_m_s2, froude, diameter_m, mass_kg, grain_diameter_m;
+  /// The bed the law was fitted on: its bulk density and fill height (the floor below the
+  /// surface). Recorded for the user to compare with their ground; predict takes no bed and does
+  /// not flag against them. NaN when the file predates them or no trial records them.
+  LawRange bulk_density_kg_m3, fill_height_m;
   int trials = 0, levels = 0;
   std::string code_version;  ///< the build that fitted it
   std::string fitted_on;     ///< the inputs, as given

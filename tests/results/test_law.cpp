@@ -62,6 +62,25 @@ TEST(Law, TheFileHoldsTheLawAndItsPredictionsExactly) {
   EXPECT_EQ(back.covariance, law.covariance);
   EXPECT_EQ(back.bootstrap, law.bootstrap);
   EXPECT_EQ(back.model, law.model);
+  // The bed it was fitted on (synth.h's defaults), kept for the user to compare with their ground.
+  EXPECT_DOUBLE_EQ(law.bulk_density_kg_m3.lo, 1450);
+  EXPECT_DOUBLE_EQ(law.bulk_density_kg_m3.hi, 1450);
+  EXPECT_DOUBLE_EQ(law.fill_height_m.lo, 0.21);
+  EXPECT_DOUBLE_EQ(law.fill_height_m.hi, 0.21);
+  EXPECT_EQ(back.bulk_density_kg_m3.lo, law.bulk_density_kg_m3.lo);
+  EXPECT_EQ(back.bulk_density_kg_m3.hi, law.bulk_density_kg_m3.hi);
+  EXPECT_EQ(back.fill_height_m.lo, law.fill_height_m.lo);
+  EXPECT_EQ(back.fill_height_m.hi, law.fill_height_m.hi);
+  // A version-1 file written before the bed was recorded still loads, with no bed range.
+  nlohmann::json j;
+  std::ifstream(file) >> j;
+  j["ranges"].erase("bulk_density_kg_m3");
+  j["ranges"].erase("fill_height_m");
+  std::ofstream(d.path / "old.json") << j.dump();
+  const SavedLaw old = read_law(d.path / "old.json");
+  EXPECT_TRUE(std::isnan(old.bulk_density_kg_m3.lo));
+  EXPECT_TRUE(std::isnan(old.fill_height_m.hi));
+  EXPECT_EQ(old.values, law.values);
   const LawCase c{0.1, 0.3, 0.1, 1.0};
   const LawPrediction a = predict_case(law, c), b = predict_case(back, c);
   EXPECT_EQ(a.zstop_m, b.zstop_m);
@@ -82,7 +101,10 @@ TEST(Law, FarBeyondTheFittedRangesACaseIsRefusedJustOutsideItIsFlagged) {
   const double v_fr1 = [](double g) { return std::sqrt(g * 0.1); }(1e-7);
   EXPECT_EQ(predict_case(law, {1e-7, v_fr1, 0.1, 1.0}).range, LawRangeFlag::refused);
   const LawPrediction big = predict_case(law, {0.1, 0.3, 1.0, 1.0});
-  EXPECT_EQ(big.range, LawRangeFlag::refused) << big.note;  // D = 1 m: Fr and D beyond their factors
+  // D = 1 m is refused by the diameter alone (10 times the fitted 0.1 m); its Fr 0.95 is inside.
+  EXPECT_EQ(big.range, LawRangeFlag::refused) << big.note;
+  EXPECT_NE(big.note.find("diameter"), std::string::npos) << big.note;
+  EXPECT_EQ(big.note.find("Froude"), std::string::npos) << big.note;
   EXPECT_TRUE(std::isnan(big.zstop_m));
   const LawPrediction below = predict_case(law, {0.005, std::sqrt(0.005 * 0.1), 0.1, 1.0});
   EXPECT_EQ(below.range, LawRangeFlag::extrapolated) << below.note;
@@ -196,6 +218,10 @@ TEST(Law, TheVerbsSaveAndPredictWithExitCodesScriptsCanTrust) {
   r = gravsweep::testing::run_gravsweep("model predict --law '" + law + "' --gravity 1e-7 --speed 0.0001", true);
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("refused"), std::string::npos) << r.out;
+  r = gravsweep::testing::run_gravsweep("model predict --law '" + law + "' --gravity 0.1 --speed 0.3 --diameter 1",
+                                        true);
+  EXPECT_EQ(r.code, 2) << r.out;  // D = 1 m: ten times the fitted 0.1 m
+  EXPECT_NE(r.out.find("projectile diameter (m) 1 outside the fitted 0.1-0.1"), std::string::npos) << r.out;
   r = gravsweep::testing::run_gravsweep(
       "model predict --law '" + law + "' --gravity 1e-7 --speed 0.0001 --extrapolate --format csv", false);
   EXPECT_EQ(r.code, 0) << r.out;
