@@ -250,8 +250,9 @@ bool DropRun::next_sample(long long k) {
   if (checkpoints_.save && checkpoints_.due && checkpoints_.due()) checkpoints_.save(sys_, st_);
   if (progress_ && k % 50 == 0)
     progress_(static_cast<double>(k) / static_cast<double>(max_samples_),
-              fmt::format("t={:.4f}s depth={:.2f}cm v={:.3f}m/s contacts={}", s.t_s, 100 * s.depth_m,
-                          s.velocity_down_m_s, s.contacts));
+              fmt::format("t={:.4f}s of {:.4g}s cap step={} dt={:.3g}s depth={:.2f}cm v={:.3f}m/s contacts={}", s.t_s,
+                          static_cast<double>(max_samples_) * sample_dt_, sys_.step_count(), sys_.config().dt_s,
+                          100 * s.depth_m, s.velocity_down_m_s, s.contacts));
   return false;
 }
 

@@ -106,10 +106,7 @@ std::string num(double v) { return std::isfinite(v) ? fmt::format("{}", v) : std
 std::optional<results::BedData> bed_of(db::Database& db, const queue::CampaignPaths& paths,
                                        const results::TraceData& td, const std::string& bed_job) {
   std::vector<fs::path> candidates{td.bed_file};
-  db::Statement st(db, "SELECT output_path FROM attempts WHERE job_id=? AND outcome='done' ORDER BY attempt DESC");
-  st.bind(1, bed_job);
-  while (st.step())
-    if (!st.is_null(0)) candidates.push_back(paths.abs(st.get_text(0)));
+  if (const std::string out = queue::done_output_path(db, bed_job); !out.empty()) candidates.push_back(paths.abs(out));
   for (const auto& p : candidates) {
     std::error_code ec;
     if (!p.empty() && fs::exists(p, ec)) return results::read_bed(p);

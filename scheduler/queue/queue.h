@@ -255,6 +255,19 @@ struct TroubledPage {
 /// The failed and dead jobs, latest first, `limit` of them from `offset`.
 TroubledPage troubled_jobs(db::Database& db, std::int64_t offset, std::int64_t limit);
 
+/// One attempt of a job as the attempts table keeps it: a job's log (jobs run inside their
+/// worker's process and write no log of their own).
+struct AttemptRecord {
+  int attempt = 0;
+  std::string worker, host, code_version, outcome, error;
+  int threads = 0;
+  double started_at = 0, ended_at = 0, runtime_s = 0;  ///< ended_at, runtime_s 0: not ended
+};
+/// The job's attempts, latest first, at most `limit`.
+std::vector<AttemptRecord> job_attempts(db::Database& db, const std::string& job_id, std::int64_t limit);
+/// The output (files-root relative) of the job's latest done attempt; empty: none.
+std::string done_output_path(db::Database& db, const std::string& job_id);
+
 // ---- results ----------------------------------------------------------------------------------
 /// Column names of the results table, in display order (fixed, parameters, metrics).
 std::vector<std::string> result_columns(db::Database& db);

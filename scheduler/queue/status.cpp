@@ -336,4 +336,26 @@ TroubledPage troubled_jobs(Database& db, std::int64_t offset, std::int64_t limit
   return page;
 }
 
+std::vector<AttemptRecord> job_attempts(Database& db, const std::string& job_id, std::int64_t limit) {
+  Statement st(db,
+               "SELECT attempt, worker, host, code_version, outcome, coalesce(error,''), threads, started_at, "
+               "coalesce(ended_at,0), coalesce(runtime_s,0) FROM attempts WHERE job_id=? "
+               "ORDER BY attempt_id DESC LIMIT ?");  // index attempts_job
+  st.bind(1, job_id).bind(2, std::max<std::int64_t>(0, limit));
+  std::vector<AttemptRecord> out;
+  while (st.step())
+    out.push_back({static_cast<int>(st.get_int(0)), st.get_text(1), st.get_text(2), st.get_text(3), st.get_text(4),
+                   st.get_text(5), static_cast<int>(st.get_int(6)), st.get_double(7), st.get_double(8),
+                   st.get_double(9)});
+  return out;
+}
+
+std::string done_output_path(Database& db, const std::string& job_id) {
+  Statement st(db,
+               "SELECT output_path FROM attempts WHERE job_id=? AND outcome='done' AND output_path IS NOT NULL "
+               "ORDER BY attempt DESC LIMIT 1");
+  st.bind(1, job_id);
+  return st.step() ? st.get_text(0) : std::string();
+}
+
 }  // namespace gravsweep::queue

@@ -135,12 +135,6 @@ Reply results_unchecked(db::Database& db, const Params& p) {
                      {"numeric_columns", numeric_columns_json(db)}});
 }
 
-/// Job ids are hex digests: anything else is no job (and never reaches the where grammar).
-bool is_job_id(const std::string& id) {
-  return !id.empty() && id.size() <= 64 &&
-         std::all_of(id.begin(), id.end(), [](char c) { return std::isxdigit(static_cast<unsigned char>(c)); });
-}
-
 /// Every `stride`-th sample of `v`, the last one kept.
 json thinned(const std::vector<double>& v, std::size_t stride) {
   json a = json::array();
@@ -210,6 +204,11 @@ Reply guarded(F&& f) {
 
 }  // namespace
 
+bool is_job_id(const std::string& id) {
+  return !id.empty() && id.size() <= 64 &&
+         std::all_of(id.begin(), id.end(), [](char c) { return std::isxdigit(static_cast<unsigned char>(c)); });
+}
+
 std::mutex& hdf5_mutex() {
   static std::mutex m;
   return m;
@@ -252,6 +251,29 @@ Reply failed_reply(db::Database& db, const Params& params) {
                       {"blocked_by", j.blocked_by.empty() ? json(nullptr) : json(j.blocked_by)},
                       {"error", j.error}});
     return json_reply({{"total", page.total}, {"offset", offset}, {"limit", limit}, {"jobs", std::move(jobs)}});
+  });
+}
+
+Reply attempts_reply(db::Database& db, const std::string& job_id) {
+  return guarded([&] {
+    if (!is_job_id(job_id)) throw ApiError(404, fmt::format("'{}' is not a job id (hexadecimal digits)", job_id));
+    json attempts = json::array();
+    for (const auto& a : queue::job_attempts(db, job_id, kMaxAttempts)) {
+      const auto when = [](double t) { return t > 0 ? json(t) : json(nullptr); };
+      attempts.push_back({{"attempt", a.attempt},
+                          {"outcome", a.outcome},
+                          {"worker", a.worker},
+                          {"host", a.host},
+                          {"threads", a.threads},
+                          {"code_version", a.code_version},
+                          {"started_at", when(a.started_at)},
+                          {"ended_at", when(a.ended_at)},
+                          {"runtime_s", when(a.runtime_s)},
+                          {"error", a.error}});
+    }
+    if (attempts.empty())
+      throw ApiError(404, fmt::format("job {} has no attempts (unknown, or never claimed)", job_id));
+    return json_reply({{"job_id", job_id}, {"attempts", std::move(attempts)}});
   });
 }
 

@@ -33,6 +33,10 @@ inline constexpr std::int64_t kMaxPageRows = 5000;   ///< a JSON page of results
 inline constexpr std::int64_t kMaxCsvRows = 200000;  ///< one CSV download
 inline constexpr std::int64_t kDefaultTracePoints = 2000;
 inline constexpr std::int64_t kMaxTracePoints = 20000;
+inline constexpr std::int64_t kMaxAttempts = 50;  ///< a job's attempts in /api/attempts/ID
+
+/// Job ids are hex digests: anything else is no job (and never reaches the where grammar).
+bool is_job_id(const std::string& id);
 
 /// Debian's HDF5 library is built without its thread-safety option: every trace read of the
 /// process (a drop's trace, the traces behind the model verdict) holds this lock.
@@ -52,6 +56,11 @@ Reply results_reply(db::Database& db, const Params& params);
 
 /// /api/failed: the failed and dead jobs with their reasons, latest first; offset, limit.
 Reply failed_reply(db::Database& db, const Params& params);
+
+/// /api/attempts/ID: the job's attempts, latest first (at most kMaxAttempts): outcome, worker,
+/// host, threads, build, start, end, run time and the error each attempt ended with. A job runs
+/// inside its worker's process and writes no log of its own: this history is its log.
+Reply attempts_reply(db::Database& db, const std::string& job_id);
 
 /// /api/collapse: the drops the filter `where` keeps (the first kMaxPageRows) in Froude scaling:
 /// gravity and projectile diameter from each drop's scenario, Fr = vc / sqrt(g D), zstop / D,

@@ -17,6 +17,7 @@
 #include "scheduler/queue/queue.h"
 #include "scheduler/queue/stop.h"
 #include "scheduler/serve/api.h"
+#include "scheduler/serve/figures.h"
 #include "scheduler/serve/levels.h"
 #include "scheduler/serve/page_html.h"
 #include "scheduler/serve/rank.h"
@@ -124,7 +125,7 @@ std::string host_of(const std::string& header) {
   return header.substr(0, header.find(':'));
 }
 
-void add_routes(httplib::Server& svr, Connections& pool, StatusCache& status, LevelCounts& levels,
+void add_routes(httplib::Server& svr, Connections& pool, StatusCache& status, LevelCounts& levels, DropFigures& figures,
                 const ServeOptions& o, const std::optional<queue::CampaignPaths>& paths,
                 const std::optional<RankWatch>& rank) {
   svr.Get("/", [](const httplib::Request&, httplib::Response& res) {
@@ -147,6 +148,13 @@ void add_routes(httplib::Server& svr, Connections& pool, StatusCache& status, Le
           }));
   svr.Get(R"(/api/drop/([^/]+))", with_db(pool, [&paths](db::Database& db, const httplib::Request& req) {
             return drop_reply(db, paths ? &*paths : nullptr, req.matches[1].str(), params_of(req));
+          }));
+  svr.Get(R"(/api/drop/([^/]+)/([^/]+)\.png)",
+          with_db(pool, [&paths, &figures](db::Database& db, const httplib::Request& req) {
+            return figures.reply(db, paths ? &*paths : nullptr, req.matches[1].str(), req.matches[2].str());
+          }));
+  svr.Get(R"(/api/attempts/([^/]+))", with_db(pool, [](db::Database& db, const httplib::Request& req) {
+            return attempts_reply(db, req.matches[1].str());
           }));
   // The verdict is computed by its own thread (rank.h): a request only copies the latest answer.
   svr.Get("/api/rank", [&rank](const httplib::Request&, httplib::Response& res) {
@@ -205,8 +213,9 @@ void serve(const ServeOptions& o, const std::function<void(const std::string& ur
   svr.set_keep_alive_timeout(2);
   StatusCache status;
   LevelCounts levels;
+  DropFigures figures;
   std::optional<RankWatch> rank;  // started once the port is bound
-  add_routes(svr, pool, status, levels, o, paths, rank);
+  add_routes(svr, pool, status, levels, figures, o, paths, rank);
   errno = 0;
   int port = o.port;
   if (o.port == 0) {

@@ -65,6 +65,13 @@ async function main() {
   await page.waitForSelector("#trace-canvas[data-drawn]", { timeout: 60000 });
   const traceInk = await inkedPixels(page, "trace-canvas");
   if (traceInk < 500) fail(`the trace canvas is nearly blank (${traceInk} pixels drawn)`);
+  // The drop's Fig. 2 and Fig. 1, drawn by the server, shown as images.
+  for (const fig of ["fig2", "fig1"]) {
+    await page.waitForSelector(`#${fig}-img[data-loaded="${dropId}"]`, { timeout: 120000 })
+      .catch(async () => fail(`${fig} of the drop never loaded: ` + await page.textContent("#figs-info")));
+    const width = await page.evaluate((id) => document.getElementById(id).naturalWidth, `${fig}-img`);
+    if (!(width > 400)) fail(`${fig} of the drop is ${width} pixels wide`);
+  }
   // The figure: zstop against impact speed (the drops' metrics).
   await page.selectOption("#fig-y", "zstop_m").catch(() => {});
   await page.waitForSelector("#figure-canvas[data-drawn]", { timeout: 60000 });

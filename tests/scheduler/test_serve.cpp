@@ -184,6 +184,36 @@ TEST(Serve, TheApiFollowsAWorkerAsItFinishesJobs) {
   get_json(c, "/api/drop/0123456789abcdef", 404);
   get_json(c, "/api/drop/not-a-job", 404);
 
+  // The drop's Fig. 2 and Fig. 1 as PNG images (drawn once, then served again as drawn); a no-op
+  // job has none, and a figure of another name is no page.
+  for (const char* fig : {"fig2", "fig1"}) {
+    const std::string path = "/api/drop/" + drop + "/" + fig + ".png";
+    const auto png = c.Get(path.c_str());
+    ASSERT_TRUE(png) << path;
+    ASSERT_EQ(png->status, 200) << path << ": " << png->body;
+    EXPECT_EQ(png->get_header_value("Content-Type"), "image/png");
+    ASSERT_GT(png->body.size(), 10000u) << path;
+    EXPECT_EQ(png->body.substr(1, 3), "PNG") << path;
+    const auto again = c.Get(path.c_str());
+    ASSERT_TRUE(again);
+    EXPECT_EQ(again->body, png->body) << "the figure is drawn once per drop";
+  }
+  EXPECT_NE(get_json(c, "/api/drop/" + noop + "/fig2.png", 404).value("error", "").find("not a drop"),
+            std::string::npos);
+  get_json(c, "/api/drop/" + drop + "/fig3.png", 404);
+
+  // A job's attempts are its log: the dead job's attempts, the last first, with worker, host and error.
+  const std::string dead = f.at("jobs")[0].at("job_id");
+  const json a = get_json(c, "/api/attempts/" + dead);
+  ASSERT_EQ(a.at("attempts").size(), f.at("jobs")[0].at("attempts").get<std::size_t>()) << a.dump();
+  EXPECT_EQ(a.at("attempts")[0].at("outcome"), "dead") << a.dump();
+  EXPECT_FALSE(a.at("attempts")[0].at("worker").get<std::string>().empty());
+  EXPECT_FALSE(a.at("attempts")[0].at("host").get<std::string>().empty());
+  EXPECT_NE(a.at("attempts")[0].at("error").get<std::string>().find("asked to fail"), std::string::npos) << a.dump();
+  EXPECT_EQ(get_json(c, "/api/attempts/" + drop).at("attempts")[0].at("outcome"), "done");
+  get_json(c, "/api/attempts/0123456789abcdef", 404);
+  get_json(c, "/api/attempts/not-a-job", 404);
+
   // Nothing served writes: other methods are refused, unknown paths are 404, the campaign unchanged.
   const std::string before = campaign_state(d.path / "c.db");
   for (const char* path : {"/api/status", "/api/results", "/", "/api/drop/"}) {
