@@ -3,7 +3,7 @@
     import gravsweep
     ds = gravsweep.open_dataset("data/gravity_sweep/g0.1")       # an exported dataset or a lab campaign
     ds.results()                                                 # pandas DataFrame, units in the names
-    ds.trace(ds.results().trial_id[0])                           # t_s, accel_m_s2, ... of one drop
+    ds.trace(ds.trials().trial_id[0])                            # t_s, accel_m_s2, ... of one drop
     c = gravsweep.open_campaign("runs/sweep.db")                 # a campaign database (or postgresql://...)
     c.counts(), c.status()["eta_s"], c.results(where="gravity_m_s2<1"), c.trace(job_id)
     gravsweep.metrics(["data/gravity_sweep/g9.81", "data/gravity_sweep/g0.1"])  # each drop processed in its own scales
