@@ -63,7 +63,8 @@ url="$(grep -o 'http://[0-9.:]*/' serve.log | head -1)"
 [ -n "$url" ] || { echo "bench-serve: serve printed no URL within 60 s:" >&2; cat serve.log >&2; exit 1; }
 for path in "api/status" "api/status" "api/status" "api/results?limit=50" "api/results?limit=50&sort=-impact_speed_m_s" \
             "api/results?limit=50&offset=80000&where=gravity_m_s2%3C1" "api/failed?limit=20" \
-            "api/results?columns=impact_speed_m_s,noop_value,gravity_m_s2&limit=5000" "api/results?format=csv"; do
+            "api/results?columns=impact_speed_m_s,noop_value,gravity_m_s2&limit=5000" "api/results?format=csv" \
+            "api/levels" "api/levels" "api/collapse"; do
   curl -s -o /dev/null -w "GET /$path: %{http_code}, %{size_download} bytes, %{time_total} s\n" "$url$path"
 done
 for run in 1 2 3; do
