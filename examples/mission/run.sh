@@ -26,9 +26,12 @@ case_run lander_extrapolated predict --gravity 6e-5 --speed 0.1 --diameter 0.3 -
 case_run moon_sampler predict --gravity 1.62 --speed 0.1 0.3 --diameter 0.1 --mass 1
 # A 10 cm rock (1.3 kg, basalt) falling onto dusty regolith at Mars at 1 and 3 m/s.
 case_run mars_rock predict --gravity 3.71 --speed 1 3 --diameter 0.1 --mass 1.3
+# A 10 cm meteorite (1.3 kg) arriving at Mars at 250 m/s: a cratering impact at Fr 410, far
+# beyond the sweep's Fr <= 10 (refused: exit 2).
+case_run mars_meteorite predict --gravity 3.71 --speed 250 --diameter 0.1 --mass 1.3
 # What one measured depth says about the ground: the Moon sampler at 0.3 m/s sank 4.0 cm, deeper
 # than the 3.2 cm the law predicts.
 case_run moon_sampler_infer infer --gravity 1.62 --speed 0.3 --diameter 0.1 --mass 1 --zstop 0.04
 # The same impact with its duration measured too (0.30 s).
 case_run moon_sampler_infer_tstop infer --gravity 1.62 --speed 0.3 --diameter 0.1 --mass 1 --zstop 0.04 --tstop 0.3
-echo "wrote $out/law.json and $out/{fit,lander,lander_extrapolated,moon_sampler,mars_rock,moon_sampler_infer,moon_sampler_infer_tstop}.txt"
+echo "wrote $out/law.json and $out/{fit,lander,lander_extrapolated,moon_sampler,mars_rock,mars_meteorite,moon_sampler_infer,moon_sampler_infer_tstop}.txt"

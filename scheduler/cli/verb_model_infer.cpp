@@ -35,33 +35,41 @@ struct InferVerbOptions {
   std::string format = "table";
 };
 
-/// A value rounded to `digits` significant digits as a typed cell, or null (an empty cell in text
-/// and CSV) when `known` is false or the value is not finite.
-nlohmann::json rounded(double x, int digits, bool known = true) {
+/// A value as a typed cell: rounded to `digits` significant digits for the eye (table), at full
+/// precision for a script (`full`: csv and json), or null (an empty cell in text and CSV) when
+/// `known` is false or the value is not finite.
+nlohmann::json rounded(double x, int digits, bool full, bool known = true) {
   if (!known || !std::isfinite(x)) return nullptr;
-  return std::stod(num(x, digits));
+  return full ? x : std::stod(num(x, digits));
 }
 
-results::Table constants_table(const results::Inference& r) {
+results::Table constants_table(const results::Inference& r, bool full) {
+  const auto cell = [full](double x, int digits, bool known = true) { return rounded(x, digits, full, known); };
   results::Table t({"constant", "campaign", "prior_lo", "prior_hi", "posterior_median", "posterior_lo", "posterior_hi",
                     "interval_shrink_pct", "constrained"});
   for (const auto& c : r.constants) {
     // An unconstrained constant gets no number (null in JSON): the measurement says nothing the
     // prior did not.
     const bool say = c.constrained;
-    t.add_values({c.name, rounded(c.campaign, 4), rounded(c.prior_lo, 4), rounded(c.prior_hi, 4),
-                  rounded(c.median, 4, say), rounded(c.lo, 4, say), rounded(c.hi, 4, say), rounded(100 * c.shrink, 3),
+    t.add_values({c.name, cell(c.campaign, 4), cell(c.prior_lo, 4), cell(c.prior_hi, 4), cell(c.median, 4, say),
+                  cell(c.lo, 4, say), cell(c.hi, 4, say), cell(100 * c.shrink, 3),
                   say ? "yes" : "no: one impact does not constrain it (posterior = prior)"});
   }
   return t;
 }
 
-results::Table metrics_table(const results::Inference& r) {
+results::Table metrics_table(const results::Inference& r, bool full) {
   results::Table t(
       {"metric", "measured", "sigma_pct", "campaign_law", "posterior_median", "posterior_lo", "posterior_hi"});
-  for (const auto& m : r.metrics)
-    t.add({m.name, num(m.measured, 4), num(m.sigma_pct, 3), num(m.campaign, 4), num(m.median, 4), num(m.lo, 4),
-           num(m.hi, 4)});
+  for (const auto& m : r.metrics) {
+    if (!full) {  // the table keeps `nan` for a metric not measured
+      t.add({m.name, num(m.measured, 4), num(m.sigma_pct, 3), num(m.campaign, 4), num(m.median, 4), num(m.lo, 4),
+             num(m.hi, 4)});
+      continue;
+    }
+    t.add_values({m.name, rounded(m.measured, 0, true), rounded(m.sigma_pct, 0, true), rounded(m.campaign, 0, true),
+                  rounded(m.median, 0, true), rounded(m.lo, 0, true), rounded(m.hi, 0, true)});
+  }
   return t;
 }
 
@@ -89,9 +97,9 @@ void run_infer(const InferVerbOptions& v) {
         results::to_string(r.campaign.range));
     fmt::print("\nThe ground's constants (95 % intervals; prior: the campaign's constants, x/÷ {:g} geometric sd):\n",
                v.o.prior_width);
-    constants_table(r).print("table");
+    constants_table(r, false).print("table");
     fmt::print("\nThe measurement beside the campaign's law and the posterior's prediction:\n");
-    metrics_table(r).print("table");
+    metrics_table(r, false).print("table");
     fmt::print(
         "\nPosterior by importance sampling ({:.0f} effective samples). sigma: the law's error at this Froude "
         "number ({}) and the measurement's own, in quadrature.{}\n",
@@ -100,13 +108,13 @@ void run_infer(const InferVerbOptions& v) {
   }
   // csv and json: the constants (the table a script reads); the metrics with --format json only.
   if (v.format == "csv") {
-    constants_table(r).print("csv");
+    constants_table(r, true).print("csv");
     return;
   }
   fmt::print("{{\"constants\": ");
-  constants_table(r).print("json");
+  constants_table(r, true).print("json");
   fmt::print(", \"metrics\": ");
-  metrics_table(r).print("json");
+  metrics_table(r, true).print("json");
   fmt::print(", \"impact_froude\": {}, \"range\": \"{}\", \"effective_samples\": {:.1f}}}\n", r.campaign.froude,
              results::to_string(r.campaign.range), r.effective_samples);
 }

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,14 @@ struct PredictOptions {
   std::string plot;                 ///< PNG of the prediction against g; empty: none
   std::vector<double> plot_froude;  ///< the figure's curves at these Froude numbers (else at the speeds)
 };
+
+/// A number of the cases table: rounded to `digits` significant digits for the eye (`nan` when
+/// not finite), or at full precision for a script (csv and json; null, an empty CSV cell, when
+/// not finite), so that a prediction read back is the one computed.
+nlohmann::json number_cell(double x, int digits, bool full) {
+  if (!full) return num(x, digits);
+  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+}
 
 /// Points of the figure's g grid per decade, and how far beyond the fitted g range it reaches
 /// (a factor: past the extrapolation limit, so that the refused zone shows).
@@ -138,10 +147,11 @@ void run_predict(const PredictOptions& o) {
     }
     refused += p.range == results::LawRangeFlag::refused ? 1 : 0;
     extrapolated += p.range == results::LawRangeFlag::extrapolated ? 1 : 0;
-    t.add({num(c.gravity_m_s2), num(c.speed_m_s), num(c.diameter_m), num(c.mass_kg), num(p.froude, 3),
-           num(p.zstop_m, 4), num(p.zstop_lo_m, 4), num(p.zstop_hi_m, 4), num(p.tstop_s, 4), num(p.tstop_lo_s, 4),
-           num(p.tstop_hi_s, 4), num(p.apeak_m_s2, 4), num(p.apeak_lo_m_s2, 4), num(p.apeak_hi_m_s2, 4),
-           results::to_string(p.range), p.note});
+    const auto cell = [full = o.format != "table"](double x, int digits) { return number_cell(x, digits, full); };
+    t.add_values({cell(c.gravity_m_s2, 4), cell(c.speed_m_s, 4), cell(c.diameter_m, 4), cell(c.mass_kg, 4),
+                  cell(p.froude, 3), cell(p.zstop_m, 4), cell(p.zstop_lo_m, 4), cell(p.zstop_hi_m, 4),
+                  cell(p.tstop_s, 4), cell(p.tstop_lo_s, 4), cell(p.tstop_hi_s, 4), cell(p.apeak_m_s2, 4),
+                  cell(p.apeak_lo_m_s2, 4), cell(p.apeak_hi_m_s2, 4), results::to_string(p.range), p.note});
   }
   if (o.format == "table")
     fmt::print("Law {} ({}; fitted on {} trials at {} levels, {:.3g}-{:.3g} m/s2, Fr {:.2g}-{:.2g}):\n", law.model,

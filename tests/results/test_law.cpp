@@ -11,6 +11,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -215,6 +216,12 @@ TEST(Law, TheVerbsSaveAndPredictWithExitCodesScriptsCanTrust) {
             0u)
       << r.out;
   EXPECT_NE(r.out.find(",inside,"), std::string::npos) << r.out;
+  {  // csv at full precision: the depth read back (column 6, zstop_m) is the one the law gives
+    std::istringstream row(r.out.substr(r.out.find('\n') + 1));
+    std::string zstop;
+    for (int k = 0; k < 6; ++k) std::getline(row, zstop, ',');
+    EXPECT_EQ(std::stod(zstop), predict_case(read_law(law), {0.1, 0.3, 0.1, 1.0}).zstop_m) << r.out;
+  }
   r = gravsweep::testing::run_gravsweep("model predict --law '" + law + "' --gravity 1e-7 --speed 0.0001", true);
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("refused"), std::string::npos) << r.out;
@@ -258,8 +265,8 @@ TEST(Law, PredictDrawsTheLawAgainstGravity) {
 TEST(Law, TheWorkedExamplesMatchTheirCommittedOutputs) {
   const auto dir = std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "examples" / "mission";
   int checked = 0;
-  for (const char* name : {"lander", "lander_extrapolated", "moon_sampler", "mars_rock", "moon_sampler_infer",
-                           "moon_sampler_infer_tstop"}) {
+  for (const char* name : {"lander", "lander_extrapolated", "moon_sampler", "mars_rock", "mars_meteorite",
+                           "moon_sampler_infer", "moon_sampler_infer_tstop"}) {
     std::ifstream in(dir / (std::string(name) + ".txt"));
     ASSERT_TRUE(in.good()) << name;
     std::vector<std::string> lines;
@@ -281,7 +288,7 @@ TEST(Law, TheWorkedExamplesMatchTheirCommittedOutputs) {
     EXPECT_EQ(out, want) << name;
     ++checked;
   }
-  EXPECT_EQ(checked, 6);
+  EXPECT_EQ(checked, 7);
 }
 
 }  // namespace gravsweep::results
