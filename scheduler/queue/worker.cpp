@@ -23,6 +23,7 @@
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/exit_codes.h"
 #include "scheduler/queue/canonical.h"
+#include "scheduler/queue/worker_heartbeat.h"
 
 namespace gravsweep::queue {
 
@@ -30,15 +31,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
-
-/// True when this worker was started by a `work --workers N` supervisor that is gone.
-bool supervisor_gone() {
-  static const long supervisor = [] {
-    const char* s = std::getenv("GRAVSWEEP_SUPERVISOR_PID");
-    return s ? std::atol(s) : 0L;
-  }();
-  return supervisor > 0 && static_cast<long>(getppid()) != supervisor;
-}
 
 void sleep_interruptible(double seconds) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
@@ -134,54 +126,6 @@ bool environmental(const std::string& error, const std::string& full) {
          error.find("disk is full") != std::string::npos;
 }
 
-/// Shared between the job and its heartbeat thread.
-struct JobSignals {
-  std::mutex m;
-  std::condition_variable cv;
-  bool finished = false;
-  std::string phase = "started", detail;
-  double fraction = 0;
-  std::atomic<bool> stop{false};  // tells the runner to end early
-  std::atomic<bool> lease_lost{false};
-  std::atomic<bool> progress_saved{false};  // the runner left state the next attempt continues from
-};
-
-/// `db` is the heartbeat connection of this worker: used only by this thread while the job runs.
-void heartbeat_loop(const WorkerOptions& o, const Claim& c, JobSignals& sig, double interval_s,
-                    std::unique_ptr<db::Database>& db) {
-  auto next = std::chrono::steady_clock::now();  // first beat at once: the job has started
-  std::unique_lock lock(sig.m);
-  while (!sig.finished) {
-    if (supervisor_gone()) queue::stop_requested().store(true);
-    if (queue::stop_requested().load()) sig.stop.store(true);
-    if (std::chrono::steady_clock::now() >= next) {
-      const std::string phase = sig.phase, detail = sig.detail;
-      const double f = sig.fraction;
-      lock.unlock();
-      try {
-        if (!db) db = std::make_unique<db::Database>(o.db_path.string());
-        if (!heartbeat(*db, c, o.lease_s, f, phase, detail)) {
-          sig.lease_lost.store(true);
-          sig.stop.store(true);
-          std::fprintf(stderr, "worker %d: lease on job %s lost (another worker took it); stopping it\n",
-                       static_cast<int>(getpid()), c.job_id.c_str());
-        }
-      } catch (const std::exception& e) {
-        // A lost connection (server restarted) is made again at the next beat; the lease is fenced,
-        // so a beat after the lease expired is refused as lost.
-        const auto* dbe = dynamic_cast<const db::DbError*>(&e);
-        if (dbe && dbe->connection_lost()) db.reset();
-        std::fprintf(stderr, "worker %d: heartbeat failed (will retry): %s\n", static_cast<int>(getpid()), e.what());
-      }
-      lock.lock();
-      next = std::chrono::steady_clock::now() +
-             std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(interval_s));
-      if (sig.lease_lost.load()) return;
-    }
-    sig.cv.wait_for(lock, std::chrono::milliseconds(50), [&sig] { return sig.finished; });
-  }
-}
-
 void remove_tmp_of(const fs::path& tmp_dir, const std::string& prefix) {
   std::error_code ec;
   if (!fs::exists(tmp_dir, ec)) return;
@@ -226,7 +170,7 @@ class Worker {
   WorkerReport run() {
     long ran = 0;
     while (!queue::stop_requested().load() && (o_.max_jobs < 0 || ran < o_.max_jobs)) {
-      if (supervisor_gone()) {
+      if (detail::supervisor_gone()) {
         std::fprintf(stderr, "worker %d: its supervisor is gone; stopping\n", who_.pid);
         queue::stop_requested().store(true);
         break;
@@ -352,8 +296,9 @@ class Worker {
   Attempt run_attempt(const Claim& c) {
     Attempt a;
     a.threads = threads_for(c);
-    JobSignals sig;
-    std::thread beat(heartbeat_loop, std::cref(o_), std::cref(c), std::ref(sig), heartbeat_s_, std::ref(beat_db_));
+    detail::JobSignals sig;
+    std::thread beat(detail::heartbeat_loop, std::cref(o_), std::cref(c), std::ref(sig), heartbeat_s_,
+                     std::ref(beat_db_));
     const auto t0 = std::chrono::steady_clock::now();
     try {
       const auto runner = runners_.find(c.kind);
