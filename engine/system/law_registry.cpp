@@ -7,6 +7,7 @@
 
 #include "engine/contact/hertz_chrono.h"
 #include "engine/contact/hooke_pkdgrav.h"
+#include "engine/contact/law_concepts.h"
 #include "engine/core/error.h"
 #include "engine/core/registry.h"
 #include "engine/rolling/rolling_none.h"
@@ -20,6 +21,9 @@ namespace gravsweep {
 using ContactLaws = std::tuple<HertzChrono, HookePkdgrav>;
 using RollingModels = std::tuple<RollingNone, RollingSunday, RollingZhang>;
 // -------------------------------------------------------------------------------------------------
+
+// Each entry's row is built by a template constrained by its concept (engine/contact/law_concepts.h):
+// an entry that lacks a member is refused here, with the member named.
 
 namespace {
 
@@ -42,7 +46,7 @@ struct LawRow {
   std::array<ForceFunction, std::tuple_size_v<RollingModels>> force_with_rolling;
 };
 
-template <class Law>
+template <ContactLaw Law>
 LawRow law_row() {
   return std::apply(
       [](auto... r) {
@@ -64,13 +68,14 @@ const std::vector<LawRow>& law_rows() {
   return rows;
 }
 
+template <RollingModel Rolling>
+RollingRow rolling_row() {
+  return RollingRow{Rolling::name, Rolling::description, Rolling::uses_frame_history};
+}
+
 const std::vector<RollingRow>& rolling_rows() {
-  static const std::vector<RollingRow> rows = std::apply(
-      [](auto... r) {
-        return std::vector<RollingRow>{
-            RollingRow{decltype(r)::name, decltype(r)::description, decltype(r)::uses_frame_history}...};
-      },
-      RollingModels{});
+  static const std::vector<RollingRow> rows =
+      std::apply([](auto... r) { return std::vector<RollingRow>{rolling_row<decltype(r)>()...}; }, RollingModels{});
   return rows;
 }
 

@@ -1,10 +1,9 @@
 // The registry of contact laws and rolling models: one table each (law_registry.cpp).
 //
-// To add a contact law: write engine/contact/<name>.h with a struct that has `name`,
-// `description`, `static void prepare(PairCoefficients&)`, `static void check(const LawSetup&)`, `static double
-// shortest_contact_time_s(const LawSetup&, double v_rel_m_s)`, `static double normal_energy_J(...)` and `static void
-// evaluate(...)` (see hertz_chrono.h), then add the struct to the ContactLaws list in law_registry.cpp. A rolling model
-// is the same with `apply(...)` (see engine/rolling/) and the RollingModels list.
+// To add a contact law: write engine/contact/<name>.h with a struct that has the members of the
+// ContactLaw concept (engine/contact/law_concepts.h; see hertz_chrono.h), then add the struct to the
+// ContactLaws list in law_registry.cpp. A rolling model is the same with the RollingModel concept
+// (see engine/rolling/) and the RollingModels list. The compiler names a missing member.
 #pragma once
 #include <string>
 #include <string_view>
