@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The README's test command: installs the Debian packages, builds, runs every test (CTest labels
-# unit, physics, integration, postgres, cluster). Exit code: 0 when all pass.
+# unit, physics, model, integration, postgres, cluster). Exit code: 0 when all pass.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$root/deploy/install-deps.sh"

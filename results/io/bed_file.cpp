@@ -107,6 +107,7 @@ void write_bed(const std::filesystem::path& path, const BedData& b) {
     h5::set_attr(f.id(), "format", kBedFormat);
     h5::set_attr(f.id(), "format_version", kBedFormatVersion);
     h5visit::Writer w;
+    w.storage = h5::Storage::compressed;            // a bed is kept and shared: its arrays deflated
     visit_bed(w, f.id(), const_cast<BedData&>(b));  // the writer only reads the values
     f.close();
   });

@@ -5,8 +5,10 @@
 #pragma once
 #include <fmt/format.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -86,6 +88,7 @@ struct Rec {
 struct Writer {
   static constexpr bool kReading = false;
   ContentHash hash;
+  h5::Storage storage = h5::Storage::contiguous;  ///< of the arrays (a checkpoint: contiguous)
   h5::Handle group(hid_t parent, const char* name) { return h5::create_group(parent, name); }
   void attr(hid_t obj, const char* name, double& v) {
     h5::set_attr(obj, name, v);
@@ -103,7 +106,7 @@ struct Writer {
   void array(hid_t g, const char* name, std::vector<T>& v, const char* units, const char* description) {
     std::vector<hsize_t> dims{v.size()};
     if (Rec<T>::width > 1) dims.push_back(Rec<T>::width);
-    h5::write_raw(g, name, Rec<T>::type(), v.data(), dims, units, description);
+    h5::write_raw(g, name, Rec<T>::type(), v.data(), dims, units, description, storage);
     Rec<T>::hash(hash, v);
   }
   /// Doubles kept flat in memory, `width` a row, as an (N, width) dataset.
@@ -111,7 +114,7 @@ struct Writer {
             const char* description) {
     if (v.size() % width != 0)
       throw h5::H5Error(fmt::format("{}/{}: {} values are not rows of {}", h5::where(g), name, v.size(), width));
-    h5::write_raw(g, name, Rec<double>::type(), v.data(), {v.size() / width, width}, units, description);
+    h5::write_raw(g, name, Rec<double>::type(), v.data(), {v.size() / width, width}, units, description, storage);
     Rec<double>::hash(hash, v);
   }
 };

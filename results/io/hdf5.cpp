@@ -229,8 +229,8 @@ void write_uint8(hid_t parent, const std::string& name, const std::vector<std::u
 }
 
 void write_raw(hid_t parent, const std::string& name, hid_t type, const void* data, const std::vector<hsize_t>& dims,
-               const std::string& units, const std::string& description) {
-  write_dataset(parent, name, type, type, data, dims, units, description, Storage::contiguous);
+               const std::string& units, const std::string& description, Storage storage) {
+  write_dataset(parent, name, type, type, data, dims, units, description, storage);
 }
 
 std::vector<hsize_t> dataset_dims(hid_t parent, const std::string& name) {

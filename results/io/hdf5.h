@@ -105,11 +105,11 @@ void write_int32(hid_t parent, const std::string& name, const std::vector<std::i
 void write_uint8(hid_t parent, const std::string& name, const std::vector<std::uint8_t>& data, const std::string& units,
                  const std::string& description);
 
-/// Writes records of `type` (a native type or a compound type) straight from memory as a
-/// contiguous dataset of shape `dims`, in the file with the same type (checkpoints: no copy, no
-/// conversion). Plus "units" and "description".
+/// Writes records of `type` (a native type or a compound type) straight from memory as a dataset
+/// of shape `dims`, in the file with the same type (no copy, no conversion: the visit functions of
+/// h5_visit.h, for checkpoints contiguous, for beds compressed). Plus "units" and "description".
 void write_raw(hid_t parent, const std::string& name, hid_t type, const void* data, const std::vector<hsize_t>& dims,
-               const std::string& units, const std::string& description);
+               const std::string& units, const std::string& description, Storage storage = Storage::contiguous);
 /// The shape of dataset `name` under `parent` (throws naming the file when it is missing).
 std::vector<hsize_t> dataset_dims(hid_t parent, const std::string& name);
 /// Reads dataset `name` as records of `mem_type` into `data`, which has room for the whole

@@ -2,7 +2,7 @@
 // field table each (record_fields.h): a drop's DEM figures (depths below the bed's mean surface,
 // rest, steps, the run's setup) and a bed's preparation report. The job's JSON, its results
 // columns and the bed file's `report` attribute are made from these tables; readers (export,
-// `run`'s summary, the bed cache) read the typed records back.
+// `run`'s summary) read the typed records back.
 #pragma once
 #include <nlohmann/json.hpp>
 

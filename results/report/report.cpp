@@ -10,7 +10,10 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <cerrno>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sys/wait.h>
@@ -189,9 +192,13 @@ void write_report_data(const std::string& dir, const Campaign& c, const std::vec
   }
 }
 
-ScratchDir::ScratchDir(const std::string& tag)
-    : path(std::filesystem::temp_directory_path() / fmt::format("gravsweep-{}-{}", tag, ::getpid())) {
-  std::filesystem::create_directories(path);
+ScratchDir::ScratchDir(const std::string& tag) {
+  // A fresh folder of this process's own (mode 0700): never one that was there before, another
+  // user's or another thread's.
+  std::string pattern = (std::filesystem::temp_directory_path() / fmt::format("gravsweep-{}-XXXXXX", tag)).string();
+  if (!::mkdtemp(pattern.data()))
+    throw std::runtime_error(fmt::format("cannot create a temporary folder {}: {}", pattern, std::strerror(errno)));
+  path = pattern;
 }
 
 ScratchDir::~ScratchDir() {

@@ -30,7 +30,8 @@ void write_report_data(const std::string& dir, const Campaign& c, const std::vec
 /// and fills `log` with its output.
 int run_plots(const std::string& dir, const std::string& which, std::string& log);
 
-/// A private temporary folder for a figure's data (<tmp>/gravsweep-<tag>-<pid>), removed afterwards.
+/// A private temporary folder for a figure's data (<tmp>/gravsweep-<tag>-XXXXXX, made by mkdtemp,
+/// mode 0700: one of its own for each use, even within one process), removed afterwards.
 struct ScratchDir {
   std::filesystem::path path;
   explicit ScratchDir(const std::string& tag);

@@ -142,7 +142,10 @@ std::vector<std::string> trial_row(const std::string& job, const std::string& sw
   ti.bulk_density_kg_m3 = NAN;
   if (bed && !bed->report_json.empty()) {
     const json r = json::parse(bed->report_json, nullptr, false);
-    if (r.is_object()) ti.bulk_density_kg_m3 = results::bed_summary_of_json(r, "bed report").bulk_density_kg_m3;
+    try {  // a report this build cannot read leaves the density unknown, as a missing one does
+      if (r.is_object()) ti.bulk_density_kg_m3 = results::bed_summary_of_json(r, "bed report").bulk_density_kg_m3;
+    } catch (const std::runtime_error&) {
+    }
   }
   std::vector<std::string> row;
   for (const auto& f : results::trial_fields()) row.push_back(f.number ? num(ti.*f.number) : ti.*f.text);

@@ -166,7 +166,7 @@ Reply drop_unchecked(db::Database& db, const queue::CampaignPaths* paths, const 
   if (!is_job_id(id)) throw ApiError(404, fmt::format("'{}' is not a job id (hexadecimal digits)", id));
   const std::int64_t points = int_param(p, "points", kDefaultTracePoints, 2, kMaxTracePoints);
   queue::ResultsQuery q;
-  q.where = {"job_id=" + id};
+  q.where = {"job_id='" + id + "'"};  // quoted: an id of digits alone is still text
   q.limit = 1;
   const queue::ResultsTable t = queue::query_results(db, q);
   if (t.rows.empty()) throw ApiError(404, fmt::format("job {} has no results row (unknown, or not finished)", id));

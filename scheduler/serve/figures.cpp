@@ -25,7 +25,7 @@ struct DropFiles {
 
 DropFiles drop_files(db::Database& db, const queue::CampaignPaths& paths, const std::string& job_id) {
   queue::ResultsQuery q;
-  q.where = {"job_id=" + job_id};
+  q.where = {"job_id='" + job_id + "'"};  // quoted: an id of digits alone is still text
   q.columns = {"kind", "trace_path", "bed_job_id"};
   q.limit = 1;
   const queue::ResultsTable t = queue::query_results(db, q);
@@ -59,22 +59,33 @@ Reply DropFigures::reply(db::Database& db, const queue::CampaignPaths* paths, co
   if (which != "fig1" && which != "fig2")
     return error_reply(404, fmt::format("{}.png: the figures of a drop are fig1.png and fig2.png", which));
   if (!paths) return error_reply(404, "the campaign's files root is unknown: serve it with --files");
-  const DropFiles files = drop_files(db, *paths, job_id);
+  DropFiles files;
+  try {
+    files = drop_files(db, *paths, job_id);
+  } catch (const std::invalid_argument& e) {  // the where grammar refused the id: no such job
+    return error_reply(404, fmt::format("job {}: {}", job_id, e.what()));
+  }
   if (!files.why_not.empty()) return error_reply(404, files.why_not);
   const fs::path png = cache_->path / fmt::format("{}_{}.png", job_id, which);
-  const std::lock_guard<std::mutex> one_at_a_time(drawing_);
   std::error_code ec;
-  if (fs::exists(png, ec)) return png_reply(png);
+  if (fs::exists(png, ec)) return png_reply(png);  // drawn before: no lock needed to read it
+  if (which == "fig1" && files.bed.empty())
+    return error_reply(404, fmt::format("the bed of drop {} is not in the campaign", job_id));
+  const std::lock_guard<std::mutex> one_at_a_time(drawing_);
+  if (fs::exists(png, ec)) return png_reply(png);  // drawn while this request waited
+  // Drawn under another name and renamed: a request never reads half a PNG.
+  const fs::path tmp = cache_->path / fmt::format("{}_{}.tmp.png", job_id, which);
   try {
-    const std::lock_guard<std::mutex> hdf5(hdf5_mutex());  // the drawing reads the trace and the bed
-    if (which == "fig2") {
-      results::draw_fig2({files.trace.string(), "", png.string()});
-    } else {
-      if (files.bed.empty()) return error_reply(404, fmt::format("the bed of drop {} is not in the campaign", job_id));
-      results::draw_fig1({files.bed.string(), files.trace.string(), "", "", png.string()});
-    }
+    // results/report reads the trace and the bed with HDF5 (not thread-safe in Debian's build), then
+    // runs plots.py: the lock is held for both, a drop's figure at a time.
+    const std::lock_guard<std::mutex> hdf5(hdf5_mutex());
+    if (which == "fig2")
+      results::draw_fig2({files.trace.string(), "", tmp.string()});
+    else
+      results::draw_fig1({files.bed.string(), files.trace.string(), "", "", tmp.string()});
+    fs::rename(tmp, png);
   } catch (const std::exception& e) {  // a trace moved or unreadable, plots.py failing: the page says why
-    fs::remove(png, ec);
+    fs::remove(tmp, ec);
     return error_reply(500, fmt::format("drop {}: {} could not be drawn: {}", job_id, which, e.what()));
   }
   return png_reply(png);

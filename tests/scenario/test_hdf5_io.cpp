@@ -84,6 +84,36 @@ TEST(Hdf5Io, BedRoundTripIsBitExact) {
   EXPECT_EQ(files, 1);
 }
 
+// A bed is kept and shared by many drops: its larger arrays are deflated (chunked, shuffled), as
+// they were before its layout became one visit function; a checkpoint's stay contiguous.
+TEST(Hdf5Io, ABedsLargeArraysAreStoredCompressed) {
+  test::TempDir dir;
+  results::BedData b = sample_bed();
+  for (int i = 0; i < 3000; ++i) {  // 3,005 grains: (3005, 3) positions, 9,015 values
+    for (int k = 0; k < 3; ++k) {
+      b.position_m.push_back(0.001 * (i % 100) + 0.01 * k);
+      b.velocity_m_s.push_back(0);
+      b.omega_rad_s.push_back(0);
+    }
+    b.radius_m.push_back(0.005);
+    b.mass_kg.push_back(1.3e-3);
+    b.material.push_back(0);
+  }
+  results::write_bed(dir.path / "bed.h5", b);
+  auto f = results::h5::File::open_read(dir.path / "bed.h5");
+  auto g = results::h5::open_group(f.id(), "grains");
+  for (const char* name : {"position_m", "velocity_m_s", "omega_rad_s"}) {  // 4,096 values or more
+    const hid_t ds = H5Dopen2(g, name, H5P_DEFAULT);
+    ASSERT_GE(ds, 0) << name;
+    const hid_t plist = H5Dget_create_plist(ds);
+    EXPECT_EQ(H5Pget_layout(plist), H5D_CHUNKED) << name;
+    EXPECT_GE(H5Pget_nfilters(plist), 2) << name << ": shuffle and deflate";
+    H5Pclose(plist);
+    H5Dclose(ds);
+  }
+  EXPECT_EQ(results::read_bed(dir.path / "bed.h5").position_m, b.position_m);
+}
+
 TEST(Hdf5Io, EveryDatasetHasUnits) {
   test::TempDir dir;
   results::write_bed(dir.path / "bed.h5", sample_bed());

@@ -184,20 +184,29 @@ TEST(Serve, TheApiFollowsAWorkerAsItFinishesJobs) {
   get_json(c, "/api/drop/0123456789abcdef", 404);
   get_json(c, "/api/drop/not-a-job", 404);
 
-  // The drop's Fig. 2 and Fig. 1 as PNG images (drawn once, then served again as drawn); a no-op
-  // job has none, and a figure of another name is no page.
+  // The drop's Fig. 2 and Fig. 1 as PNG images, drawn once: with the trace moved away they are
+  // still served, as drawn. A no-op job has none, and a figure of another name is no page.
+  std::map<std::string, std::string> drawn;
+  const auto png_of = [&c](const std::string& path) {
+    const auto png = c.Get(path.c_str());
+    EXPECT_TRUE(png) << path;
+    if (!png) return std::string();
+    EXPECT_EQ(png->status, 200) << path << ": " << png->body;
+    EXPECT_EQ(png->get_header_value("Content-Type"), "image/png") << path;
+    return png->body;
+  };
   for (const char* fig : {"fig2", "fig1"}) {
     const std::string path = "/api/drop/" + drop + "/" + fig + ".png";
-    const auto png = c.Get(path.c_str());
-    ASSERT_TRUE(png) << path;
-    ASSERT_EQ(png->status, 200) << path << ": " << png->body;
-    EXPECT_EQ(png->get_header_value("Content-Type"), "image/png");
-    ASSERT_GT(png->body.size(), 10000u) << path;
-    EXPECT_EQ(png->body.substr(1, 3), "PNG") << path;
-    const auto again = c.Get(path.c_str());
-    ASSERT_TRUE(again);
-    EXPECT_EQ(again->body, png->body) << "the figure is drawn once per drop";
+    drawn[path] = png_of(path);
+    ASSERT_GT(drawn[path].size(), 10000u) << path;
+    EXPECT_EQ(drawn[path].substr(1, 3), "PNG") << path;
   }
+  const std::filesystem::path trace =
+      d.path / "c.files" / sql_text(db, "SELECT trace_path FROM results WHERE job_id='" + drop + "'");
+  ASSERT_TRUE(std::filesystem::exists(trace)) << trace;
+  std::filesystem::rename(trace, trace.string() + ".away");
+  for (const auto& [path, bytes] : drawn) EXPECT_EQ(png_of(path), bytes) << path << ": drawn again";
+  std::filesystem::rename(trace.string() + ".away", trace);
   EXPECT_NE(get_json(c, "/api/drop/" + noop + "/fig2.png", 404).value("error", "").find("not a drop"),
             std::string::npos);
   get_json(c, "/api/drop/" + drop + "/fig3.png", 404);
