@@ -89,6 +89,31 @@ Snapshot snapshot_of(const System& sys, ParticleIndex projectile, double t_s) {
   return sn;
 }
 
+BedSummary bed_summary_of(const System& sys, const BedReport& rep, const BedRestState& rest,
+                          double at_rest_for_impacts_above_m_s) {
+  BedSummary r;
+  r.grains_placed = static_cast<long long>(rep.grains_placed);
+  r.grains_kept = static_cast<long long>(rep.grains_kept);
+  r.settled = rep.settled;
+  r.settle_end = to_string(rep.settle_end);
+  r.relax_end = to_string(rep.relax_end);
+  r.settle_time_s = rep.settle_time_s;
+  r.relax_time_s = rep.relax_time_s;
+  r.quench_time_s = rep.quench_time_s;
+  r.surface_relax_s = rep.surface_relax_s;
+  r.rms_speed_m_s = rest.rms_speed_m_s;
+  r.max_speed_m_s = rest.max_speed_m_s;
+  r.max_surface_speed_m_s = rest.max_surface_speed_m_s;
+  r.surface_grains = static_cast<long long>(rest.surface_grains);
+  if (std::isfinite(at_rest_for_impacts_above_m_s)) r.at_rest_for_impacts_above_m_s = at_rest_for_impacts_above_m_s;
+  r.surface_height_m = rep.surface_height_m;
+  r.bulk_density_kg_m3 = rep.bulk_density_kg_m3;
+  r.steps = sys.step_count();
+  r.dt_s = sys.config().dt_s;
+  r.threads = sys.threads();
+  return r;
+}
+
 DemFigures dem_figures_of(const TraceData& td, const DropResult& dr, const BedData& bed,
                           std::optional<double> t_start_s, double lateral_offset_m) {
   DemFigures d;

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <optional>
 
+#include "engine/scenario/bed.h"
 #include "engine/scenario/impact.h"
 #include "engine/system/system.h"
 #include "results/io/bed_file.h"
@@ -30,6 +31,11 @@ TraceData trace_columns_of(const DropResult& dr, double nominal_rate_hz);
 /// One grain snapshot: every particle before `projectile` as a grain (the bed's order), the
 /// projectile as its own point set.
 Snapshot snapshot_of(const System& sys, ParticleIndex projectile, double t_s);
+
+/// The report of a prepared bed from the preparation's report and the bed's rest state;
+/// `at_rest_for_impacts_above_m_s` infinite: none. The wall time and checkpoint counts are the job's.
+BedSummary bed_summary_of(const System& sys, const BedReport& rep, const BedRestState& rest,
+                          double at_rest_for_impacts_above_m_s);
 
 /// The DEM figures of a drop from its trace (depths below the bed's surface), its result and the
 /// bed; `t_start_s` is the paper's collision start (none: duration_to_rest_s is absent).

@@ -124,27 +124,7 @@ BedJobResult write_prepared_bed(const System& sys, const BedReport& rep, const S
   b.code_version = pipeline::build_version();
   b.bed_key_json = bed_key_of_validated(s).dump();
   b.scenario_json = s.dump();
-  results::BedSummary r;
-  r.grains_placed = static_cast<long long>(rep.grains_placed);
-  r.grains_kept = static_cast<long long>(rep.grains_kept);
-  r.settled = rep.settled;
-  r.settle_end = to_string(rep.settle_end);
-  r.relax_end = to_string(rep.relax_end);
-  r.settle_time_s = rep.settle_time_s;
-  r.relax_time_s = rep.relax_time_s;
-  r.quench_time_s = rep.quench_time_s;
-  r.surface_relax_s = rep.surface_relax_s;
-  r.rms_speed_m_s = rest.rms_speed_m_s;
-  r.max_speed_m_s = rest.max_speed_m_s;
-  r.max_surface_speed_m_s = rest.max_surface_speed_m_s;
-  r.surface_grains = static_cast<long long>(rest.surface_grains);
-  if (const double v = slowest_impact_at_rest_m_s(rest, p.at_rest); std::isfinite(v))
-    r.at_rest_for_impacts_above_m_s = v;
-  r.surface_height_m = rep.surface_height_m;
-  r.bulk_density_kg_m3 = rep.bulk_density_kg_m3;
-  r.steps = sys.step_count();
-  r.dt_s = sys.config().dt_s;
-  r.threads = sys.threads();
+  results::BedSummary r = results::bed_summary_of(sys, rep, rest, slowest_impact_at_rest_m_s(rest, p.at_rest));
   r.wall_time_s = wall_s;
   results::set_checkpoint_counts(r, ckpt.counts());
   b.report_json = results::to_json(r).dump();
