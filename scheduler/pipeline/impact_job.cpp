@@ -267,17 +267,17 @@ results::TraceData trace_of(const DropResult& dr, const ScenarioParams& p, const
 
 /// Sect. 2.3 through the one processing entry (results::process_trial): the trial's facts from
 /// the trace (fill height = the measured surface height) and the scenario's /output settings,
-/// exactly as a campaign reading this trace back measures it. Nulls and metrics_error when the
-/// trace cannot be measured.
-json paper_metrics(const results::TraceData& td, const std::filesystem::path& trace_out) {
+/// exactly as a campaign reading this trace back measures it; `error` says why there are none
+/// (a trace that cannot be measured).
+std::optional<results::Metrics> paper_metrics(const results::TraceData& td, const std::filesystem::path& trace_out,
+                                              std::string& error) {
   try {
     results::MeasuredTrial trial = results::dem_trial_of(td, {"", "", trace_out});
     results::process_trial(trial);
-    return json(trial.processed.metrics);
+    return trial.processed.metrics;
   } catch (const std::exception& e) {
-    json m = results::null_metrics_json();
-    m["metrics_error"] = e.what();
-    return m;
+    error = e.what();
+    return std::nullopt;
   }
 }
 
@@ -316,9 +316,12 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   const double wall_s = seconds_since(t0) + ckpt.prior_wall_time_s();
 
   results::TraceData td = trace_of(dr, p, s, bed, bed_in);
-  json m = paper_metrics(td, trace_out);
-  const std::optional<double> t_start =
-      m["t_start_s"].is_number() ? std::optional<double>(m["t_start_s"].get<double>()) : std::nullopt;
+  std::string metrics_error;
+  const std::optional<results::Metrics> metrics = paper_metrics(td, trace_out, metrics_error);
+  // Nulls and metrics_error when the trace cannot be measured.
+  json m = metrics ? json(*metrics) : results::null_metrics_json();
+  if (!metrics) m["metrics_error"] = metrics_error;
+  const std::optional<double> t_start = metrics ? std::optional<double>(metrics->t_start_s) : std::nullopt;
   results::DemFigures dem = results::dem_figures_of(
       td, dr, bed, t_start, std::hypot(p.projectile.lateral_offset_x_m, p.projectile.lateral_offset_y_m));
   dem.threads = sys.threads();
