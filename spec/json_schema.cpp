@@ -163,6 +163,14 @@ std::string type_name(const json& v) {
   }
 }
 
+bool is_exact_integer(const json& v) {
+  constexpr double kExactIntegers = 9007199254740992.0;  // 2^53
+  if (v.is_number_integer()) return true;
+  if (!v.is_number_float()) return false;
+  const double d = v.get<double>();
+  return std::isfinite(d) && std::floor(d) == d && std::abs(d) < kExactIntegers;
+}
+
 std::string shown_value(const json& v) {
   std::string s = v.dump();
   if (s.size() > 80) s = s.substr(0, 77) + "...";

@@ -58,6 +58,10 @@ class SpecError : public ConfigError {
 /// The JSON type of `v` as messages name it: null, boolean, integer, number, string, array, object.
 std::string type_name(const nlohmann::json& v);
 
+/// An integer, or a float with an integral value that a double holds exactly (|v| < 2^53): a value
+/// a spec may give where a count or an integer axis is meant (`3` and `3.0` alike).
+bool is_exact_integer(const nlohmann::json& v);
+
 /// `v` as a problem shows it: compact JSON (cut at 80 characters) and its JSON type, `"1.62" (string)`.
 std::string shown_value(const nlohmann::json& v);
 

@@ -9,6 +9,7 @@
 #include "scheduler/queue/canonical.h"
 #include "scheduler/sweep/sweep_kind.h"
 #include "spec/json_pointer.h"
+#include "spec/json_schema.h"
 
 namespace gravsweep::sweep {
 
@@ -16,10 +17,9 @@ using nlohmann::json;
 
 namespace {
 
+/// A whole number from 0 to `most`.
 bool is_count(const json& v, double most) {
-  if (!v.is_number()) return false;
-  const double d = v.get<double>();
-  return std::isfinite(d) && std::floor(d) == d && d >= 0 && d <= most;
+  return spec::is_exact_integer(v) && v.get<double>() >= 0 && v.get<double>() <= most;
 }
 
 /// Problems of a no-op job's scenario at `ptr`: sleep_s and fail_attempts are what the no-op

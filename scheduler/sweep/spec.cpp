@@ -15,6 +15,7 @@
 
 #include "scheduler/queue/canonical.h"
 #include "spec/json_pointer.h"
+#include "spec/json_schema.h"
 #include "spec/schemas.h"
 
 namespace gravsweep::sweep {
@@ -33,15 +34,6 @@ namespace {
 
 std::string join(const std::string& ptr, const std::string& token) { return spec::pointer_child(ptr, token); }
 std::string join(const std::string& ptr, std::size_t i) { return ptr + "/" + std::to_string(i); }
-
-bool is_int(const json& v) {
-  if (v.is_number_integer()) return true;
-  if (v.is_number_float()) {
-    const double d = v.get<double>();
-    return std::isfinite(d) && std::floor(d) == d && std::abs(d) < 9007199254740992.0;
-  }
-  return false;
-}
 
 using spec::Problems;
 
@@ -87,7 +79,8 @@ std::optional<std::vector<json>> range_values(const json& r, const std::string& 
     ck.add(join(rp, "step"), r["step"], "a step giving at most 1000000 values");
     return std::nullopt;
   }
-  const bool ints = is_int(r["start"]) && is_int(r["stop"]) && is_int(r["step"]) && integer_base;
+  const bool ints = spec::is_exact_integer(r["start"]) && spec::is_exact_integer(r["stop"]) &&
+                    spec::is_exact_integer(r["step"]) && integer_base;
   for (long i = 0; i < static_cast<long>(n); ++i) {
     const double v = queue::round_decimal(start + static_cast<double>(i) * step);
     values.push_back(ints ? json(static_cast<std::int64_t>(std::llround(v))) : json(v));
@@ -103,7 +96,7 @@ std::optional<std::vector<json>> repeat_values(const json& a, const std::string&
   if (base_value && base_value->is_number_integer()) {
     bool ok = true;
     for (const char* k : {"start", "step"})
-      if (!is_int(a[k])) {
+      if (!spec::is_exact_integer(a[k])) {
         ck.add(join(ptr, k), a[k],
                fmt::format("an integer like the base value at {} ({})", pointer, base_value->dump()));
         ok = false;
@@ -111,7 +104,7 @@ std::optional<std::vector<json>> repeat_values(const json& a, const std::string&
     if (!ok) return std::nullopt;
   }
   std::vector<json> values;
-  const bool ints = is_int(start) && is_int(step);
+  const bool ints = spec::is_exact_integer(start) && spec::is_exact_integer(step);
   for (long i = 0; i < a["count"].get<long>(); ++i) {
     if (ints)
       values.emplace_back(static_cast<std::int64_t>(std::llround(start.get<double>())) +
