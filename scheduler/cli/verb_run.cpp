@@ -83,7 +83,8 @@ double snapshot_interval(const RunOptions& o, const nlohmann::json& validated) {
   const auto raw = nlohmann::json::parse(f, nullptr, false);
   const auto ptr = "/output/snapshot_interval_s"_json_pointer;
   if (raw.is_object() && raw.contains(ptr) && raw[ptr].is_number()) return raw[ptr].get<double>();
-  const double D = validated["/projectile/diameter_m"_json_pointer], g = validated["gravity_m_s2"];
+  const pipeline::Scenario s = pipeline::scenario_of(validated);
+  const double D = s.projectile.diameter_m, g = s.gravity_m_s2;
   return kRunSnapshotInterval_sqrt_D_g * std::sqrt(D / g);
 }
 

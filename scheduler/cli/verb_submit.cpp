@@ -132,7 +132,8 @@ void print_memory(const Planned& p) {
   double most = 0, grains = 0;
   for (const auto& j : p.jobs) {
     if (j.kind != sweep::bed_kind()) continue;  // a drop loads its bed: the same bound
-    const auto s = nlohmann::json::parse(j.scenario_json);
+    const pipeline::Scenario s =
+        pipeline::scenario_of(pipeline::StoredScenario::parse(nlohmann::json::parse(j.scenario_json)).validated);
     if (pipeline::job_memory_bytes(s) > most)
       most = pipeline::job_memory_bytes(s), grains = pipeline::bed_grain_bound(s);
   }

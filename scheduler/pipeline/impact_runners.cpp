@@ -34,17 +34,15 @@ Checkpointing checkpointing_of(const RunContext& ctx) {
 /// --max-memory` allows (ConfigError: permanent), whatever its validation mark says.
 void check_memory(const RunContext& ctx) {
   if (!(ctx.max_memory_bytes > 0)) return;
-  const nlohmann::json s = job_scenario(ctx.claim.scenario);
+  const Scenario s = job_scenario_record(ctx.claim.scenario);
   const double need = job_memory_bytes(s);
   if (need > ctx.max_memory_bytes)
     throw ConfigError(fmt::format(
         "job {}: its bed (/grains/diameter_m {:g} m in /container/diameter_m {:g} m filled to "
         "/container/fill_height_m {:g} m: up to {:.3g} grains) needs about {:.3g} MB, above work --max-memory "
         "{:.3g} MB",
-        ctx.claim.job_id, s.at("/grains/diameter_m"_json_pointer).get<double>(),
-        s.at("/container/diameter_m"_json_pointer).get<double>(),
-        s.at("/container/fill_height_m"_json_pointer).get<double>(), bed_grain_bound(s), need / 1048576.0,
-        ctx.max_memory_bytes / 1048576.0));
+        ctx.claim.job_id, s.grains.diameter_m, s.container.diameter_m, s.container.fill_height_m, bed_grain_bound(s),
+        need / 1048576.0, ctx.max_memory_bytes / 1048576.0));
 }
 
 }  // namespace
@@ -58,7 +56,7 @@ sweep::PointCheckFn impact_point_check() {
     // what it runs: a worker of an older build then runs every other job as before.
     nlohmann::json as_written = id_point(current, validated);
     if (!as_written.contains("defaults_version")) validated.erase("defaults_version");
-    std::string stored = stored_scenario(std::move(validated), as_written).dump();
+    std::string stored = StoredScenario::of_this_build(std::move(validated), as_written).to_json().dump();
     return sweep::CheckedPoint{std::move(stored), std::move(key), std::move(as_written)};
   };
 }

@@ -6,7 +6,7 @@
 
 namespace gravsweep::pipeline {
 
-/// Validates a sweep point once, at submit: the text its jobs store (stored_scenario: validated,
+/// Validates a sweep point once, at submit: the text its jobs store (StoredScenario: validated,
 /// marked, with the point as written), its bed key (drops with equal keys share a bed) and what its
 /// id is computed from (id_point: its defaults version where that changes what it runs).
 sweep::PointCheckFn impact_point_check();

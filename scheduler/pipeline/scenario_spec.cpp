@@ -48,8 +48,10 @@ void engine_checks(const json& s, Checks& ck) {
   const double spread = s["/grains/diameter_spread_m"_json_pointer];
   const double rho = s["/grains/density_kg_m3"_json_pointer];
   const double r_min = 0.5 * (d - spread);
+  const ContactSettings contact = contact_settings_of(s.at("contact"));
   auto build = [&](double dt, const json& materials) {
-    SystemConfig c = detail::base_config(s, materials);
+    SystemConfig c = detail::base_config(contact, material_set_of(materials), s.at("integrator").get<std::string>(),
+                                         s.at("threads").get<int>());
     c.dt_s = dt;
     System sys(c);
     sys.particles.add(Vec3(0, 0, 1), r_min, sphere_mass_kg(rho, 2 * r_min), kGrainMaterial, SizeClass::grain);
@@ -173,7 +175,7 @@ void check_size_and_steps(Checks& ck) {
   });
   ck.run([&] {
     const double g = ck.num("/gravity_m_s2"), D = ck.num("/projectile/diameter_m");
-    const double max_time_s = drop_stop(ck.at("/stop"), g, D).max_time_s;
+    const double max_time_s = drop_stop(stop_settings_of(ck.at("/stop")), g, D).max_time_s;
     const double steps = max_time_s / ck.num("/dt_s");
     if (steps > kMaxSteps)
       ck.bad("/dt_s", fmt::format("{:g}", ck.num("/dt_s")),
@@ -295,33 +297,54 @@ bool validation_is_named() {
   return named;
 }
 
-json stored_scenario(json validated, json as_written) {
-  validated[kValidatedByKey] = validated_by();
-  validated[kAsWrittenKey] = std::move(as_written);
-  return validated;
+StoredScenario StoredScenario::of_this_build(json validated, json as_written) {
+  return {std::move(validated), pipeline::validated_by(), std::move(as_written)};
+}
+
+StoredScenario StoredScenario::parse(const json& stored) {
+  StoredScenario out{stored, std::nullopt, std::nullopt};
+  if (!stored.is_object()) return out;  // validate_scenario says what it expected
+  if (const auto it = stored.find(kValidatedByKey); it != stored.end()) {
+    if (!it->is_string())
+      throw SpecError("stored scenario",
+                      {{std::string("/") + kValidatedByKey, it->dump(), "a build's validation mark"}});
+    out.validated_by = it->get<std::string>();
+    out.validated.erase(kValidatedByKey);
+  }
+  if (const auto it = stored.find(kAsWrittenKey); it != stored.end()) {
+    out.as_written = *it;
+    out.validated.erase(kAsWrittenKey);
+  }
+  return out;
+}
+
+json StoredScenario::to_json() const {
+  json s = validated;
+  if (validated_by) s[kValidatedByKey] = *validated_by;
+  if (as_written) s[kAsWrittenKey] = *as_written;
+  return s;
 }
 
 json job_scenario(const json& stored) {
-  if (!stored.is_object() || !stored.contains(kValidatedByKey)) return validate_scenario(stored);
-  const bool trusted = stored.at(kValidatedByKey) == validated_by() && validation_is_named();
-  if (!trusted && stored.contains(kAsWrittenKey)) return validate_scenario(stored.at(kAsWrittenKey));
-  json s = stored;
-  s.erase(kValidatedByKey);
-  s.erase(kAsWrittenKey);  // no-op when absent
+  const StoredScenario st = StoredScenario::parse(stored);
+  if (!st.validated_by) return validate_scenario(st.validated);  // unmarked: stored before marks
+  const bool trusted = *st.validated_by == validated_by() && validation_is_named();
+  if (!trusted && st.as_written) return validate_scenario(*st.as_written);
   // Trusted or marked by a build that stored no point as written: the stored scenario, checked
   // again (validating a validated scenario returns it unchanged).
-  return validate_scenario(s);
+  return validate_scenario(st.validated);
 }
+
+Scenario job_scenario_record(const json& stored) { return scenario_of(job_scenario(stored)); }
 
 json load_scenario(const std::filesystem::path& path) {
   return validate_scenario(with_current_defaults(spec::read_spec_file(path, spec::Schema::scenario)), path.string());
 }
 
-double bed_grain_bound(const json& s) {
-  const auto at = [&](const char* p) { return s.at(json::json_pointer(p)).get<double>(); };
-  return grain_bound(at("/grains/diameter_m"), at("/container/diameter_m"), at("/container/fill_height_m"));
+double bed_grain_bound(const Scenario& s) {
+  return grain_bound(s.grains.diameter_m, s.container.diameter_m, s.container.fill_height_m);
 }
 
-double job_memory_bytes(const json& s) { return bed_grain_bound(s) * kBytesPerGrain; }
+double job_memory_bytes(const Scenario& s) { return bed_grain_bound(s) * kBytesPerGrain; }
 
 }  // namespace gravsweep::pipeline

@@ -3,11 +3,13 @@
 #pragma once
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "engine/scenario/bed.h"
 #include "engine/scenario/impact.h"
 #include "engine/system/system.h"
+#include "scheduler/pipeline/scenario.h"
 #include "spec/json_schema.h"
 
 namespace gravsweep::pipeline {
@@ -23,20 +25,35 @@ using spec::SpecProblem;
 /// expected; a rule that needs a field already found bad is skipped rather than reported twice.
 nlohmann::json validate_scenario(const nlohmann::json& scenario, const std::string& source = "scenario");
 
-/// The keys under which a job's stored scenario names the validation it passed (the build and the
-/// scenario schema's SHA-256, validated_by()) and keeps the point as the sweep wrote it.
-inline constexpr const char* kValidatedByKey = "$validated_by";
-inline constexpr const char* kAsWrittenKey = "$as_written";
 /// This build's validation: "<build version> schema:<first 12 hex of the schema's SHA-256>".
 const std::string& validated_by();
 /// False when validated_by() does not name one build's rules: a build with uncommitted changes
 /// ("-dirty") or outside a git checkout ("+unknown"), which other such builds share. Its marks are
 /// never trusted: its workers validate every job again.
 bool validation_is_named();
-/// A validated scenario as a queue job stores it (sweep expansion at submit): marked with
-/// validated_by(), which tells a worker of the same build that the stored defaults are its own, and
-/// carrying the point as written, which another build validates with its own rules and defaults.
-nlohmann::json stored_scenario(nlohmann::json validated, nlohmann::json as_written);
+
+/// A job's stored scenario: the scenario validated at submit, the validation it passed (which
+/// tells a worker of the same build that the stored defaults are its own) and the point as the
+/// sweep wrote it (which another build validates with its own rules and defaults). Stored as one
+/// JSON object, the validated scenario with the two marks as keys beside its fields, the form
+/// every job has had since submit validated scenarios; a job stored before has neither mark.
+struct StoredScenario {
+  /// The keys of the marks in the stored object.
+  static constexpr const char* kValidatedByKey = "$validated_by";
+  static constexpr const char* kAsWrittenKey = "$as_written";
+
+  nlohmann::json validated;                  ///< as validate_scenario returned it
+  std::optional<std::string> validated_by;   ///< absent: a job stored unmarked
+  std::optional<nlohmann::json> as_written;  ///< absent: unmarked, or a build that kept none
+
+  /// Marked by this build (validated_by()), with the point as written (sweep expansion at submit).
+  static StoredScenario of_this_build(nlohmann::json validated, nlohmann::json as_written);
+  /// The parts of a stored object (a mark of the wrong type is a SpecError naming its key).
+  static StoredScenario parse(const nlohmann::json& stored);
+  /// The stored object.
+  [[nodiscard]] nlohmann::json to_json() const;
+};
+
 /// The validated scenario of a job (what validate_scenario returns, without the keys above): the
 /// stored one, checked again, when this build validated it at submit (and validation_is_named()),
 /// else the point as written validated now (a job submitted by another build; one that stored no
@@ -46,16 +63,18 @@ nlohmann::json stored_scenario(nlohmann::json validated, nlohmann::json as_writt
 /// checks that bound a job's resources and types; they take milliseconds, a job minutes.
 /// Throws as validate_scenario (a SpecError naming the field's JSON pointer: a permanent failure).
 nlohmann::json job_scenario(const nlohmann::json& stored);
+/// The typed record of a job's scenario: scenario_of(job_scenario(stored)).
+Scenario job_scenario_record(const nlohmann::json& stored);
 
 /// Memory per grain of a bed in the engine (state, Verlet pairs with their contact histories,
 /// per-thread force buffers): a bound, measured at 1.1-1.6 kB on the paper's and the sweep's beds.
 inline constexpr double kBytesPerGrain = 2048;
 /// The most grains a validated (or stored) scenario's bed can hold while it is poured: random close
 /// packing (0.64) of the fill, twice over for the lattice poured above the fill height.
-double bed_grain_bound(const nlohmann::json& validated);
+double bed_grain_bound(const Scenario& s);
 /// The memory a bed or drop job of that scenario needs at most (bytes): bed_grain_bound grains at
 /// kBytesPerGrain. `work --max-memory` refuses a job above its limit, `submit --dry-run` prints it.
-double job_memory_bytes(const nlohmann::json& validated);
+double job_memory_bytes(const Scenario& s);
 
 /// How many times validation has run the engine's own checks (each builds an engine System four
 /// times) in this process: once per distinct set of the fields they read, not once per scenario.
@@ -65,21 +84,21 @@ std::size_t engine_check_runs();
 /// file that names no /defaults_version takes the current defaults (scenario_defaults.h).
 nlohmann::json load_scenario(const std::filesystem::path& path);
 
-/// The drop's stop criterion from a validated /stop: each quantity absolute when given, else in
-/// the drop's scales (speed in sqrt(g D), time in sqrt(D/g); scenario.schema.json, /stop).
-DropStop drop_stop(const nlohmann::json& stop, double gravity_m_s2, double projectile_diameter_m);
+/// The drop's stop criterion from /stop: each quantity absolute when given, else in the drop's
+/// scales (speed in sqrt(g D), time in sqrt(D/g); scenario.schema.json, /stop).
+DropStop drop_stop(const StopSettings& stop, double gravity_m_s2, double projectile_diameter_m);
 
 /// The drop's rolling-friction regularisation speed (/rolling_threshold): Chrono's value at
 /// 9.81 m/s2 scaled by sqrt(g / 9.81), or the absolute value given.
-double drop_min_roll_vel_m_s(const nlohmann::json& validated);
+double drop_min_roll_vel_m_s(const Scenario& s);
 
 /// The impact speed the bed must be at rest for (/at_rest): impact_speed_m_s, or for a release
 /// from rest sqrt(2 g h) with h the drop height (at least one grain diameter).
-double reference_impact_speed_m_s(const nlohmann::json& validated);
+double reference_impact_speed_m_s(const Scenario& s);
 
 /// The seed of the drop's random start: /projectile/seed mixed with the sweep point (gravity,
 /// projectile incl. its speed or drop height, grains, container) unless site_draw is "seed".
-std::uint64_t site_seed(const nlohmann::json& validated);
+std::uint64_t site_seed(const Scenario& s);
 
 /// The bed's residual grain speeds a drop accepts, relative to its impact speed (/at_rest).
 struct AtRestCriterion {
@@ -104,6 +123,8 @@ struct ScenarioParams {
   double snapshot_interval_s = 0;  ///< /output/snapshot_interval_s: grain snapshots, 0 = none
 };
 
+/// The engine's inputs from the typed scenario, or from a validated one (read by scenario_of).
+ScenarioParams scenario_params(const Scenario& s);
 ScenarioParams scenario_params(const nlohmann::json& validated);
 
 }  // namespace gravsweep::pipeline

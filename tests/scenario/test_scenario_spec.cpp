@@ -358,9 +358,9 @@ TEST(ScenarioSpec, TheAdaptiveStepsSpeedBoundIsOptionalAndNamed) {
 TEST(ScenarioSpec, AScenarioValidatedAtSubmitIsCheckedAgainByTheWorker) {
   const json written = minimal();
   const json validated = validate_scenario(written);
-  const json stored = pipeline::stored_scenario(validated, written);
-  EXPECT_EQ(stored.at(pipeline::kValidatedByKey), pipeline::validated_by());
-  EXPECT_EQ(stored.at(pipeline::kAsWrittenKey), written);
+  const json stored = pipeline::StoredScenario::of_this_build(validated, written).to_json();
+  EXPECT_EQ(stored.at(pipeline::StoredScenario::kValidatedByKey), pipeline::validated_by());
+  EXPECT_EQ(stored.at(pipeline::StoredScenario::kAsWrittenKey), written);
   EXPECT_EQ(pipeline::job_scenario(stored), validated);  // the two keys removed, nothing else changed
   // A stored value broken after submit (the database is a trust boundary) is refused whatever the
   // mark says, naming its field: a permanent failure, not a retry. A string where a number
@@ -389,16 +389,16 @@ TEST(ScenarioSpec, AScenarioValidatedAtSubmitIsCheckedAgainByTheWorker) {
     EXPECT_EQ(pipeline::job_scenario(typo), validated);
   }
   // Another build's mark: the point as written is validated, not the stored defaults.
-  broken[pipeline::kValidatedByKey] = "0.0.0+another schema:000000000000";
+  broken[pipeline::StoredScenario::kValidatedByKey] = "0.0.0+another schema:000000000000";
   EXPECT_EQ(pipeline::job_scenario(broken), validated);
-  broken[pipeline::kAsWrittenKey]["dt_s"] = -1;
+  broken[pipeline::StoredScenario::kAsWrittenKey]["dt_s"] = -1;
   EXPECT_THROW((void)pipeline::job_scenario(broken), SpecError);
   // Another build's mark without a point as written (builds that stored only the mark): the stored
   // scenario is validated again, without the mark; a bad stored value is a SpecError, not a
   // missing-key error.
   json mark_only = stored;
-  mark_only[pipeline::kValidatedByKey] = "0.0.0+another schema:000000000000";
-  mark_only.erase(pipeline::kAsWrittenKey);
+  mark_only[pipeline::StoredScenario::kValidatedByKey] = "0.0.0+another schema:000000000000";
+  mark_only.erase(pipeline::StoredScenario::kAsWrittenKey);
   EXPECT_EQ(pipeline::job_scenario(mark_only), validated);
   mark_only["dt_s"] = -1;
   EXPECT_THROW((void)pipeline::job_scenario(mark_only), SpecError);

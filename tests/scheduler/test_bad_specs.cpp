@@ -213,9 +213,9 @@ TEST(BadSpecs, ATamperedStoredScenarioIsRefusedAtOnceNamingItsField) {
     ASSERT_TRUE(q.step());
     const std::string job = q.get_text(0);
     json s = json::parse(q.get_text(1));
-    s["container"]["diameter_m"] = 1000.0;    // the validated scenario, and the point as written (a
-    if (s.contains(pipeline::kAsWrittenKey))  // build with uncommitted changes trusts no mark)
-      s[pipeline::kAsWrittenKey]["container"]["diameter_m"] = 1000.0;
+    s["container"]["diameter_m"] = 1000.0;                    // the validated scenario, and the point as written (a
+    if (s.contains(pipeline::StoredScenario::kAsWrittenKey))  // build with uncommitted changes trusts no mark)
+      s[pipeline::StoredScenario::kAsWrittenKey]["container"]["diameter_m"] = 1000.0;
     db::Statement u(db, "UPDATE jobs SET scenario_json = ? WHERE job_id = ?");
     u.bind(1, s.dump());
     u.bind(2, job);

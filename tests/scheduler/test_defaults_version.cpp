@@ -59,8 +59,9 @@ TEST(DefaultsVersion, AScenarioThatNamesVersionOneOrNoneKeepsTheFixedStep) {
   EXPECT_FALSE(new_scenario(v1).contains("time_step"));
   // A job stored before versions existed: its point as written names none, and means version 1.
   EXPECT_FALSE(pipeline::validate_scenario(point(0.01)).contains("time_step"));
-  json stored = pipeline::stored_scenario(pipeline::validate_scenario(point(0.01)), point(0.01));
-  stored[pipeline::kValidatedByKey] = "another build";
+  json stored =
+      pipeline::StoredScenario::of_this_build(pipeline::validate_scenario(point(0.01)), point(0.01)).to_json();
+  stored[pipeline::StoredScenario::kValidatedByKey] = "another build";
   EXPECT_FALSE(pipeline::job_scenario(stored).contains("time_step")) << "revalidated by a newer build";
 }
 
@@ -118,7 +119,7 @@ TEST(DefaultsVersion, ALowGravitySweepWithoutAStepGetsNewIdsAndPinningVersionOne
   for (const auto& j : sweep::expand(pinned, impact()))
     if (j.kind == sweep::drop_kind()) {
       const json stored = json::parse(j.scenario_json);
-      json as_written = stored.at(pipeline::kAsWrittenKey);
+      json as_written = stored.at(pipeline::StoredScenario::kAsWrittenKey);
       as_written.erase("defaults_version");
       EXPECT_EQ(j.job_id, queue::job_id(queue::kind_name(j.kind), as_written));
       EXPECT_FALSE(stored.contains("time_step"));
@@ -136,7 +137,7 @@ TEST(DefaultsVersion, AJobNamesItsVersionOnlyWhereItChangesWhatItRuns) {
   const auto spec = sweep::load_spec(fs::path(GRAVSWEEP_SOURCE_DIR) / "examples/gravity_sweep/g0.01_axis.json");
   for (const auto& j : sweep::expand(spec, impact())) {
     const json stored = json::parse(j.scenario_json);
-    EXPECT_FALSE(stored.at(pipeline::kAsWrittenKey).contains("defaults_version")) << j.job_id;
+    EXPECT_FALSE(stored.at(pipeline::StoredScenario::kAsWrittenKey).contains("defaults_version")) << j.job_id;
     EXPECT_FALSE(stored.contains("defaults_version")) << j.job_id;
   }
 }

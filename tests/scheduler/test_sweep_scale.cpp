@@ -53,9 +53,9 @@ TEST(SweepScale, EngineChecksRunOncePerDistinctSetupNotPerPoint) {
   // the id of the point as written; the bed job stores its first drop's.
   for (const auto& job : jobs) {
     const json stored = json::parse(job.scenario_json);
-    EXPECT_EQ(stored.at(pipeline::kValidatedByKey), pipeline::validated_by());
+    EXPECT_EQ(stored.at(pipeline::StoredScenario::kValidatedByKey), pipeline::validated_by());
     EXPECT_TRUE(stored.contains("at_rest")) << "a default the base does not write";
-    EXPECT_FALSE(stored.at(pipeline::kAsWrittenKey).contains("at_rest")) << "the point as written";
+    EXPECT_FALSE(stored.at(pipeline::StoredScenario::kAsWrittenKey).contains("at_rest")) << "the point as written";
   }
 }
 
