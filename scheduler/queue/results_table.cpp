@@ -141,9 +141,13 @@ void declare_output_columns_of_jobs(Database& db) {
     const bool lacks = std::any_of(info.outputs.begin(), info.outputs.end(),
                                    [&](const OutputField& o) { return !has_column_for(o, cols); });
     if (!info.results_row || !lacks) continue;
-    Statement st(db, "SELECT 1 FROM jobs WHERE kind=? LIMIT 1");
-    st.bind(1, info.name);
-    if (st.step()) declare_output_columns(db, k);
+    bool has_jobs = false;
+    {  // finished before the columns change (SQLite drops no table under an open statement)
+      Statement st(db, "SELECT 1 FROM jobs WHERE kind=? LIMIT 1");
+      st.bind(1, info.name);
+      has_jobs = st.step();
+    }
+    if (has_jobs) declare_output_columns(db, k);
   }
 }
 
