@@ -27,6 +27,8 @@ struct RecordField {
   long long R::*count = nullptr;
   bool R::*flag = nullptr;
   std::string R::*text = nullptr;
+  /// Its column type where a job's results row holds it: REAL, INTEGER (counts, flags) or TEXT.
+  [[nodiscard]] const char* sql_type() const { return number || maybe ? "REAL" : count || flag ? "INTEGER" : "TEXT"; }
 };
 
 /// Every field of r, in the table's order (an absent number as null).

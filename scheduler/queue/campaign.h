@@ -44,7 +44,8 @@ std::string files_rel(const std::string& stored);
 void migrate_paths(db::Database& db);
 
 /// Adds the columns a campaign written by an earlier gravsweep lacks (jobs.blocked_by, filled from
-/// the earlier message form once), in one transaction. Schema version 2 either way.
+/// the earlier message form once; the results columns the kinds of its jobs declare), in one
+/// transaction. Schema version 2 either way.
 void add_missing_columns(db::Database& db);
 
 // ---- the files root's marker ---------------------------------------------------------------------

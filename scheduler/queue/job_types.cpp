@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <deque>
 #include <mutex>
@@ -13,10 +14,16 @@ namespace gravsweep::queue {
 
 namespace {
 
+/// The no-op kind's row: its runner (scheduler/sweep/noop_kind.cpp) echoes the point's `value`
+/// and reports the time it slept.
+JobKindInfo noop_row() {
+  return {"noop", "noop", ".json", true, false, {{"noop_value", "1", "REAL"}, {"sleep_s", "s", "REAL"}}};
+}
+
 /// The table of kinds: rows are only appended (JobKind is an index), so references stay valid.
 struct KindTable {
   std::mutex mutex;
-  std::deque<JobKindInfo> rows{{"noop", "noop", ".json", true, false}};
+  std::deque<JobKindInfo> rows{noop_row()};
 };
 
 KindTable& kind_table() {
@@ -26,7 +33,36 @@ KindTable& kind_table() {
 
 bool same_row(const JobKindInfo& a, const JobKindInfo& b) {
   return a.name == b.name && a.folder == b.folder && a.extension == b.extension && a.results_row == b.results_row &&
-         a.takes_idle_threads == b.takes_idle_threads;
+         a.takes_idle_threads == b.takes_idle_threads && a.outputs == b.outputs;
+}
+
+/// A key that is a column name as it stands (no quoting, no clash with SQL's case folding).
+bool plain_column_name(const std::string& key) {
+  if (key.empty() || key[0] < 'a' || key[0] > 'z') return false;
+  for (char c : key)
+    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_')) return false;
+  return true;
+}
+
+/// Refuses outputs that could not be a results column each.
+void check_outputs_declared(const JobKindInfo& info) {
+  if (!info.outputs.empty() && !info.results_row)
+    throw ConfigError(
+        fmt::format("job kind '{}': declares outputs but its finished jobs are no results rows", info.name));
+  std::vector<std::string> seen;
+  for (const auto& o : info.outputs) {
+    if (!plain_column_name(o.key))
+      throw ConfigError(
+          fmt::format("job kind '{}': output key '{}' is not a plain column name (expected lower case "
+                      "letters, digits and '_', starting with a letter)",
+                      info.name, o.key));
+    if (o.type != "REAL" && o.type != "INTEGER" && o.type != "TEXT")
+      throw ConfigError(fmt::format("job kind '{}': output '{}' has type '{}', expected REAL, INTEGER or TEXT",
+                                    info.name, o.key, o.type));
+    if (std::find(seen.begin(), seen.end(), o.key) != seen.end())
+      throw ConfigError(fmt::format("job kind '{}': output '{}' is declared twice", info.name, o.key));
+    seen.push_back(o.key);
+  }
 }
 
 constexpr std::array<const char*, 6> kStates{"waiting", "queued", "running", "failed", "done", "dead"};
@@ -34,6 +70,7 @@ constexpr std::array<const char*, 6> kStates{"waiting", "queued", "running", "fa
 }  // namespace
 
 JobKind register_kind(JobKindInfo info) {
+  check_outputs_declared(info);
   KindTable& t = kind_table();
   const std::lock_guard lock(t.mutex);
   for (std::size_t i = 0; i < t.rows.size(); ++i) {

@@ -15,6 +15,24 @@
 
 namespace gravsweep::queue {
 
+/// One field a job kind's runner reports in its metrics (RunOutput::metrics) and the column of the
+/// results table that holds it. The columns of the kinds a sweep plans are added at submit, so a
+/// campaign's results table is known before any job finishes; a runner that reports a key its
+/// kind does not declare fails its attempt (see check_outputs in queue.h).
+struct OutputField {
+  std::string key;   ///< metrics key and results column: lower case, digits, '_'; units in the name
+  std::string unit;  ///< SI unit; "1" for counts and flags, "" for text
+  std::string type;  ///< column type: REAL, INTEGER (counts, flags) or TEXT
+  friend bool operator==(const OutputField&, const OutputField&) = default;
+};
+
+/// Appends the rows of a field table (results::MetricField, results::RecordField: a key, a unit
+/// and sql_type()) to a kind's outputs: the table that writes a record also declares its columns.
+template <class Fields>
+void append_outputs(std::vector<OutputField>& outputs, const Fields& fields) {
+  for (const auto& f : fields) outputs.push_back({f.key, f.unit, f.sql_type()});
+}
+
 struct JobKindInfo {
   std::string name;       ///< stored in jobs.kind
   std::string folder;     ///< outputs under <files root>/<folder>/
@@ -25,6 +43,9 @@ struct JobKindInfo {
   /// A job of this kind takes the whole worker pool's threads when no other job is waiting to run
   /// beside it (an input every dependent waits for: nothing else would use the idle threads).
   bool takes_idle_threads = false;
+  /// What its runner reports: a column of the results table each (only for a kind whose finished
+  /// job is a results row).
+  std::vector<OutputField> outputs;
 };
 
 /// A job kind: its row in the table of registered kinds. The default is noop.
@@ -46,7 +67,9 @@ class JobKind {
 
 /// Adds a kind to the table (before any campaign is opened: its name enters the schema's check of
 /// jobs.kind for new databases). Registering a name again returns its kind when the row is the
-/// same; a different row under a known name, or a folder another kind uses, throws ConfigError.
+/// same; a different row under a known name, a folder another kind uses, or an output whose key is
+/// not a plain column name (or given twice) or whose type is not REAL, INTEGER or TEXT throws
+/// ConfigError.
 JobKind register_kind(JobKindInfo info);
 /// The queue's own kind: a job that runs no physics (JobKind{}).
 inline JobKind noop_kind() { return JobKind{}; }

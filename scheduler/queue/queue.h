@@ -2,7 +2,8 @@
 // content-addressed ids, dependencies (drop jobs wait for their bed job), claims in BEGIN IMMEDIATE
 // with UPDATE ... RETURNING, leases renewed by heartbeats that carry progress, completion fenced by
 // the lease token, retries with exponential backoff, a `dead` state after max_attempts, one
-// attempts row per try, and a results table with one column per swept parameter and per metric.
+// attempts row per try, and a results table with one column per swept parameter and per output
+// a job kind declares (both added at submit).
 //
 // Job states: waiting (dependencies not done) -> queued -> running -> done
 //                                                         \-> failed (backoff) -> running ...
@@ -16,6 +17,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -128,7 +130,7 @@ struct Completion {
   std::string output_rel;
   std::string sha256;
   std::int64_t bytes = 0;
-  nlohmann::json metrics = nlohmann::json::object();  ///< flat {name_with_units: value}
+  nlohmann::json metrics = nlohmann::json::object();  ///< {declared output key: value} (check_outputs)
   nlohmann::json report = nlohmann::json::object();   ///< free-form, kept in attempts.report_json
 };
 /// Marks the job done (fenced), records output path and checksum, closes the attempt, writes the
@@ -269,6 +271,20 @@ std::vector<AttemptRecord> job_attempts(db::Database& db, const std::string& job
 std::string done_output_path(db::Database& db, const std::string& job_id);
 
 // ---- results ----------------------------------------------------------------------------------
+/// A runner reported a metric its kind does not declare (JobKindInfo::outputs), or a value that
+/// does not fit the declared type. A mistake of the program, not of the job: the attempt fails
+/// for good (a retry would report the same key), and no column is made for it. A silently added
+/// column is how a renamed key used to split a campaign's values over two columns unnoticed.
+class OutputError : public std::logic_error {
+ public:
+  using std::logic_error::logic_error;
+};
+/// Checks a runner's metrics ({key: value}, flat) against the outputs `kind` declares: every key
+/// declared, every value null or of the declared type (REAL: a number; INTEGER: an integer or a
+/// flag; TEXT: a string). Throws OutputError naming the kind and the key. A declared key a runner
+/// leaves out is NULL in its row.
+void check_outputs(JobKind kind, const nlohmann::json& metrics);
+
 /// Column names of the results table, in display order (fixed, parameters, metrics).
 std::vector<std::string> result_columns(db::Database& db);
 /// The names of the results columns that hold numbers (fixed INTEGER/REAL ones, and the swept

@@ -8,12 +8,14 @@
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/dialect.h"
 #include "scheduler/queue/queue.h"
+#include "scheduler/queue/queue_internal.h"
 
 namespace gravsweep::queue {
 
 namespace {
 
-/// Every queue table and index (README.md, "Tables"), in the words of the backend's SchemaTypes.
+/// Every queue table and index (README.md, "Tables"), in the words of the backend's SchemaTypes;
+/// the results table's fixed columns from their table (detail::fixed_result_columns).
 constexpr const char* kSchemaTemplate = R"SQL(
 CREATE TABLE IF NOT EXISTS queue_meta(key TEXT PRIMARY KEY, value TEXT NOT NULL) {strict};
 CREATE TABLE IF NOT EXISTS sweeps(
@@ -96,19 +98,7 @@ CREATE TABLE IF NOT EXISTS attempts(
 ) {strict};
 CREATE INDEX IF NOT EXISTS attempts_job ON attempts(job_id, outcome);
 CREATE INDEX IF NOT EXISTS attempts_runtime ON attempts(kind, outcome, runtime_s);
-CREATE TABLE IF NOT EXISTS results(
-  job_id TEXT PRIMARY KEY REFERENCES jobs(job_id),
-  sweep TEXT NOT NULL,
-  kind TEXT NOT NULL,
-  bed_job_id TEXT,
-  attempt {integer} NOT NULL,
-  trace_path TEXT,
-  trace_sha256 TEXT,
-  trace_bytes {integer},
-  runtime_s {real},
-  finished_at {real},
-  code_version TEXT
-) {strict};
+{results}
 CREATE TABLE IF NOT EXISTS results_columns(
   name TEXT PRIMARY KEY,
   role TEXT NOT NULL CHECK(role IN ('param','metric')),
@@ -124,10 +114,12 @@ std::string kind_list_sql() {
   return list;
 }
 
-std::string schema_sql(const SchemaTypes& t) {
+std::string schema_sql(const Dialect& d) {
+  const SchemaTypes t = d.schema_types();
   return fmt::format(kSchemaTemplate, fmt::arg("kinds", kind_list_sql()), fmt::arg("key", t.key),
                      fmt::arg("integer", t.integer), fmt::arg("real", t.real), fmt::arg("strict", t.strict),
-                     fmt::arg("strict_without_rowid", t.strict_without_rowid));
+                     fmt::arg("strict_without_rowid", t.strict_without_rowid),
+                     fmt::arg("results", detail::results_table_sql(d)));
 }
 
 }  // namespace
@@ -143,7 +135,7 @@ double now_s() { return std::chrono::duration<double>(std::chrono::system_clock:
 void ensure_schema(Database& db) {
   {
     Transaction tx(db);
-    db.exec(schema_sql(dialect_of(db).schema_types()));
+    db.exec(schema_sql(dialect_of(db)));
     Statement get(db, "SELECT value FROM queue_meta WHERE key='schema_version'");
     if (!get.step()) {
       Statement put(db, "INSERT INTO queue_meta(key, value) VALUES('schema_version', ?)");
@@ -174,6 +166,9 @@ void add_missing_columns(Database& db) {
         fmt::format("ALTER TABLE jobs ADD COLUMN stalled_releases {} NOT NULL DEFAULT 0", d.schema_types().integer));
     db.exec("UPDATE jobs SET stalled_releases=releases");  // earlier campaigns knew no progress
   }
+  // Jobs an older build submitted got their metric columns at completion: their kinds' declared
+  // columns are added here, before a worker of this build completes one of them.
+  detail::declare_output_columns_of_jobs(db);
   tx.commit();
 }
 

@@ -1,4 +1,7 @@
-// Sweep expansion into the queue: idempotent inserts, dependencies and sweep memberships.
+// Sweep expansion into the queue: idempotent inserts, dependencies and sweep memberships, and the
+// results columns of the sweep's parameters and of its job kinds' outputs.
+#include <set>
+
 #include "scheduler/queue/queue_internal.h"
 #include "scheduler/queue/canonical.h"
 
@@ -33,6 +36,15 @@ void add_param_columns(Database& db, const SweepRecord& spec) {
     }
     for (const auto& v : values) detail::widen_result_column(db, name, cols[name], v);
   }
+}
+
+/// The results columns of the outputs the planned jobs' kinds declare, after the parameters' (an
+/// output named as a parameter is metric_<name>): a campaign's results table is known before
+/// any of its jobs finishes, and a completion adds no column.
+void add_output_columns(Database& db, const std::vector<PlannedJob>& jobs) {
+  std::set<JobKind> kinds;
+  for (const auto& j : jobs) kinds.insert(j.kind);
+  for (JobKind k : kinds) detail::declare_output_columns(db, k);
 }
 
 /// Each planned job inserted unless present, with its dependencies and its membership of the sweep.
@@ -102,6 +114,7 @@ SubmitReport submit(Database& db, const SweepRecord& spec, const std::vector<Pla
   }
   upsert_sweep(db, spec, spec_text, now);
   add_param_columns(db, spec);
+  add_output_columns(db, jobs);
   insert_jobs(db, spec, jobs, now, rep);
   tx.commit();
   return rep;

@@ -321,6 +321,11 @@ class Worker {
                      &sig.progress_saved,
                      o_.max_memory_bytes};
       a.out = runner->second(ctx);
+      check_outputs(c.kind, a.out.metrics);  // before the output is stored as the job's
+    } catch (const OutputError& e) {
+      a.error = fmt::format("logic error: {}", e.what());
+      a.exit_code = kExitFailure;
+      a.permanent = true;  // the program's mistake: every attempt would report the same
     } catch (const ConfigError& e) {
       a.error = e.what();
       a.exit_code = kExitUsage;
@@ -451,11 +456,23 @@ class Worker {
 
   void completed(const Claim& c, const Completion& done, double wall_s) {
     bool retried = false;  // after a lost connection the completion may have gone through
-    const bool ok = with_db_([&] {
-      if (retried && completed_already(db_, c)) return true;
-      retried = true;
-      return complete(db_, c, done);
-    });
+    bool ok = false;
+    try {
+      ok = with_db_([&] {
+        if (retried && completed_already(db_, c)) return true;
+        retried = true;
+        return complete(db_, c, done);
+      });
+    } catch (const std::exception& e) {
+      if (const auto* d = dynamic_cast<const db::DbError*>(&e); d && (d->busy() || d->connection_lost())) throw;
+      // The results row was refused (rolled back with the rest of the completion): the attempt
+      // fails, its output removed, instead of the worker.
+      std::error_code ec;
+      fs::remove(paths_.abs(c.output_rel), ec);
+      failed(c, fmt::format("job {}: its completion was refused: {}", c.job_id, e.what()), kExitFailure,
+             dynamic_cast<const OutputError*>(&e) != nullptr);
+      return;
+    }
     if (ok) {
       ++rep_.done;
       largest_ = std::max(largest_, done.bytes);

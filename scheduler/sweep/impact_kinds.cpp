@@ -1,14 +1,30 @@
 #include "scheduler/sweep/impact_kinds.h"
 
+#include "results/io/job_reports.h"
+#include "results/processing/metric_fields.h"
+
 namespace gravsweep::sweep {
 
 queue::JobKind bed_kind() {
-  static const queue::JobKind kind = queue::register_kind({"bed", "beds", ".h5", false, true});
+  static const queue::JobKind kind = queue::register_kind({"bed", "beds", ".h5", false, true, {}});
   return kind;
 }
 
+namespace {
+
+/// What a drop's runner reports: its metrics JSON is written from the same tables.
+std::vector<queue::OutputField> drop_outputs() {
+  std::vector<queue::OutputField> outputs;
+  queue::append_outputs(outputs, results::metric_fields());
+  queue::append_outputs(outputs, results::dem_figure_fields());
+  outputs.push_back({"metrics_error", "", "TEXT"});
+  return outputs;
+}
+
+}  // namespace
+
 queue::JobKind drop_kind() {
-  static const queue::JobKind kind = queue::register_kind({"drop", "traces", ".h5", true, false});
+  static const queue::JobKind kind = queue::register_kind({"drop", "traces", ".h5", true, false, drop_outputs()});
   return kind;
 }
 

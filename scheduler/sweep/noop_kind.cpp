@@ -22,8 +22,9 @@ bool is_count(const json& v, double most) {
   return spec::is_exact_integer(v) && v.get<double>() >= 0 && v.get<double>() <= most;
 }
 
-/// Problems of a no-op job's scenario at `ptr`: sleep_s and fail_attempts are what the no-op
-/// runner reads; anything else is carried along (an axis may sweep any field).
+/// Problems of a no-op job's scenario at `ptr`: sleep_s, fail_attempts and value are what the
+/// no-op runner reads (value: a number, its declared output noop_value); anything else is carried
+/// along (an axis may sweep any field).
 std::vector<SpecProblem> noop_problems(const json& s, const std::string& ptr) {
   std::vector<SpecProblem> out;
   if (!s.is_object()) return {{ptr, spec::shown_value(s), "an object (the no-op job's scenario)"}};
@@ -34,6 +35,9 @@ std::vector<SpecProblem> noop_problems(const json& s, const std::string& ptr) {
   if (s.contains("fail_attempts") && !is_count(s["fail_attempts"], 100))
     out.push_back({spec::pointer_child(ptr, "fail_attempts"), spec::shown_value(s["fail_attempts"]),
                    "an integer between 0 and 100"});
+  if (s.contains("value") && !s["value"].is_number())
+    out.push_back({spec::pointer_child(ptr, "value"), spec::shown_value(s["value"]),
+                   "a number (echoed as the metric noop_value)"});
   return out;
 }
 

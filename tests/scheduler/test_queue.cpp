@@ -78,7 +78,11 @@ struct QueueTest : ::testing::TestWithParam<test::Store> {
     d.output_rel = c.output_rel;
     d.sha256 = std::string(64, 'a');
     d.bytes = 1;
-    d.metrics = {{"apeak_m_s2", value}, {"rebound", false}, {"note", nullptr}};
+    // What each kind declares (a bed's job is no results row: no metrics).
+    if (c.kind == sweep::drop_kind())
+      d.metrics = {{"apeak_m_s2", value}, {"rebound", false}, {"note", nullptr}};
+    else if (c.kind == noop_kind())
+      d.metrics = {{"noop_value", value}, {"sleep_s", 0.25}};
     return d;
   }
 };
@@ -110,27 +114,27 @@ TEST_P(QueueTest, SubmitTwiceAddsNothingExtensionAddsOnlyNewJobs) {
 
 TEST_P(QueueTest, ANonIntegerValueWidensAnIntegerResultsColumnAndKeepsItsValues) {
   // An axis of 1, 2 gets an INTEGER column; extended by 2.5 it must hold 2.5 (it used to refuse the
-  // row: "cannot store REAL value in INTEGER column"). The same for a metric first seen as 3.
+  // row: "cannot store REAL value in INTEGER column"). A metric declared REAL is REAL from submit
+  // on: a first value of 3 no longer types it INTEGER.
   submit_spec(noop_spec("s", {1, 2}));
-  auto finish = [&](const json& depth) {
+  auto finish = [&](const json& value) {
     auto c = claim(db, me, paths, 60);
     if (!c) return false;
     Completion d = done_for(*c);
-    d.metrics["depth_count"] = depth;
+    d.metrics["noop_value"] = value;
     return complete(db, *c, d);
   };
   EXPECT_TRUE(finish(3));
   EXPECT_TRUE(finish(4));
   EXPECT_EQ(sql_text(db, "SELECT sql_type FROM results_columns WHERE name='gravity_m_s2'"), "INTEGER");
-  EXPECT_EQ(sql_text(db, "SELECT sql_type FROM results_columns WHERE name='depth_count'"), "INTEGER");
+  EXPECT_EQ(sql_text(db, "SELECT sql_type FROM results_columns WHERE name='noop_value'"), "REAL");
   submit_spec(noop_spec("s", {1, 2, 2.5}));
   EXPECT_EQ(sql_text(db, "SELECT sql_type FROM results_columns WHERE name='gravity_m_s2'"), "REAL");
   EXPECT_TRUE(finish(3.5)) << "the row with 2.5 (and a metric of 3.5) is stored";
-  EXPECT_EQ(sql_text(db, "SELECT sql_type FROM results_columns WHERE name='depth_count'"), "REAL");
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results WHERE gravity_m_s2 IN (1, 2)"), 2);
-  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results WHERE gravity_m_s2=2.5 AND depth_count=3.5"), 1);
-  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results WHERE depth_count IN (3, 4)"), 2);
-  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results WHERE apeak_m_s2=1.0"), 3) << "other columns kept";
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results WHERE gravity_m_s2=2.5 AND noop_value=3.5"), 1);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results WHERE noop_value IN (3, 4)"), 2);
+  EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results WHERE sleep_s=0.25"), 3) << "other columns kept";
   // The rebuilt table still refuses a result for a job that does not exist (its foreign key).
   EXPECT_THROW(db.exec("INSERT INTO results(job_id, sweep, kind, attempt) VALUES('nope', 's', 'noop', 1)"),
                db::DbError);
@@ -472,15 +476,15 @@ INSTANTIATE_TEST_SUITE_P(Sqlite, QueueTest, ::testing::Values(test::Store::sqlit
 // of jobs.kind and its folder the files root; a name registered again with another row, or a
 // folder two kinds would share, is refused; an unknown name lists the registered ones.
 TEST(JobKinds, AreRegisteredByTheLibrariesThatRunThem) {
-  const JobKind probe = register_kind({"kind_probe", "kind_probe_out", ".json", true, false});
-  EXPECT_EQ(register_kind({"kind_probe", "kind_probe_out", ".json", true, false}), probe) << "same row: same kind";
+  const JobKind probe = register_kind({"kind_probe", "kind_probe_out", ".json", true, false, {}});
+  EXPECT_EQ(register_kind({"kind_probe", "kind_probe_out", ".json", true, false, {}}), probe) << "same row: same kind";
   EXPECT_EQ(parse_kind("kind_probe"), probe);
   EXPECT_EQ(parse_kind("bed"), sweep::bed_kind());
   EXPECT_EQ(parse_kind("noop"), noop_kind());
-  EXPECT_THROW(register_kind({"kind_probe", "elsewhere", ".json", true, false}), gravsweep::ConfigError);
-  EXPECT_THROW(register_kind({"another", "beds", ".h5", true, false}), gravsweep::ConfigError)
+  EXPECT_THROW(register_kind({"kind_probe", "elsewhere", ".json", true, false, {}}), gravsweep::ConfigError);
+  EXPECT_THROW(register_kind({"another", "beds", ".h5", true, false, {}}), gravsweep::ConfigError)
       << "beds/ is the bed kind's";
-  EXPECT_THROW(register_kind({"scratch", "tmp", ".h5", true, false}), gravsweep::ConfigError)
+  EXPECT_THROW(register_kind({"scratch", "tmp", ".h5", true, false, {}}), gravsweep::ConfigError)
       << "tmp/ holds running attempts";
   try {
     parse_kind("gpu");
