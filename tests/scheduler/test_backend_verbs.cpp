@@ -18,12 +18,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct BackendVerbs : ::testing::TestWithParam<Store> {
-  TempDir dir;
-  CampaignStore store{GetParam(), dir.path};
-  void SetUp() override {
-    if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
-  }
+struct BackendVerbs : StoreTest {
   /// `verb...` followed by --db LOCATION [--files DIR] and `more`.
   CmdResult cli(std::vector<std::string> args, const std::vector<std::string>& more = {}) {
     for (const auto& a : store.args()) args.push_back(a);
@@ -116,10 +111,9 @@ TEST_P(BackendVerbs, EveryVerbReadingACampaignTakesItsLocation) {
   EXPECT_TRUE(fs::exists(dir.path / "rep")) << r.out;
 }
 
-#ifdef GRAVSWEEP_QUEUE_TESTS_ON_POSTGRES
-INSTANTIATE_TEST_SUITE_P(Postgres, BackendVerbs, ::testing::Values(Store::postgres),
-                         [](const auto& info) { return store_name(info.param); });
+GRAVSWEEP_INSTANTIATE_ON_THE_QUEUE_BACKEND(BackendVerbs);
 
+#ifdef GRAVSWEEP_QUEUE_TESTS_ON_POSTGRES
 TEST(BackendVerbs, AServerCampaignReadWithoutItsFilesRootIsRefused) {
   TempDir d;
   const CampaignStore store(Store::postgres, d.path);
@@ -130,7 +124,4 @@ TEST(BackendVerbs, AServerCampaignReadWithoutItsFilesRootIsRefused) {
   EXPECT_EQ(r.code, 2) << r.out << r.err;
   EXPECT_NE(r.err.find("--files"), std::string::npos) << r.err;
 }
-#else
-INSTANTIATE_TEST_SUITE_P(Sqlite, BackendVerbs, ::testing::Values(Store::sqlite),
-                         [](const auto& info) { return store_name(info.param); });
 #endif
