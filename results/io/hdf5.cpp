@@ -42,11 +42,34 @@ Handle string_type() {
   return t;
 }
 
+/// Opens the link `name` of `parent` with `open` (H5Dopen2, H5Gopen2), closed by `close`: a
+/// missing link and one that does not open are two messages, each naming the `kind` of object.
+Handle open_link(hid_t parent, const std::string& name, const char* kind, hid_t (*open)(hid_t, const char*, hid_t),
+                 Handle::Closer close) {
+  if (!exists(parent, name)) fail(parent, fmt::format("{} '{}' is missing", kind, name));
+  Handle h(open(parent, name.c_str(), H5P_DEFAULT), close);
+  if (h.get() < 0) fail(parent, fmt::format("cannot open {} '{}'", kind, name));
+  return h;
+}
+
 Handle open_dataset(hid_t parent, const std::string& name) {
-  if (!exists(parent, name)) fail(parent, fmt::format("dataset '{}' is missing", name));
-  Handle d(H5Dopen2(parent, name.c_str(), H5P_DEFAULT), &H5Dclose);
-  if (d.get() < 0) fail(parent, fmt::format("cannot open dataset '{}'", name));
-  return d;
+  return open_link(parent, name, "dataset", &H5Dopen2, &H5Dclose);
+}
+
+/// The number of values of an array of shape `dims` (1 for a scalar's empty shape).
+hsize_t element_count(const std::vector<hsize_t>& dims) {
+  hsize_t total = 1;
+  for (hsize_t d : dims) total *= d;
+  return total;
+}
+
+/// The shape of the dataspace `space` of dataset `name` of `parent` (named in the error).
+std::vector<hsize_t> shape_of(hid_t parent, const std::string& name, hid_t space) {
+  const int rank = H5Sget_simple_extent_ndims(space);
+  if (rank < 0) fail(parent, fmt::format("cannot read the shape of '{}'", name));
+  std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
+  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+  return dims;
 }
 
 void write_dataset(hid_t parent, const std::string& name, hid_t file_type, hid_t mem_type, const void* data,
@@ -55,8 +78,7 @@ void write_dataset(hid_t parent, const std::string& name, hid_t file_type, hid_t
   Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), &H5Sclose);
   if (space.get() < 0) fail(parent, fmt::format("cannot create dataspace for '{}'", name));
   Handle plist(H5Pcreate(H5P_DATASET_CREATE), &H5Pclose);
-  hsize_t total = 1;
-  for (hsize_t d : dims) total *= d;
+  const hsize_t total = element_count(dims);
   // Compress larger datasets (chunked along the first axis); small ones stay contiguous.
   if (storage == Storage::compressed && total >= 4096 && !dims.empty()) {
     std::vector<hsize_t> chunk = dims;
@@ -77,12 +99,8 @@ template <class T>
 std::vector<T> read_dataset(hid_t parent, const std::string& name, hid_t mem_type, std::vector<hsize_t>* dims_out) {
   Handle ds = open_dataset(parent, name);
   Handle space(H5Dget_space(ds), &H5Sclose);
-  const int rank = H5Sget_simple_extent_ndims(space);
-  if (rank < 0) fail(parent, fmt::format("cannot read the shape of '{}'", name));
-  std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
-  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
-  hsize_t total = 1;
-  for (hsize_t d : dims) total *= d;
+  const std::vector<hsize_t> dims = shape_of(parent, name, space);
+  const hsize_t total = element_count(dims);
   std::vector<T> out(static_cast<std::size_t>(total));
   if (total > 0 && H5Dread(ds, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) < 0)
     fail(parent, fmt::format("cannot read dataset '{}' as {}", name, sizeof(T) == 8 ? "double" : "integer"));
@@ -200,10 +218,7 @@ Handle create_group(hid_t parent, const std::string& name) {
 }
 
 Handle open_group(hid_t parent, const std::string& name) {
-  if (!exists(parent, name)) fail(parent, fmt::format("group '{}' is missing", name));
-  Handle g(H5Gopen2(parent, name.c_str(), H5P_DEFAULT), &H5Gclose);
-  if (g.get() < 0) fail(parent, fmt::format("cannot open group '{}'", name));
-  return g;
+  return open_link(parent, name, "group", &H5Gopen2, &H5Gclose);
 }
 
 bool exists(hid_t parent, const std::string& name) { return H5Lexists(parent, name.c_str(), H5P_DEFAULT) > 0; }
@@ -211,9 +226,7 @@ bool exists(hid_t parent, const std::string& name) { return H5Lexists(parent, na
 void write_doubles(hid_t parent, const std::string& name, const std::vector<double>& data,
                    const std::vector<hsize_t>& dims, const std::string& units, const std::string& description,
                    Storage storage) {
-  hsize_t total = 1;
-  for (hsize_t d : dims) total *= d;
-  if (total != data.size())
+  if (element_count(dims) != data.size())
     fail(parent, fmt::format("dataset '{}': {} values do not fill the shape", name, data.size()));
   write_dataset(parent, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, data.data(), dims, units, description, storage);
 }
@@ -236,11 +249,7 @@ void write_raw(hid_t parent, const std::string& name, hid_t type, const void* da
 std::vector<hsize_t> dataset_dims(hid_t parent, const std::string& name) {
   Handle ds = open_dataset(parent, name);
   Handle space(H5Dget_space(ds), &H5Sclose);
-  const int rank = H5Sget_simple_extent_ndims(space);
-  if (rank < 0) fail(parent, fmt::format("cannot read the shape of '{}'", name));
-  std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
-  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
-  return dims;
+  return shape_of(parent, name, space);
 }
 
 void read_raw(hid_t parent, const std::string& name, hid_t mem_type, void* data) {

@@ -18,6 +18,7 @@
 #include <string>
 
 #include "db/database.h"
+#include "tests/common/started_once.h"
 
 namespace gravsweep::test {
 
@@ -26,15 +27,8 @@ class PostgresServer {
   /// The server of this test process (started on the first call); nullptr with `why` filled in
   /// when it cannot run here.
   static PostgresServer* shared(std::string& why) {
-    static std::string reason;
-    static std::unique_ptr<PostgresServer> server = [] {
-      auto s = std::unique_ptr<PostgresServer>(new PostgresServer);
-      reason = s->start();
-      if (!reason.empty()) s.reset();
-      return s;
-    }();
-    why = reason;
-    return server.get();
+    return started_once(
+        why, [] { return std::unique_ptr<PostgresServer>(new PostgresServer); }, &PostgresServer::start);
   }
 
   /// Creates an empty database and returns its URL (postgresql://postgres@127.0.0.1:PORT/NAME).

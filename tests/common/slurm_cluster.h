@@ -24,6 +24,8 @@
 #include <thread>
 #include <vector>
 
+#include "tests/common/started_once.h"
+
 namespace gravsweep::test {
 
 class SlurmCluster {
@@ -31,15 +33,8 @@ class SlurmCluster {
   /// The cluster of this test process (started on the first call); nullptr with `why` filled in
   /// when it cannot run here.
   static SlurmCluster* shared(std::string& why) {
-    static std::string reason;
-    static std::unique_ptr<SlurmCluster> cluster = [] {
-      auto c = std::unique_ptr<SlurmCluster>(new SlurmCluster);
-      reason = c->start();
-      if (!reason.empty()) c.reset();
-      return c;
-    }();
-    why = reason;
-    return cluster.get();
+    return started_once(
+        why, [] { return std::unique_ptr<SlurmCluster>(new SlurmCluster); }, &SlurmCluster::start);
   }
 
   /// Runs a Slurm client command (SLURM_CONF is set) and returns its stdout; `rc` gets its status.

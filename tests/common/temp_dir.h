@@ -23,6 +23,7 @@ struct TempDir {
   }
   TempDir(const TempDir&) = delete;
   TempDir& operator=(const TempDir&) = delete;
+  [[nodiscard]] std::string str() const { return path.string(); }
 };
 
 }  // namespace gravsweep::test

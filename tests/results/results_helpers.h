@@ -1,4 +1,4 @@
-// Helpers for the results/ tests: temporary folders and the shared dev campaign.
+// Helpers for the results/ tests: temporary folders, the real binary and the shared dev campaign.
 #pragma once
 #include <sys/wait.h>
 
@@ -8,25 +8,12 @@
 #include <random>
 #include <string>
 
+#include "tests/common/temp_dir.h"
+
 namespace gravsweep::testing {
 
-/// A fresh temporary folder, removed when the object goes out of scope.
-struct TempDir {
-  std::filesystem::path path;
-  TempDir() {
-    std::random_device rd;
-    path =
-        std::filesystem::temp_directory_path() / ("gravsweep_results_" + std::to_string(rd()) + std::to_string(rd()));
-    std::filesystem::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  [[nodiscard]] std::string str() const { return path.string(); }
-};
+/// A fresh temporary folder, removed when the object goes out of scope (the one of tests/common).
+using TempDir = gravsweep::test::TempDir;
 
 /// The exit code and output of the real `gravsweep` binary (stderr too when merge_stderr).
 struct CliRun {

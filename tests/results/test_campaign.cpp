@@ -41,6 +41,20 @@ std::string csv_quoted(const std::string& text) {
   return out + "\"";
 }
 
+/// The synthetic campaign of `model` on the small design, written to d/c and read from there.
+Campaign synthetic_campaign(const TempDir& d, const std::string& model) {
+  write_synthetic_campaign((d.path / "c").string(), parse_model(model), small());
+  return load_campaign((d.path / "c").string());
+}
+
+/// `c` stored into a new SQLite file d/lab.db (every trial, checked); returns the file's path.
+std::string stored_in_sqlite(const TempDir& d, const Campaign& c) {
+  const std::string dbfile = (d.path / "lab.db").string();
+  db::Database db(dbfile);
+  EXPECT_EQ(store_campaign(db, c), static_cast<int>(c.trials.size()));
+  return dbfile;
+}
+
 }  // namespace
 
 TEST(Campaign, ReadsSyntheticCampaignAndRecoversImpactSpeed) {
@@ -123,8 +137,7 @@ TEST(Campaign, MissingRequiredColumnIsAnErrorNamingIt) {
 
 TEST(Campaign, StoresTrialsSamplesAndMetricsInSqlite) {
   TempDir d;
-  write_synthetic_campaign((d.path / "c").string(), parse_model("base"), small());
-  const Campaign c = load_campaign((d.path / "c").string());
+  const Campaign c = synthetic_campaign(d, "base");
   const std::string dbfile = (d.path / "lab.db").string();
   {
     db::Database db(dbfile);
@@ -148,13 +161,8 @@ TEST(Campaign, StoresTrialsSamplesAndMetricsInSqlite) {
 
 TEST(Campaign, ReadBackFromSqliteFitsExactlyAsFromTheFolder) {
   TempDir d;
-  write_synthetic_campaign((d.path / "c").string(), parse_model("base+depth_friction"), small());
-  const Campaign c = load_campaign((d.path / "c").string());
-  const std::string dbfile = (d.path / "lab.db").string();
-  {
-    db::Database db(dbfile);
-    store_campaign(db, c);
-  }
+  const Campaign c = synthetic_campaign(d, "base+depth_friction");
+  const std::string dbfile = stored_in_sqlite(d, c);
   const Campaign back = load_campaign_any(dbfile);
   ASSERT_EQ(back.trials.size(), c.trials.size());
   for (std::size_t i = 0; i < c.trials.size(); ++i) {
@@ -173,14 +181,9 @@ TEST(Campaign, ReadBackFromSqliteFitsExactlyAsFromTheFolder) {
 // and storing into it adds the column (no rows lost).
 TEST(Campaign, AnOlderMetricsTableGainsTheNewColumnsWhenStoredInto) {
   TempDir d;
-  write_synthetic_campaign((d.path / "c").string(), parse_model("base"), small());
-  const Campaign c = load_campaign((d.path / "c").string());
-  const std::string dbfile = (d.path / "lab.db").string();
-  {
-    db::Database db(dbfile);
-    store_campaign(db, c);
-    db.exec("ALTER TABLE trial_metrics DROP COLUMN depth_at_end_m");
-  }
+  const Campaign c = synthetic_campaign(d, "base");
+  const std::string dbfile = stored_in_sqlite(d, c);
+  db::Database(dbfile).exec("ALTER TABLE trial_metrics DROP COLUMN depth_at_end_m");
   const Campaign old = load_campaign_any(dbfile);
   ASSERT_EQ(old.trials.size(), c.trials.size());
   EXPECT_EQ(old.trials[0].processed.metrics.depth_at_end_m, 0.0);

@@ -16,6 +16,7 @@
 
 #include "results/io/trace_file.h"
 #include "results_helpers.h"
+#include "tests/common/tiny_campaign.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -27,31 +28,26 @@ Cmd run(const std::string& args, bool merge_stderr = true) {
   return gravsweep::testing::run_gravsweep(args, merge_stderr);
 }
 
-constexpr const char* kSweep = R"({
-  "sweep": "campaign_cli_test",
-  "base": {
-    "name": "tiny", "gravity_m_s2": 9.81,
-    "container": {"diameter_m": 0.08, "fill_height_m": 0.04},
-    "dt_s": 1e-5,
-    "bed": {"seed": 7, "dt_s": 1e-5, "settle": {"max_time_s": 0.3, "rms_speed_m_s": 1e-4,
-            "max_speed_m_s": 5e-3}, "relax_time_s": 0.02},
-    "projectile": {"diameter_m": 0.03, "mass_kg": 0.03, "impact_speed_m_s": 0.5,
-                   "lateral_offset_max_grain_diameters": 0.5, "seed": 3},
-    "stop": {"max_time_s": 0.25}
-  },
-  "axes": [
-    {"name": "gravity_m_s2", "pointer": "/gravity_m_s2", "values": [9.81, 3.71]},
-    {"name": "impact_speed_m_s", "pointer": "/projectile/impact_speed_m_s", "values": [0.4, 0.6]}
-  ],
-  "repeats": {"name": "projectile_seed", "pointer": "/projectile/seed", "count": 2, "start": 1},
-  "max_attempts": 1
-})";
+/// 2 gravities x 2 speeds x 2 repeats of the tiny campaign scenario (tests/common/tiny_campaign.h).
+std::string sweep_spec() {
+  json doc = json::parse(R"({
+    "sweep": "campaign_cli_test",
+    "axes": [
+      {"name": "gravity_m_s2", "pointer": "/gravity_m_s2", "values": [9.81, 3.71]},
+      {"name": "impact_speed_m_s", "pointer": "/projectile/impact_speed_m_s", "values": [0.4, 0.6]}
+    ],
+    "repeats": {"name": "projectile_seed", "pointer": "/projectile/seed", "count": 2, "start": 1},
+    "max_attempts": 1
+  })");
+  doc["base"] = json::parse(gravsweep::test::tiny_base());
+  return doc.dump();
+}
 
 class CampaignCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new gravsweep::testing::TempDir;
-    std::ofstream(dir_->path / "sweep.json") << kSweep;
+    std::ofstream(dir_->path / "sweep.json") << sweep_spec();
     const Cmd s = run("submit '" + (dir_->path / "sweep.json").string() + "' --db '" + db() + "'");
     ASSERT_EQ(s.code, 0) << s.out;
     const Cmd w = run("work --db '" + db() + "' --workers 2 --threads 1");

@@ -11,6 +11,9 @@
 
 namespace gravsweep::test {
 
+/// A checkpoint interval that never passes during a test: a job checkpoints only when asked to stop.
+constexpr double kNeverDue_s = 1e6;
+
 /// 9 cm container, 5 cm fill (about 330 grains of 1 cm kept of 420 poured), a 4 cm, 250 g
 /// projectile at 1 m/s; dt = 10 us (below the Hertz bound of ~14 us for these grains).
 inline nlohmann::json tiny_scenario() {

@@ -20,8 +20,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-/// Checkpoints only when asked to stop (the interval never passes during a test).
-constexpr double kNeverDue_s = 1e6;
+using test::kNeverDue_s;
 
 class BedJobCheckpoint : public ::testing::Test {
  protected:

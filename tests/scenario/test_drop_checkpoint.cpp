@@ -18,6 +18,7 @@
 #include "scenario_helpers.h"
 #include "scheduler/pipeline/impact_job.h"
 #include "scheduler/pipeline/scenario_spec.h"
+#include "tests/common/same_trace.h"
 
 namespace gravsweep {
 namespace {
@@ -25,8 +26,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-/// Checkpoints only when asked to stop (the interval never passes during a test).
-constexpr double kNeverDue_s = 1e6;
+using test::kNeverDue_s;
 
 class DropCheckpoint : public ::testing::Test {
  protected:
@@ -87,18 +87,10 @@ class DropCheckpoint : public ::testing::Test {
 };
 test::TempDir* DropCheckpoint::dir_ = nullptr;
 
-/// Every column of two traces, value for value (== on doubles: bit-identical but for -0/+0).
+/// Every column of two traces (tests/common/same_trace.h), and the drop's end and metrics.
 void expect_same_trace(const fs::path& a_path, const fs::path& b_path) {
+  ASSERT_NO_FATAL_FAILURE(test::expect_same_trace_columns(a_path, b_path));
   const results::TraceData a = results::read_trace(a_path), b = results::read_trace(b_path);
-  ASSERT_EQ(a.size(), b.size());
-  EXPECT_EQ(a.t_s, b.t_s);
-  EXPECT_EQ(a.depth_m, b.depth_m);
-  EXPECT_EQ(a.velocity_down_m_s, b.velocity_down_m_s);
-  EXPECT_EQ(a.accel_up_m_s2, b.accel_up_m_s2);
-  EXPECT_EQ(a.omega_rad_s, b.omega_rad_s);
-  EXPECT_EQ(a.position_m, b.position_m);
-  EXPECT_EQ(a.contacts, b.contacts);
-  EXPECT_EQ(a.grain_kinetic_energy_J, b.grain_kinetic_energy_J);
   EXPECT_EQ(a.stopped, b.stopped);
   const json ma = json::parse(a.metrics_json), mb = json::parse(b.metrics_json);
   for (const char* k : {"zstop_m", "tstop_s", "vc_m_s", "apeak_m_s2", "steps", "first_contact_s", "rest_time_s"})

@@ -17,6 +17,7 @@
 namespace gravsweep {
 namespace {
 
+namespace fs = std::filesystem;
 using nlohmann::json;
 using pipeline::run_bed_job;
 using pipeline::run_drop_job;
@@ -76,6 +77,19 @@ std::size_t surface_grain(const results::BedData& bed, bool outermost) {
   return best;
 }
 
+/// A short drop (2 ms) of the tiny scenario on `bed` (written to dir/wall.h5): refused while the
+/// whole bed counts, accepted when only the grains within half a projectile diameter of the impact
+/// axis do (/at_rest/surface_radius_D 0.5). Returns the scenario with that window.
+json refused_on_the_whole_bed_accepted_about_the_axis(const fs::path& dir, const results::BedData& bed) {
+  write_bed(dir / "wall.h5", bed);
+  json s = test::tiny_scenario();
+  s["stop"]["max_time_s"] = 0.002;
+  EXPECT_THROW(run_drop_job(s, dir / "wall.h5", dir / "never.h5", 1, {}, nullptr), ConfigError);
+  s["at_rest"] = {{"surface_radius_D", 0.5}};
+  EXPECT_NO_THROW(run_drop_job(s, dir / "wall.h5", dir / "ok.h5", 1, {}, nullptr));
+  return s;
+}
+
 // /at_rest/surface_radius_D: a grain creeping at the wall, 4 cm from the axis, refuses the drop
 // when the whole surface counts, and not when only the surface within half a projectile diameter
 // (2 cm) of the impact axis does; a grain moving there still refuses it, the message naming the
@@ -87,12 +101,7 @@ TEST(AtRest, ASurfaceRadiusCountsOnlyTheGrainsAboutTheImpactAxis) {
   const std::size_t wall = surface_grain(bed, true), central = surface_grain(bed, false);
   ASSERT_GT(std::hypot(bed.position_m[3 * wall], bed.position_m[3 * wall + 1]), 0.035) << "a grain at the wall";
   bed.velocity_m_s[3 * wall] = 0.012;  // 1.2 % of the 1 m/s impact (1 % allowed; the RMS stays below 0.1 %)
-  write_bed(dir.path / "wall.h5", bed);
-  json s = test::tiny_scenario();
-  s["stop"]["max_time_s"] = 0.002;
-  EXPECT_THROW(run_drop_job(s, dir.path / "wall.h5", dir.path / "never.h5", 1, {}, nullptr), ConfigError);
-  s["at_rest"] = {{"surface_radius_D", 0.5}};
-  EXPECT_NO_THROW(run_drop_job(s, dir.path / "wall.h5", dir.path / "ok.h5", 1, {}, nullptr));
+  const json s = refused_on_the_whole_bed_accepted_about_the_axis(dir.path, bed);
   bed.velocity_m_s[3 * wall] = 0;
   bed.velocity_m_s[3 * central] = 0.012;  // within 1 cm of the axis, so within 1.5 cm of the impact's
   ASSERT_LT(std::hypot(bed.position_m[3 * central], bed.position_m[3 * central + 1]), 0.01);
@@ -123,12 +132,7 @@ TEST(AtRest, TheRmsSpeedCountsTheSameColumnAboutTheImpactAxis) {
       ++outside;
     }
   ASSERT_GT(static_cast<double>(outside) / static_cast<double>(bed.size()), 0.2) << "whole-bed RMS above 0.1 %";
-  write_bed(dir.path / "wall.h5", bed);
-  json s = test::tiny_scenario();
-  s["stop"]["max_time_s"] = 0.002;
-  EXPECT_THROW(run_drop_job(s, dir.path / "wall.h5", dir.path / "never.h5", 1, {}, nullptr), ConfigError);
-  s["at_rest"] = {{"surface_radius_D", 0.5}};
-  EXPECT_NO_THROW(run_drop_job(s, dir.path / "wall.h5", dir.path / "ok.h5", 1, {}, nullptr));
+  const json s = refused_on_the_whole_bed_accepted_about_the_axis(dir.path, bed);
   for (std::size_t i = 0; i < bed.size(); ++i)
     bed.velocity_m_s[3 * i] = std::hypot(bed.position_m[3 * i], bed.position_m[3 * i + 1]) > kWindow_m ? 0 : kCreep_m_s;
   write_bed(dir.path / "column.h5", bed);

@@ -2,10 +2,13 @@
 // test process's throwaway PostgreSQL server (tests/common/postgres_server.h) with the files root
 // in the test's folder. The queue tests run on both (parameterised by Store).
 #pragma once
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <string>
 
 #include "tests/common/postgres_server.h"
+#include "tests/common/temp_dir.h"
 
 namespace gravsweep::test {
 
@@ -45,4 +48,27 @@ struct CampaignStore {
   }
 };
 
+/// A test on the store of its parameter: a fresh folder and a campaign location in it; skipped,
+/// saying why, where that backend cannot run here.
+struct StoreTest : ::testing::TestWithParam<Store> {
+  TempDir dir;
+  CampaignStore store{GetParam(), dir.path};
+  void SetUp() override {
+    if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
+  }
+};
+
 }  // namespace gravsweep::test
+
+/// Instantiates the parameterised suite `suite` (a TEST_P on a Store) on the backend this test
+/// binary tests the queue on: PostgreSQL where it is built with GRAVSWEEP_QUEUE_TESTS_ON_POSTGRES,
+/// SQLite elsewhere; each test's name carries the backend's.
+#ifdef GRAVSWEEP_QUEUE_TESTS_ON_POSTGRES
+#define GRAVSWEEP_INSTANTIATE_ON_THE_QUEUE_BACKEND(suite)                                          \
+  INSTANTIATE_TEST_SUITE_P(Postgres, suite, ::testing::Values(::gravsweep::test::Store::postgres), \
+                           [](const auto& info) { return ::gravsweep::test::store_name(info.param); })
+#else
+#define GRAVSWEEP_INSTANTIATE_ON_THE_QUEUE_BACKEND(suite)                                      \
+  INSTANTIATE_TEST_SUITE_P(Sqlite, suite, ::testing::Values(::gravsweep::test::Store::sqlite), \
+                           [](const auto& info) { return ::gravsweep::test::store_name(info.param); })
+#endif

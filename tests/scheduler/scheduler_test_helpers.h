@@ -16,7 +16,8 @@
 #include <vector>
 
 #include "db/database.h"
-#include "tests/common/temp_dir.h"  // TempDir
+#include "tests/common/temp_dir.h"       // TempDir
+#include "tests/common/tiny_campaign.h"  // tiny_base
 
 namespace gravsweep::test {
 
@@ -116,19 +117,11 @@ inline std::string sql_text(db::Database& db, const std::string& sql) {
   return st.get_text(0);
 }
 
-/// The tiny scenario of the integration tests: an 8 cm cup of 1 cm grains, 4 cm deep (a bed
-/// takes about a second, a drop less).
-inline std::string tiny_base() {
-  return R"({
-    "name": "tiny", "gravity_m_s2": 9.81,
-    "container": {"diameter_m": 0.08, "fill_height_m": 0.04},
-    "dt_s": 1e-5,
-    "bed": {"seed": 7, "dt_s": 1e-5, "settle": {"max_time_s": 0.3, "rms_speed_m_s": 1e-4,
-            "max_speed_m_s": 5e-3}, "relax_time_s": 0.02},
-    "projectile": {"diameter_m": 0.03, "mass_kg": 0.03, "impact_speed_m_s": 0.5,
-                   "lateral_offset_max_grain_diameters": 0.5, "seed": 3},
-    "stop": {"max_time_s": 0.25}
-  })";
+/// The smallest sweep spec (JSON text): sweep "s" of two no-op jobs, i = 1 and 2, for the tests
+/// that need a campaign to exist rather than any work in it.
+inline std::string two_noop_jobs_spec() {
+  return R"({"sweep": "s", "job": "noop", "base": {"i": 0},
+             "axes": [{"name": "i", "pointer": "/i", "values": [1, 2]}]})";
 }
 
 }  // namespace gravsweep::test

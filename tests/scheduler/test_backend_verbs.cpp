@@ -18,12 +18,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct BackendVerbs : ::testing::TestWithParam<Store> {
-  TempDir dir;
-  CampaignStore store{GetParam(), dir.path};
-  void SetUp() override {
-    if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
-  }
+struct BackendVerbs : StoreTest {
   /// `verb...` followed by --db LOCATION [--files DIR] and `more`.
   CmdResult cli(std::vector<std::string> args, const std::vector<std::string>& more = {}) {
     for (const auto& a : store.args()) args.push_back(a);
@@ -97,13 +92,7 @@ TEST_P(BackendVerbs, WhereIsTypedTheSameOnBothBackends) {
 }
 
 TEST_P(BackendVerbs, EveryVerbReadingACampaignTakesItsLocation) {
-  json doc = {{"sweep", "v"},
-              {"base", json::parse(tiny_base())},
-              {"axes",
-               {{{"name", "impact_speed_m_s"},
-                 {"pointer", "/projectile/impact_speed_m_s"},
-                 {"values", {0.4, 0.5, 0.6, 0.7, 0.8, 0.9}}}}}};
-  write_text(dir.path / "spec.json", doc.dump());
+  write_text(dir.path / "spec.json", tiny_speed_sweep("v", {0.4, 0.5, 0.6, 0.7, 0.8, 0.9}));
   ASSERT_EQ(cli({"submit", "spec.json"}).code, 0);
   auto r = cli({"work", "--workers", "2", "--threads", "1", "--quiet"});
   ASSERT_EQ(r.code, 0) << r.err;
@@ -122,25 +111,17 @@ TEST_P(BackendVerbs, EveryVerbReadingACampaignTakesItsLocation) {
   EXPECT_TRUE(fs::exists(dir.path / "rep")) << r.out;
 }
 
-#ifdef GRAVSWEEP_QUEUE_TESTS_ON_POSTGRES
-INSTANTIATE_TEST_SUITE_P(Postgres, BackendVerbs, ::testing::Values(Store::postgres),
-                         [](const auto& info) { return store_name(info.param); });
+GRAVSWEEP_INSTANTIATE_ON_THE_QUEUE_BACKEND(BackendVerbs);
 
+#ifdef GRAVSWEEP_QUEUE_TESTS_ON_POSTGRES
 TEST(BackendVerbs, AServerCampaignReadWithoutItsFilesRootIsRefused) {
   TempDir d;
   const CampaignStore store(Store::postgres, d.path);
   if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
-  json doc = {{"sweep", "s"},
-              {"job", "noop"},
-              {"base", {{"i", 0}}},
-              {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"values", {1, 2}}}}}};
-  write_text(d.path / "spec.json", doc.dump());
+  write_text(d.path / "spec.json", two_noop_jobs_spec());
   ASSERT_EQ(run_cli({"submit", "spec.json", "--db", store.location, "--files", store.files.string()}, d.path).code, 0);
   const auto r = run_cli({"model", "fit", store.location}, d.path);
   EXPECT_EQ(r.code, 2) << r.out << r.err;
   EXPECT_NE(r.err.find("--files"), std::string::npos) << r.err;
 }
-#else
-INSTANTIATE_TEST_SUITE_P(Sqlite, BackendVerbs, ::testing::Values(Store::sqlite),
-                         [](const auto& info) { return store_name(info.param); });
 #endif

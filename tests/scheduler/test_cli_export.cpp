@@ -56,11 +56,7 @@ std::string read_text(const std::filesystem::path& p) {
 
 TEST(CliExport, FinishedDropsBecomeAMeasurementCampaign) {
   TempDir d;
-  json doc = {
-      {"sweep", "exp"},
-      {"base", json::parse(tiny_base())},
-      {"axes", {{{"name", "impact_speed_m_s"}, {"pointer", "/projectile/impact_speed_m_s"}, {"values", {0.4, 0.6}}}}}};
-  write_text(d.path / "spec.json", doc.dump());
+  write_text(d.path / "spec.json", tiny_speed_sweep("exp", {0.4, 0.6}));
   ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
   auto r = run_cli({"work", "--db", "c.db", "--workers", "2", "--threads", "1", "--quiet"}, d.path);
   ASSERT_EQ(r.code, 0) << r.err;

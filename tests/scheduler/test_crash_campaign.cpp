@@ -297,10 +297,4 @@ TEST_P(CrashCampaign, SigkilledSupervisorTakesItsWorkersDownAndLosesNothing) {
   }
 }
 
-#ifdef GRAVSWEEP_QUEUE_TESTS_ON_POSTGRES
-INSTANTIATE_TEST_SUITE_P(Postgres, CrashCampaign, ::testing::Values(Store::postgres),
-                         [](const auto& info) { return store_name(info.param); });
-#else
-INSTANTIATE_TEST_SUITE_P(Sqlite, CrashCampaign, ::testing::Values(Store::sqlite),
-                         [](const auto& info) { return store_name(info.param); });
-#endif
+GRAVSWEEP_INSTANTIATE_ON_THE_QUEUE_BACKEND(CrashCampaign);

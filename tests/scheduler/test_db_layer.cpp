@@ -93,10 +93,4 @@ TEST_P(DbBackends, TypesChangesTransactionsAndErrors) {
   }
 }
 
-#ifdef GRAVSWEEP_QUEUE_TESTS_ON_POSTGRES
-INSTANTIATE_TEST_SUITE_P(Postgres, DbBackends, ::testing::Values(test::Store::postgres),
-                         [](const auto& info) { return test::store_name(info.param); });
-#else
-INSTANTIATE_TEST_SUITE_P(Sqlite, DbBackends, ::testing::Values(test::Store::sqlite),
-                         [](const auto& info) { return test::store_name(info.param); });
-#endif
+GRAVSWEEP_INSTANTIATE_ON_THE_QUEUE_BACKEND(DbBackends);

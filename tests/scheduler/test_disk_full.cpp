@@ -43,6 +43,23 @@ struct SmallTmpfs {
   GTEST_SKIP() << "cannot mount a small tmpfs here (" << (tmpfs).why \
                << "): needs root and CAP_SYS_ADMIN; the disk-full case is not tested"
 
+/// Submits five no-op jobs (one attempt each) to c.db in `dir` with their files root `root` on the
+/// small disk `mnt`, makes the root's folders, then fills `mnt` (file mnt/fill) to the last block.
+void submit_five_noops_and_fill_the_disk(const fs::path& dir, const fs::path& mnt, const std::string& root) {
+  nlohmann::json doc = {{"sweep", "full"},
+                        {"job", "noop"},
+                        {"max_attempts", 1},
+                        {"base", {{"g", 1.0}}},
+                        {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {1, 2, 3, 4, 5}}}}}};
+  write_text(dir / "spec.json", doc.dump());
+  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db", "--files", root}, dir).code, 0);
+  for (const char* sub : {"noop", "tmp", "beds", "traces"}) fs::create_directories(fs::path(root) / sub);
+  std::ofstream fill(mnt / "fill", std::ios::binary);
+  const std::string block(4096, 'x');
+  while (fill.write(block.data(), static_cast<std::streamsize>(block.size())) && fill.flush()) {
+  }
+}
+
 TEST(DiskFull, WorkerExitsOneCleanlyAndFinishedWorkStaysIntact) {
   TempDir d;
   const SmallTmpfs tmpfs(d.path, "1m");
@@ -75,22 +92,8 @@ TEST(DiskFull, ANoopJobOnAFullFilesRootFailsWithTheErrno) {
   TempDir d;
   const SmallTmpfs tmpfs(d.path, "256k");
   SKIP_WITHOUT(tmpfs);
-  const fs::path& mnt = tmpfs.path;
-  nlohmann::json doc = {{"sweep", "full"},
-                        {"job", "noop"},
-                        {"max_attempts", 1},
-                        {"base", {{"g", 1.0}}},
-                        {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {1, 2, 3, 4, 5}}}}}};
-  write_text(d.path / "spec.json", doc.dump());
-  const std::string root = (mnt / "files").string();
-  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db", "--files", root}, d.path).code, 0);
-  for (const char* dir : {"noop", "tmp", "beds", "traces"}) fs::create_directories(fs::path(root) / dir);
-  {  // fill the disk
-    std::ofstream fill(mnt / "fill", std::ios::binary);
-    const std::string block(4096, 'x');
-    while (fill.write(block.data(), static_cast<std::streamsize>(block.size())) && fill.flush()) {
-    }
-  }
+  const std::string root = (tmpfs.path / "files").string();
+  ASSERT_NO_FATAL_FAILURE(submit_five_noops_and_fill_the_disk(d.path, tmpfs.path, root));
   // --min-free-mb 0: the worker claims on the full disk (the free-space check would stop it first).
   const auto r = run_cli({"work", "--db", "c.db", "--files", root, "--min-free-mb", "0", "--quiet"}, d.path);
   EXPECT_NE(r.code, 0) << r.err;
@@ -107,22 +110,8 @@ TEST(DiskFull, AFullFilesRootStopsClaimingAndCountsNothingAgainstTheJobs) {
   TempDir d;
   const SmallTmpfs tmpfs(d.path, "256k");
   SKIP_WITHOUT(tmpfs);
-  const fs::path& mnt = tmpfs.path;
-  nlohmann::json doc = {{"sweep", "full"},
-                        {"job", "noop"},
-                        {"max_attempts", 1},
-                        {"base", {{"g", 1.0}}},
-                        {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {1, 2, 3, 4, 5}}}}}};
-  write_text(d.path / "spec.json", doc.dump());
-  const std::string root = (mnt / "files").string();
-  ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db", "--files", root}, d.path).code, 0);
-  for (const char* dir : {"noop", "tmp", "beds", "traces"}) fs::create_directories(fs::path(root) / dir);
-  {  // fill the disk
-    std::ofstream fill(mnt / "fill", std::ios::binary);
-    const std::string block(4096, 'x');
-    while (fill.write(block.data(), static_cast<std::streamsize>(block.size())) && fill.flush()) {
-    }
-  }
+  const std::string root = (tmpfs.path / "files").string();
+  ASSERT_NO_FATAL_FAILURE(submit_five_noops_and_fill_the_disk(d.path, tmpfs.path, root));
   db::Database db((d.path / "c.db").string());
   auto r = run_cli({"work", "--db", "c.db", "--files", root, "--quiet"}, d.path);
   EXPECT_EQ(r.code, 1) << r.err;
@@ -134,7 +123,7 @@ TEST(DiskFull, AFullFilesRootStopsClaimingAndCountsNothingAgainstTheJobs) {
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM attempts WHERE outcome='released' AND error LIKE '%No space left%'"), 1);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='queued' AND attempts=0 AND releases=0"), 5)
       << "an environmental failure counts against no job";
-  fs::remove(mnt / "fill");
+  fs::remove(tmpfs.path / "fill");
   r = run_cli({"work", "--db", "c.db", "--files", root, "--min-free-mb", "0", "--quiet"}, d.path);
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), 5);

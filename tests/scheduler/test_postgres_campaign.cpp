@@ -66,11 +66,7 @@ TEST(PostgresCampaign, AServerCampaignNeedsItsFilesRoot) {
   TempDir d;
   const CampaignStore store(Store::postgres, d.path);
   if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
-  json doc = {{"sweep", "s"},
-              {"job", "noop"},
-              {"base", {{"i", 0}}},
-              {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"values", {1, 2}}}}}};
-  write_text(d.path / "spec.json", doc.dump());
+  write_text(d.path / "spec.json", two_noop_jobs_spec());
   const auto r = run_cli({"submit", "spec.json", "--db", store.location}, d.path);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--files"), std::string::npos) << r.err;
@@ -150,11 +146,7 @@ TEST(PostgresCampaign, SlurmSubmitDryRunPrintsOneArrayOfPilotWorkers) {
   TempDir d;
   const CampaignStore store(Store::postgres, d.path);
   if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
-  json doc = {{"sweep", "s"},
-              {"job", "noop"},
-              {"base", {{"i", 0}}},
-              {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"values", {1, 2}}}}}};
-  write_text(d.path / "spec.json", doc.dump());
+  write_text(d.path / "spec.json", two_noop_jobs_spec());
   ASSERT_EQ(run_cli({"submit", "spec.json", "--db", store.location, "--files", store.files.string()}, d.path).code, 0);
   auto r = run_cli({"slurm", "submit", "--db", store.location, "--files", store.files.string(), "--workers", "3",
                     "--threads", "2", "--partition", "debug", "--time", "00:10:00", "--dry-run"},
@@ -180,11 +172,7 @@ TEST(PostgresCampaign, SlurmSubmitRefusesOptionsOutsideSlurmSyntaxAndQuotesEvery
   const CampaignStore store(Store::postgres, d.path);
   if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
   const fs::path root = d.path / "my files";  // a space: must not cut the #SBATCH --output line
-  json doc = {{"sweep", "s"},
-              {"job", "noop"},
-              {"base", {{"i", 0}}},
-              {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"values", {1, 2}}}}}};
-  write_text(d.path / "spec.json", doc.dump());
+  write_text(d.path / "spec.json", two_noop_jobs_spec());
   ASSERT_EQ(run_cli({"submit", "spec.json", "--db", store.location, "--files", root.string()}, d.path).code, 0);
   const auto slurm = [&](const std::string& option, const std::string& value) {
     return run_cli({"slurm", "submit", "--db", store.location, "--files", root.string(), option, value, "--dry-run"},

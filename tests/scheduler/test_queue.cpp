@@ -464,13 +464,7 @@ TEST_P(QueueTest, ABedThatRunsAloneGetsThePoolsThreads) {
   EXPECT_EQ(threads_for_claim(db, *bed2, 2, 2), 2) << "one worker: its own threads";
 }
 
-#ifdef GRAVSWEEP_QUEUE_TESTS_ON_POSTGRES
-INSTANTIATE_TEST_SUITE_P(Postgres, QueueTest, ::testing::Values(test::Store::postgres),
-                         [](const auto& info) { return test::store_name(info.param); });
-#else
-INSTANTIATE_TEST_SUITE_P(Sqlite, QueueTest, ::testing::Values(test::Store::sqlite),
-                         [](const auto& info) { return test::store_name(info.param); });
-#endif
+GRAVSWEEP_INSTANTIATE_ON_THE_QUEUE_BACKEND(QueueTest);
 
 // A kind registered by the library that plans and runs it: its name enters a new database's check
 // of jobs.kind and its folder the files root; a name registered again with another row, or a

@@ -241,11 +241,7 @@ TEST(ResumeSafety, VersionOneCampaignIsMigratedAndItsRenamedCopyKeepsItsFiles) {
 
 TEST(BedChecksum, AFlippedBitInAFinishedBedFailsTheDropAndRebuildsTheBed) {
   TempDir d;
-  json doc = {
-      {"sweep", "flip"},
-      {"base", json::parse(tiny_base())},
-      {"axes", {{{"name", "impact_speed_m_s"}, {"pointer", "/projectile/impact_speed_m_s"}, {"values", {0.4, 0.6}}}}}};
-  write_text(d.path / "spec.json", doc.dump());
+  write_text(d.path / "spec.json", tiny_speed_sweep("flip", {0.4, 0.6}));
   ASSERT_EQ(run_cli({"submit", "spec.json", "--db", "c.db"}, d.path).code, 0);
   auto r = run_cli({"work", "--db", "c.db", "--max-jobs", "1", "--quiet"}, d.path);  // the bed (priority)
   ASSERT_EQ(r.code, 0) << r.err;

@@ -16,12 +16,7 @@ using nlohmann::json;
 
 namespace {
 
-struct ServeBackends : ::testing::TestWithParam<Store> {
-  TempDir dir;
-  CampaignStore store{GetParam(), dir.path};
-  void SetUp() override {
-    if (!store.skip.empty()) GTEST_SKIP() << "PostgreSQL not available: " << store.skip;
-  }
+struct ServeBackends : StoreTest {
   CmdResult cli(std::vector<std::string> args) {
     for (const auto& a : store.args()) args.push_back(a);
     return run_cli(args, dir.path);
@@ -80,10 +75,4 @@ TEST_P(ServeBackends, PagesFiltersAndFailedJobsAreTheSameOnBothBackends) {
   EXPECT_EQ(serve.stop(), 0) << read_file(serve.log);
 }
 
-#ifdef GRAVSWEEP_QUEUE_TESTS_ON_POSTGRES
-INSTANTIATE_TEST_SUITE_P(Postgres, ServeBackends, ::testing::Values(Store::postgres),
-                         [](const auto& info) { return store_name(info.param); });
-#else
-INSTANTIATE_TEST_SUITE_P(Sqlite, ServeBackends, ::testing::Values(Store::sqlite),
-                         [](const auto& info) { return store_name(info.param); });
-#endif
+GRAVSWEEP_INSTANTIATE_ON_THE_QUEUE_BACKEND(ServeBackends);
