@@ -77,6 +77,7 @@ TraceData trace_columns_of(const DropResult& dr, double nominal_rate_hz) {
   td.release_height_m = dr.release_height_m;
   td.release_speed_m_s = dr.release_speed_m_s;
   td.stopped = dr.stopped;
+  td.mark_contact_start();
   return td;
 }
 

@@ -6,21 +6,14 @@
 
 namespace gravsweep::results {
 
-Trace TraceData::to_trace() const {
-  Trace t;
-  t.source = TraceSource::dem;
-  t.t_s = t_s;
-  t.accel_up_m_s2 = accel_up_m_s2;
-  t.depth_m = depth_m;
-  t.velocity_down_m_s = velocity_down_m_s;
-  // The engine's first contact: the last sample before the first one that counts a contact.
+void TraceData::mark_contact_start() {
+  contact_start_s.reset();
   for (std::size_t k = 0; k < contacts.size() && k < t_s.size(); ++k) {
     if (contacts[k] > 0) {
-      t.contact_start_s = t_s[k == 0 ? 0 : k - 1];
-      break;
+      contact_start_s = t_s[k == 0 ? 0 : k - 1];
+      return;
     }
   }
-  return t;
 }
 
 const std::vector<TraceText>& trace_texts() {
@@ -124,6 +117,7 @@ TraceData read_trace(const std::filesystem::path& path) {
   const std::size_t n = d.t_s.size();
   if (!columns_hold(d, n))
     throw h5::H5Error(fmt::format("trace {}: the /trace columns do not all hold {} samples", path.string(), n));
+  d.mark_contact_start();
   return d;
 }
 

@@ -27,8 +27,11 @@
 
 namespace gravsweep::results {
 
-struct TraceData {
-  std::vector<double> t_s, depth_m, velocity_down_m_s, accel_up_m_s2;
+/// A DEM drop's record as trace.h5 holds it. It is the processing's Trace itself (source dem; t_s,
+/// depth_m, velocity_down_m_s, accel_up_m_s2 and contact_start_s are read by process_trace as
+/// they are, with no copy into another form), with the engine's further columns and the drop's facts.
+struct TraceData : Trace {
+  TraceData() { source = TraceSource::dem; }
   std::vector<double> omega_rad_s;  ///< T x 3
   std::vector<double> position_m;   ///< T x 3
   std::vector<std::int32_t> contacts;
@@ -44,8 +47,10 @@ struct TraceData {
   std::string scenario_json, bed_key_json, bed_file, metrics_json, code_version;
 
   [[nodiscard]] std::size_t size() const { return t_s.size(); }
-  /// The columns compute_metrics() reads.
-  [[nodiscard]] Trace to_trace() const;
+  /// Sets contact_start_s from `contacts`: the engine's first contact is the last sample before the
+  /// first one that counts a contact (none when no sample does). Not stored: read_trace and
+  /// trace_columns_of call it.
+  void mark_contact_start();
 };
 
 /// The fields of trace.h5, one table each, from which write_trace and read_trace (and a DEM trial's

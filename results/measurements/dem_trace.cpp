@@ -41,7 +41,7 @@ MeasuredTrial dem_trial_of(const TraceData& d, const DemTraceRef& ref) {
   ti.impact_speed_m_s = d.release_speed_m_s;
   const auto m = nlohmann::json::parse(d.metrics_json.empty() ? "{}" : d.metrics_json, nullptr, false);
   if (m.is_object() && m.contains("vc_m_s") && m["vc_m_s"].is_number()) ti.impact_speed_m_s = m["vc_m_s"].get<double>();
-  t.raw = d.to_trace();
+  t.raw = d;  // the record's Trace part, as it is
   return t;
 }
 

@@ -153,8 +153,7 @@ std::vector<std::string> trial_row(const std::string& job, const std::string& sw
   const auto metric = [&](const char* k) {
     return m.is_object() && m.contains(k) && m[k].is_number() ? m[k].dump() : std::string();
   };
-  const results::Trace tr = td.to_trace();
-  for (std::string v : {std::string("dem"), tr.contact_start_s ? num(*tr.contact_start_s) : std::string(), sweep,
+  for (std::string v : {std::string("dem"), td.contact_start_s ? num(*td.contact_start_s) : std::string(), sweep,
                         "scenarios/" + job + ".json", num(td.dt_s), metric("grains"), metric("lateral_offset_m")})
     row.push_back(std::move(v));
   return row;

@@ -330,7 +330,9 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   results::merge_disjoint(m, results::to_json(dem));
   td.metrics_json = m.dump();
   check_stop(stop, "drop");
-  DropJobResult out{trace_out, m, {}, {}};
+  DropJobResult out;
+  out.trace_path = trace_out;
+  out.metrics = std::move(m);
   if (snaps) {
     out.snapshots = snaps->count();
     out.snapshot_bytes = snaps->bytes_per_snapshot();

@@ -14,6 +14,7 @@
 #include "results/io/bed_file.h"
 #include "results/io/job_reports.h"
 #include "scheduler/pipeline/job_checkpoint.h"
+#include "scheduler/queue/run_output.h"
 #include "spec/json_schema.h"
 
 namespace gravsweep::pipeline {
@@ -32,9 +33,10 @@ struct BedJobResult {
   results::BedSummary report;  ///< the preparation's report, as bed.h5's `report` holds it
 };
 
-struct DropJobResult {
+/// The drop's outputs as its runner reports them (metrics: vc_m_s, apeak_m_s2, zstop_m, tstop_s,
+/// rebound, the DEM's figures, wall_time_s, ...) with the files it wrote.
+struct DropJobResult : queue::RunOutput {
   std::filesystem::path trace_path;
-  nlohmann::json metrics;  ///< vc_m_s, apeak_m_s2, zstop_m, tstop_s, rebound, wall_time_s, ...
   /// Grain snapshots (/output/snapshot_interval_s > 0): the .h5 and its .xdmf index, else empty.
   std::filesystem::path snapshot_path, snapshot_xdmf;
   std::size_t snapshots = 0, snapshot_bytes = 0;  ///< count, state bytes per snapshot

@@ -93,9 +93,7 @@ RunOutput run_drop(const RunContext& ctx) {
     std::filesystem::create_directories(dir);
     for (const auto& f : {r.snapshot_path, r.snapshot_xdmf}) std::filesystem::rename(f, dir / f.filename());
   }
-  RunOutput out;
-  out.metrics = r.metrics;
-  return out;
+  return r;  // its RunOutput, moved as it is
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 
 #include "db/database.h"
 #include "scheduler/queue/job_types.h"
+#include "scheduler/queue/run_output.h"
 
 namespace gravsweep::queue {
 
@@ -126,12 +127,11 @@ std::optional<Claim> claim(db::Database& db, const WorkerIdentity& who, const Ca
 bool heartbeat(db::Database& db, const Claim& c, double lease_s, double fraction, const std::string& phase,
                const std::string& detail);
 
-struct Completion {
+/// A finished attempt: the runner's output with where its file was stored.
+struct Completion : RunOutput {
   std::string output_rel;
   std::string sha256;
   std::int64_t bytes = 0;
-  nlohmann::json metrics = nlohmann::json::object();  ///< {declared output key: value} (check_outputs)
-  nlohmann::json report = nlohmann::json::object();   ///< free-form, kept in attempts.report_json
 };
 /// Marks the job done (fenced), records output path and checksum, closes the attempt, writes the
 /// results row and releases the dependents, all in one transaction. false = fenced out.

@@ -380,10 +380,8 @@ class Worker {
         failed(c, a.error, a.exit_code, a.permanent);
       return Next::go_on;
     }
-    Completion done;
+    Completion done{std::move(a.out), {}, {}, 0};  // the runner's output, moved; the file's next
     if (!store_output(c, done)) return Next::go_on;
-    done.metrics = a.out.metrics;
-    done.report = a.out.report;
     done.report["wall_s"] = a.wall_s;
     done.report["threads"] = a.threads;
     completed(c, done, a.wall_s);

@@ -38,11 +38,6 @@ struct RunContext {
   double max_memory_bytes = 0;
 };
 
-struct RunOutput {
-  nlohmann::json metrics = nlohmann::json::object();
-  nlohmann::json report = nlohmann::json::object();
-};
-
 /// Runs one job; throws on failure (gravsweep::ConfigError, NumericalFailure and std::bad_alloc
 /// are permanent: the job goes dead at once; anything else is retried with backoff).
 using Runner = std::function<RunOutput(const RunContext&)>;

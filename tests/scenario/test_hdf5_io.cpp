@@ -147,7 +147,8 @@ TEST(Hdf5Io, TraceRoundTripFeedsTheMetrics) {
   EXPECT_EQ(r.contacts, d.contacts);
   EXPECT_EQ(r.metrics_json, d.metrics_json);
   EXPECT_TRUE(r.stopped);
-  const results::Trace t = r.to_trace();
+  const results::Trace& t = r;  // a DEM record is the processing's Trace
+  EXPECT_EQ(t.source, results::TraceSource::dem);
   EXPECT_EQ(t.accel_up_m_s2, d.accel_up_m_s2);
   EXPECT_EQ(t.velocity_down_m_s, d.velocity_down_m_s);
 }
