@@ -4,33 +4,37 @@
 
 namespace gravsweep {
 
-Wall Wall::plane(std::string name, const Vec3& point, const Vec3& inward_normal, std::uint8_t mat) {
+namespace {
+
+/// A wall of `kind` with what every kind has: a name, a material, point_m and the unit `direction`
+/// (Wall::normal: the inward normal of a plane or disk, the axis of a cylinder).
+Wall placed_wall(WallKind kind, std::string name, const Vec3& point, const Vec3& direction, std::uint8_t mat) {
   Wall w;
-  w.kind = WallKind::plane;
+  w.kind = kind;
   w.name = std::move(name);
   w.point_m = point;
-  w.normal = inward_normal.normalized();
+  w.normal = direction.normalized();
   w.material = mat;
   return w;
 }
 
+}  // namespace
+
+Wall Wall::plane(std::string name, const Vec3& point, const Vec3& inward_normal, std::uint8_t mat) {
+  return placed_wall(WallKind::plane, std::move(name), point, inward_normal, mat);
+}
+
 Wall Wall::disk(std::string name, const Vec3& centre, const Vec3& inward_normal, double radius_m, std::uint8_t mat) {
-  Wall w = plane(std::move(name), centre, inward_normal, mat);
-  w.kind = WallKind::disk;
+  Wall w = placed_wall(WallKind::disk, std::move(name), centre, inward_normal, mat);
   w.radius_m = radius_m;
   return w;
 }
 
 Wall Wall::cylinder(std::string name, const Vec3& base, const Vec3& axis, double radius_m, double height_m,
                     std::uint8_t mat) {
-  Wall w;
-  w.kind = WallKind::cylinder;
-  w.name = std::move(name);
-  w.point_m = base;
-  w.normal = axis.normalized();
+  Wall w = placed_wall(WallKind::cylinder, std::move(name), base, axis, mat);
   w.radius_m = radius_m;
   w.height_m = height_m;
-  w.material = mat;
   return w;
 }
 

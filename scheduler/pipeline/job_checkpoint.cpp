@@ -116,32 +116,30 @@ bool JobCheckpointer::due() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - last_write_).count() >= cfg_.interval_s;
 }
 
-DropCheckpoints JobCheckpointer::drop_hooks() {
-  DropCheckpoints h;
-  h.resume = resume_drop();
+template <class Hooks, class State, class PositionOf>
+Hooks JobCheckpointer::hooks(const State* resume, PositionOf position_s) {
+  Hooks h;
+  h.resume = resume;
   if (cfg_.path.empty() || !(cfg_.interval_s > 0)) return h;
   h.due = [this] { return due(); };
-  h.save = [this](const System& sys, const DropLoopState& loop) {
+  h.save = [this, position_s](const System& sys, const decltype(State::loop)& loop) {
     results::CheckpointData c;
-    c.state = DropState{sys.save_state(), loop};
-    c.position_s = loop.result.samples.empty() ? 0.0 : loop.result.samples.back().t_s;
+    c.state = State{sys.save_state(), loop};
+    c.position_s = position_s(sys, loop);
     save(std::move(c));
   };
   return h;
 }
 
+DropCheckpoints JobCheckpointer::drop_hooks() {
+  // A drop's checkpoint is at its last sample (0 before the first).
+  return hooks<DropCheckpoints>(resume_drop(), [](const System&, const DropLoopState& loop) {
+    return loop.result.samples.empty() ? 0.0 : loop.result.samples.back().t_s;
+  });
+}
+
 BedCheckpoints JobCheckpointer::bed_hooks() {
-  BedCheckpoints h;
-  h.resume = resume_bed();
-  if (cfg_.path.empty() || !(cfg_.interval_s > 0)) return h;
-  h.due = [this] { return due(); };
-  h.save = [this](const System& sys, const BedLoopState& loop) {
-    results::CheckpointData c;
-    c.state = BedState{sys.save_state(), loop};
-    c.position_s = sys.time_s();
-    save(std::move(c));
-  };
-  return h;
+  return hooks<BedCheckpoints>(resume_bed(), [](const System& sys, const BedLoopState&) { return sys.time_s(); });
 }
 
 void JobCheckpointer::save(results::CheckpointData c) {

@@ -100,6 +100,10 @@ class JobCheckpointer {
   /// What the run starts over from, for the warnings.
   [[nodiscard]] const char* start() const { return kind_ == "drop" ? "its release" : "its first grain"; }
   [[nodiscard]] bool due() const;
+  /// drop_hooks and bed_hooks: `resume` is the DropState or BedState to continue (or null), and
+  /// `position_s(sys, loop)` the simulated time a checkpoint of that run is at.
+  template <class Hooks, class State, class PositionOf>
+  Hooks hooks(const State* resume, PositionOf position_s);
   /// Removes temporaries of this checkpoint a writer killed mid-write left (<file>.tmp<pid>).
   void remove_stale_temporaries() const;
   void load();

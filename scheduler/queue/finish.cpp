@@ -31,6 +31,44 @@ void end_attempt(Database& db, const Claim& c, const std::string& outcome, doubl
   st.run();
 }
 
+/// Steps `st`, a fenced UPDATE of the claimed job's row (WHERE job_id, lease_token and
+/// state='running') ending in RETURNING state: the job's new state, or "" when the lease was lost
+/// (another worker holds the job now; nothing changed).
+std::string returned_state(Statement& st) {
+  if (!st.step()) return "";
+  std::string state = st.get_text(0);
+  st.run();
+  return state;
+}
+
+/// The end of fail and release once the attempt row is closed: a job that is now dead takes its
+/// waiting dependents with it (they can never run); then commits. Returns `state`.
+std::string commit_new_state(Database& db, Transaction& tx, const Claim& c, const std::string& state, double now) {
+  if (state == "dead") detail::cascade_dead(db, c.job_id, now);
+  tx.commit();
+  return state;
+}
+
+/// Takes the claimed job off its lease without counting the attempt (dependency_mismatch,
+/// give_back): `set_state` is the job's new state (and what goes with it), the lease, phase,
+/// detail and progress are cleared and last_error is `error`. Then closes the attempt row as
+/// `outcome` with `error` and kExitFailure. False when the lease was lost (another worker holds
+/// the job now; nothing changed). Inside the caller's transaction.
+bool take_back(Database& db, const Claim& c, std::string_view set_state, const std::string& outcome,
+               const std::string& error, double now) {
+  {
+    Statement st(db, fmt::format("UPDATE jobs SET {}, attempts=CASE WHEN attempts>0 THEN attempts-1 ELSE 0 END, "
+                                 "last_error=?1, lease_owner=NULL, lease_expires=NULL, progress=NULL, phase=NULL, "
+                                 "detail=NULL WHERE job_id=?2 AND lease_token=?3 AND state='running'",
+                                 set_state));
+    st.bind(1, error).bind(2, c.job_id).bind(3, c.token);
+    st.run();
+    if (db.changes() != 1) return false;
+  }
+  end_attempt(db, c, outcome, now, kExitFailure, error);
+  return true;
+}
+
 }  // namespace
 
 bool complete(Database& db, const Claim& c, const Completion& done) {
@@ -88,30 +126,18 @@ std::string fail(Database& db, const Claim& c, const std::string& error, int exi
                  "finished_at=?4 WHERE job_id=?5 AND lease_token=?6 AND state='running' RETURNING state");
     st.bind(1, permanent ? 1 : 0).bind(2, now + delay + jitter).bind(3, error).bind(4, now).bind(5, c.job_id);
     st.bind(6, c.token);
-    if (!st.step()) return "";
-    state = st.get_text(0);
-    st.run();
+    state = returned_state(st);
   }
+  if (state.empty()) return "";
   end_attempt(db, c, state, now, exit_code, error);
-  if (state == "dead") detail::cascade_dead(db, c.job_id, now);
-  tx.commit();
-  return state;
+  return commit_new_state(db, tx, c, state, now);
 }
 
 bool dependency_mismatch(Database& db, const Claim& c, const std::string& reason) {
   const double now = clock_s(db);
   Transaction tx(db);
-  {
-    Statement st(db,
-                 "UPDATE jobs SET state='waiting', deps_pending=1, last_error=?1, lease_owner=NULL, "
-                 "lease_expires=NULL, phase=NULL, detail=NULL, progress=NULL, attempts=CASE WHEN attempts>0 THEN "
-                 "attempts-1 ELSE 0 END "
-                 "WHERE job_id=?2 AND lease_token=?3 AND state='running'");
-    st.bind(1, reason).bind(2, c.job_id).bind(3, c.token);
-    st.run();
-    if (db.changes() != 1) return false;
-  }
-  end_attempt(db, c, "failed", now, kExitFailure, reason);
+  // The job waits for its dependency to be made again.
+  if (!take_back(db, c, "state='waiting', deps_pending=1", "failed", reason, now)) return false;
   {  // the dependency is made again once, by whichever dependent noticed first
     Statement st(db,
                  "UPDATE jobs SET state='queued', output_path=NULL, output_sha256=NULL, output_bytes=NULL, "
@@ -155,29 +181,17 @@ std::string release(Database& db, const Claim& c, const std::string& why, int ma
                  "RETURNING state");
     st.bind(1, max_releases).bind(2, stopped).bind(3, now).bind(4, c.job_id).bind(5, c.token);
     st.bind(6, saved_progress ? 1 : 0);
-    if (!st.step()) return "";
-    state = st.get_text(0);
-    st.run();
+    state = returned_state(st);
   }
+  if (state.empty()) return "";
   end_attempt(db, c, "released", now, kExitInterrupted, why);
-  if (state == "dead") detail::cascade_dead(db, c.job_id, now);
-  tx.commit();
-  return state;
+  return commit_new_state(db, tx, c, state, now);
 }
 
 bool give_back(Database& db, const Claim& c, const std::string& why) {
   const double now = clock_s(db);
   Transaction tx(db);
-  {
-    Statement st(db,
-                 "UPDATE jobs SET state='queued', attempts=CASE WHEN attempts>0 THEN attempts-1 ELSE 0 END, "
-                 "last_error=?1, lease_owner=NULL, lease_expires=NULL, progress=NULL, phase=NULL, detail=NULL "
-                 "WHERE job_id=?2 AND lease_token=?3 AND state='running'");
-    st.bind(1, why).bind(2, c.job_id).bind(3, c.token);
-    st.run();
-    if (db.changes() != 1) return false;
-  }
-  end_attempt(db, c, "released", now, kExitFailure, why);
+  if (!take_back(db, c, "state='queued'", "released", why, now)) return false;
   tx.commit();
   return true;
 }
