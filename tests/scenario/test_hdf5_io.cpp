@@ -149,6 +149,10 @@ TEST(Hdf5Io, TraceRoundTripFeedsTheMetrics) {
   EXPECT_TRUE(r.stopped);
   const results::Trace& t = r;  // a DEM record is the processing's Trace
   EXPECT_EQ(t.source, results::TraceSource::dem);
+  // The engine's first contact, read back from the contacts: sample 10 is the first that counts
+  // one, so the collision starts at the sample before it.
+  ASSERT_TRUE(t.contact_start_s.has_value());
+  EXPECT_DOUBLE_EQ(*t.contact_start_s, d.t_s[9]);
   EXPECT_EQ(t.accel_up_m_s2, d.accel_up_m_s2);
   EXPECT_EQ(t.velocity_down_m_s, d.velocity_down_m_s);
 }
