@@ -380,7 +380,7 @@ class Worker {
         failed(c, a.error, a.exit_code, a.permanent);
       return Next::go_on;
     }
-    Completion done{std::move(a.out), {}, {}, 0};  // the runner's output, moved; the file's next
+    Completion done{std::move(a.out), {}, {}, 0};  // the runner's output, moved; store_output adds the file
     if (!store_output(c, done)) return Next::go_on;
     done.report["wall_s"] = a.wall_s;
     done.report["threads"] = a.threads;

@@ -262,13 +262,18 @@ TEST(GravitySweep, AboveFroudeOneTheFiveLevelsCollapseAndTheStepHoldsAtThreeMetr
 
 namespace {
 
+/// A committed folder of the gravity sweep (data/gravity_sweep/<folder>).
+std::string sweep_folder(const char* folder) {
+  return (std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "data" / "gravity_sweep" / folder).string();
+}
+
 /// Mean zstop (m) of a folder's drops at each design Froude number (rounded to 0.1), processed in
 /// the drops' own scales.
 std::map<double, double> zstop_by_froude(const std::vector<const char*>& folders) {
   using namespace gravsweep::results;
   std::map<double, std::vector<double>> z;
   for (const char* f : folders) {
-    Campaign c = load_campaign((std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "data" / "gravity_sweep" / f).string());
+    Campaign c = load_campaign(sweep_folder(f));
     reprocess_campaign(c, {"froude", ""});
     for (const auto& t : c.trials) {
       const double fr = t.processed.metrics.vc_m_s / std::sqrt(t.info.gravity_m_s2 * t.info.projectile_diameter_m);
@@ -325,7 +330,7 @@ TEST(GravitySweep, ASecondBedAtOneHundredthGStopsTheProjectileWithinTheSiteSprea
 // from the wall (1.27 D and 1 D on the sweep's 21 cm bed in the 31.5 cm container). It sinks about
 // 11 % deeper than on the sweep's bed, far beyond the spread of sites (1 %) and of beds (a second
 // pour and a poured bed: 1-2 %): the small container's floor and wall hold the projectile up at
-// Fr 5, so the law's Fr 5 miss (depth under-predicted) is not an artefact of confinement.
+// Fr 5. The law's Fr 5 zstop miss (deeper than the 21 cm bed's drops) is that confinement.
 TEST(GravitySweep, ADeeperWiderBedLetsTheFroudeFiveProjectileSinkDeeperThanAnyBedOrSiteSpread) {
   const auto sweep = zstop_by_froude({"g0.01"}), deep = zstop_by_froude({"g0.01_deep"});
   const auto second = zstop_by_froude({"g0.01_bed2_relaxed"}), poured = zstop_by_froude({"g0.01_poured"});
@@ -342,8 +347,7 @@ TEST(GravitySweep, ADeeperWiderBedLetsTheFroudeFiveProjectileSinkDeeperThanAnyBe
   // floor's depth below the surface). From the wall they stay 1.9 D or more by design: the 26 cm
   // radius less the projectile's 5 cm and a site within two grain diameters of the axis.
   using namespace gravsweep::results;
-  Campaign c =
-      load_campaign((std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "data" / "gravity_sweep" / "g0.01_deep").string());
+  Campaign c = load_campaign(sweep_folder("g0.01_deep"));
   reprocess_campaign(c, {"froude", ""});
   ASSERT_FALSE(c.trials.empty());
   for (const auto& t : c.trials)
