@@ -82,7 +82,7 @@ double make_campaign(const std::string& db_path, long n) {
   const auto t0 = Clock::now();
   db::Database db(db_path);
   queue::ensure_schema(db);
-  queue::submit(db, sweep::record(spec), jobs);
+  queue::submit(db, spec, jobs);
   return since(t0);
 }
 

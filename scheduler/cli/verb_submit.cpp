@@ -170,7 +170,7 @@ void run_submit(const SubmitOptions& o) {
   db::Database db = queue::open_campaign(o.db, queue::OpenMode::create, o.files);
   queue::bind_files_root(db, queue::CampaignPaths(o.db, o.files));  // the marker naming this campaign
   for (const auto& p : planned) {
-    const auto r = queue::submit(db, sweep::record(p.spec), p.jobs);
+    const auto r = queue::submit(db, p.spec, p.jobs);
     fmt::print("sweep {} ({}): {} jobs planned ({}): {} new, {} already present\n", r.sweep,
                r.sweep_new ? "new sweep" : "existing sweep", r.planned, jobs_by_kind(p), r.added, r.present);
   }

@@ -334,6 +334,8 @@ SweepSpec parse_spec(const json& doc_in, const std::string& file, const std::fil
   refuse_costly(spec, file);
   spec.source = doc_in;
   spec.source["base"] = spec.base;
+  for (const auto& g : spec.groups)
+    for (const auto& a : g.axes) spec.columns.emplace_back(a.name, a.values);
   spec.file = file;
   return spec;
 }
@@ -364,13 +366,6 @@ queue::PlannedJob point_job(const SweepSpec& spec, std::size_t p, json& scenario
 }
 
 }  // namespace
-
-queue::SweepRecord record(const SweepSpec& spec) {
-  queue::SweepRecord r{spec.name, spec.job_kind, spec.source, spec.max_attempts, {}};
-  for (const auto& g : spec.groups)
-    for (const auto& a : g.axes) r.columns.emplace_back(a.name, a.values);
-  return r;
-}
 
 std::vector<queue::PlannedJob> expand(const SweepSpec& spec, const SweepKind& kind, const ExpandProgress& progress) {
   const std::string file = spec.file.empty() ? spec.name : spec.file;

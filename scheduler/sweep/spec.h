@@ -45,15 +45,14 @@ struct AxisGroup {
   [[nodiscard]] std::size_t size() const { return axes.empty() ? 0 : axes.front().values.size(); }
 };
 
-struct SweepSpec {
-  std::string name;                 ///< sweep name (unique within a campaign)
-  std::string job_kind = "impact";  ///< a registered SweepKind's name (sweep_kind.h): "impact", "noop", ...
-  nlohmann::json base;              ///< canonical base scenario
-  std::vector<AxisGroup> groups;    ///< product over groups, first group slowest; repeats last
-  int max_attempts = 3;
+/// A parsed spec is the sweep the queue stores (queue::SweepRecord: name, job kind, the spec as read
+/// with its base inlined, retry budget and a results column per axis, all set by parse_spec), plus
+/// what expansion needs.
+struct SweepSpec : queue::SweepRecord {
+  nlohmann::json base;            ///< canonical base scenario
+  std::vector<AxisGroup> groups;  ///< product over groups, first group slowest; repeats last
   int priority = 0;
-  nlohmann::json source;  ///< the spec as read (with the base inlined)
-  std::string file;       ///< where it was read from (for error messages)
+  std::string file;  ///< where it was read from (for error messages)
   [[nodiscard]] std::size_t points() const;
 };
 
@@ -62,10 +61,6 @@ struct SweepSpec {
 SweepSpec parse_spec(const nlohmann::json& doc, const std::string& file, const std::filesystem::path& base_dir);
 /// Reads the file (JSON parse errors are SpecError with line/column) and parses it.
 SweepSpec load_spec(const std::filesystem::path& path);
-
-/// The sweep as the queue stores it: name, job kind, source, retry budget and one results column
-/// per axis with its values.
-queue::SweepRecord record(const SweepSpec& spec);
 
 /// A point's scenario as checked by the pipeline that runs it: the scenario its jobs store
 /// (validated, defaults filled, marked so that the worker need not validate it again) and its bed

@@ -76,7 +76,7 @@ queue::WorkerReport submit_and_work(const std::filesystem::path& db_path, const 
     db::Database db(db_path.string());
     queue::ensure_schema(db);
     const auto spec = sweep::parse_spec(doc, doc["sweep"].get<std::string>() + ".json", ".");
-    EXPECT_GT(queue::submit(db, sweep::record(spec), sweep::expand(spec)).added, 0u);
+    EXPECT_GT(queue::submit(db, spec, sweep::expand(spec)).added, 0u);
     if (after_submit) after_submit(db);
   }
   queue::WorkerOptions o;

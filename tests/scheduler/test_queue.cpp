@@ -68,10 +68,10 @@ struct QueueTest : ::testing::TestWithParam<test::Store> {
   /// An impact sweep planned on the bed key `key` (a drop per point, a bed per key), or a sweep of
   /// its registered kind (noop) without one.
   SubmitReport submit_spec(const sweep::SweepSpec& s, const sweep::PointCheckFn& key = {}) {
-    if (!key) return submit(db, sweep::record(s), sweep::expand(s));
+    if (!key) return submit(db, s, sweep::expand(s));
     const sweep::SweepKind kind{
         "impact", "test", {}, sweep::shared_input_planner(key, sweep::drop_kind(), sweep::bed_kind()), {}};
-    return submit(db, sweep::record(s), sweep::expand(s, kind));
+    return submit(db, s, sweep::expand(s, kind));
   }
   Completion done_for(const Claim& c, double value = 1.0) {
     Completion d;

@@ -101,7 +101,7 @@ TEST_P(ResultColumns, TheDeclaredColumnsExistRightAfterSubmit) {
   const auto spec = sweep::parse_spec(doc, "imp.json", ".");
   const sweep::SweepKind impact{
       "impact", "test", {}, sweep::shared_input_planner(by_gravity, sweep::drop_kind(), sweep::bed_kind()), {}};
-  submit(db, sweep::record(spec), sweep::expand(spec, impact));
+  submit(db, spec, sweep::expand(spec, impact));
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE state='done'"), 0) << "nothing ran";
   const auto types = column_types(db);
   const auto& outputs = kind_info(sweep::drop_kind()).outputs;
@@ -126,7 +126,7 @@ TEST_P(ResultColumns, TheDeclaredColumnsExistRightAfterSubmit) {
   EXPECT_EQ(first[1], "checkpoint_resumes");
   EXPECT_EQ(cols.back(), "zstop_surface_m");
   // Submitted again: nothing added, nothing moved.
-  submit(db, sweep::record(spec), sweep::expand(spec, impact));
+  submit(db, spec, sweep::expand(spec, impact));
   EXPECT_EQ(result_columns(db), cols);
 }
 
@@ -138,7 +138,7 @@ TEST_P(ResultColumns, AnUndeclaredMetricOrAWrongTypeIsRefusedAndMakesNoColumn) {
                     {"base", {{"g", 1.5}}},
                     {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {1.0}}}}}};
   const auto spec = sweep::parse_spec(doc, "n.json", ".");
-  submit(db, sweep::record(spec), sweep::expand(spec));
+  submit(db, spec, sweep::expand(spec));
   const CampaignPaths paths(store.location, store.files);
   auto c = claim(db, me, paths, 60);
   ASSERT_TRUE(c);

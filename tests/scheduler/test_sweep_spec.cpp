@@ -68,6 +68,14 @@ TEST(SweepSpec, ProductOfListsRangesZipsAndRepeats) {
   // The range is 0.1, 0.2, 0.3 exactly as literals, not 0.30000000000000004.
   ASSERT_EQ(spec.groups[1].axes[0].values.size(), 3u);
   EXPECT_EQ(gravsweep::queue::canonical_json(spec.groups[1].axes[0].values[2]), "0.3");
+  // The parsed spec is the sweep the queue stores: a results column per axis, in axis order, with
+  // every value the axis takes (the zip's two axes are two columns; the repeats' column last).
+  std::vector<std::string> names;
+  for (const auto& [name, values] : spec.columns) names.push_back(name);
+  EXPECT_EQ(names, (std::vector<std::string>{"gravity_m_s2", "speed_m_s", "fill_m", "dt_s", "seed"}));
+  EXPECT_EQ(spec.columns[1].second, spec.groups[1].axes[0].values);
+  EXPECT_EQ(spec.name, "s");
+  EXPECT_EQ(spec.source["base"], spec.base);
   const auto jobs = expand(spec, test_impact());
   std::size_t beds = 0, drops = 0;
   std::set<std::string> ids;
