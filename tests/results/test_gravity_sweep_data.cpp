@@ -354,3 +354,39 @@ TEST(GravitySweep, ADeeperWiderBedLetsTheFroudeFiveProjectileSinkDeeperThanAnyBe
     EXPECT_GE((t.info.fill_height_m - t.processed.metrics.zstop_m) / t.info.projectile_diameter_m, 2.0)
         << t.info.trial_id;
 }
+
+// The same deep bed at Fr 10 (GRAVITY.md, "Confinement at Fr 5 and 10"): on the sweep's 21 cm bed
+// the projectile stops under 1 D above the floor, on the deep bed 2 D above it, and sinks about a
+// fifth deeper, several times the two sites' spread (2.5 %). The scaled law fitted on the 21 cm
+// beds lies a few % deep of the confined drops but falls short of the unconfined one, beyond 10 %.
+TEST(GravitySweep, AtFroudeTenTheDeepBedLetsTheProjectileSinkAFifthDeeperAndTheLawFallsShort) {
+  using namespace gravsweep::results;
+  const auto sweep = zstop_by_froude({"g0.01"}), deep = zstop_by_froude({"g0.01_deep_fr10"});
+  ASSERT_TRUE(deep.count(10.0) && sweep.count(10.0)) << "Fr 10 on both beds";
+  const double d_deep = deep.at(10.0) / sweep.at(10.0) - 1;
+  std::printf("Fr 10 zstop: deep %.1f mm, the sweep's bed %.1f mm: %+.1f %%\n", 1e3 * deep.at(10.0),
+              1e3 * sweep.at(10.0), 100 * d_deep);
+  EXPECT_GT(d_deep, 0.15);
+  EXPECT_LT(d_deep, 0.26);
+
+  Campaign c = load_campaign(sweep_folder("g0.01_deep_fr10"));
+  reprocess_campaign(c, {"froude", ""});
+  ASSERT_FALSE(c.trials.empty());
+  for (const auto& t : c.trials)
+    EXPECT_GE((t.info.fill_height_m - t.processed.metrics.zstop_m) / t.info.projectile_diameter_m, 2.0)
+        << t.info.trial_id;
+
+  // The law fitted on the five levels' 21 cm beds, applied to this drop (`model predict`).
+  const gravsweep::test::TempDir tmp;
+  const std::string law = (tmp.path / "law.json").string();
+  std::string out;
+  csv_rows("model fit" + sweep_levels() + " --model scaled_base+gravity_depth_friction --resamples 30 --plot '" +
+               (tmp.path / "error_falls.png").string() + "' --save '" + law + "'",
+           out);
+  const auto rows = csv_rows("model predict --law '" + law + "' --gravity 0.01 --speed 0.316228", out);
+  ASSERT_EQ(rows.size(), 1u) << out;
+  const double law_zstop_m = std::stod(rows[0].at("zstop_m"));
+  std::printf("Fr 10 zstop: the law %.1f mm\n", 1e3 * law_zstop_m);
+  EXPECT_GT(law_zstop_m, sweep.at(10.0)) << "deep of the confined drops";
+  EXPECT_LT(law_zstop_m, 0.9 * deep.at(10.0)) << "short of the unconfined drop by more than 10 %";
+}
