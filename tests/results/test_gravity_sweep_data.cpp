@@ -289,6 +289,19 @@ std::map<double, double> zstop_by_froude(const std::vector<const char*>& folders
   return mean;
 }
 
+/// Every drop of a deep-bed folder stops at least 2 D above the floor (the fill height is the
+/// floor's depth below the surface). From the wall they stay 1.9 D or more by design: the 26 cm
+/// radius less the projectile's 5 cm and a site within two grain diameters of the axis.
+void expect_two_diameters_above_the_floor(const char* folder) {
+  using namespace gravsweep::results;
+  Campaign c = load_campaign(sweep_folder(folder));
+  reprocess_campaign(c, {"froude", ""});
+  ASSERT_FALSE(c.trials.empty()) << folder;
+  for (const auto& t : c.trials)
+    EXPECT_GE((t.info.fill_height_m - t.processed.metrics.zstop_m) / t.info.projectile_diameter_m, 2.0)
+        << folder << " " << t.info.trial_id;
+}
+
 }  // namespace
 
 // Beds poured at the target gravity against the ramped beds (GRAVITY.md, "Beds poured at the
@@ -342,17 +355,7 @@ TEST(GravitySweep, ADeeperWiderBedLetsTheFroudeFiveProjectileSinkDeeperThanAnyBe
   EXPECT_GT(d_deep, 0.07);
   EXPECT_LT(d_deep, 0.15);
   EXPECT_GT(d_deep, 3 * std::max(std::abs(d_second), std::abs(d_poured)));
-
-  // Where the deep bed's projectiles stop: at least 2 D above the floor (the fill height is the
-  // floor's depth below the surface). From the wall they stay 1.9 D or more by design: the 26 cm
-  // radius less the projectile's 5 cm and a site within two grain diameters of the axis.
-  using namespace gravsweep::results;
-  Campaign c = load_campaign(sweep_folder("g0.01_deep"));
-  reprocess_campaign(c, {"froude", ""});
-  ASSERT_FALSE(c.trials.empty());
-  for (const auto& t : c.trials)
-    EXPECT_GE((t.info.fill_height_m - t.processed.metrics.zstop_m) / t.info.projectile_diameter_m, 2.0)
-        << t.info.trial_id;
+  expect_two_diameters_above_the_floor("g0.01_deep");
 }
 
 // The same deep bed at Fr 10 (GRAVITY.md, "Confinement at Fr 5 and 10"): on the sweep's 21 cm bed
@@ -360,7 +363,6 @@ TEST(GravitySweep, ADeeperWiderBedLetsTheFroudeFiveProjectileSinkDeeperThanAnyBe
 // fifth deeper, several times the two sites' spread (2.5 %). The scaled law fitted on the 21 cm
 // beds lies a few % deep of the confined drops but falls short of the unconfined one, beyond 10 %.
 TEST(GravitySweep, AtFroudeTenTheDeepBedLetsTheProjectileSinkAFifthDeeperAndTheLawFallsShort) {
-  using namespace gravsweep::results;
   const auto sweep = zstop_by_froude({"g0.01"}), deep = zstop_by_froude({"g0.01_deep_fr10"});
   ASSERT_TRUE(deep.count(10.0) && sweep.count(10.0)) << "Fr 10 on both beds";
   const double d_deep = deep.at(10.0) / sweep.at(10.0) - 1;
@@ -368,13 +370,7 @@ TEST(GravitySweep, AtFroudeTenTheDeepBedLetsTheProjectileSinkAFifthDeeperAndTheL
               1e3 * sweep.at(10.0), 100 * d_deep);
   EXPECT_GT(d_deep, 0.15);
   EXPECT_LT(d_deep, 0.26);
-
-  Campaign c = load_campaign(sweep_folder("g0.01_deep_fr10"));
-  reprocess_campaign(c, {"froude", ""});
-  ASSERT_FALSE(c.trials.empty());
-  for (const auto& t : c.trials)
-    EXPECT_GE((t.info.fill_height_m - t.processed.metrics.zstop_m) / t.info.projectile_diameter_m, 2.0)
-        << t.info.trial_id;
+  expect_two_diameters_above_the_floor("g0.01_deep_fr10");
 
   // The law fitted on the five levels' 21 cm beds, applied to this drop (`model predict`).
   const gravsweep::test::TempDir tmp;
