@@ -38,6 +38,14 @@ std::vector<std::vector<std::size_t>> Campaign::trials_by_level() const {
   return out;
 }
 
+MetricOptions applied_options(const MeasuredTrial& t) {
+  MetricOptions o = metric_options(t.info);
+  const Metrics& m = t.processed.metrics;
+  if (m.cutoff_hz > 0) o.cutoff_hz = m.cutoff_hz;
+  if (m.end_hold_s > 0) o.end_hold_s = m.end_hold_s;
+  return o;
+}
+
 void process_trial(MeasuredTrial& t) {
   t.raw.source = t.info.source;
   MetricOptions o = metric_options(t.info);

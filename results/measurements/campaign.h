@@ -46,6 +46,11 @@ struct Campaign {
 /// The one processing entry: options from the trial (metric_options), bias removal from the
 /// source, the fit window, a clipped record (mark_clipping). Throws std::invalid_argument with the reason.
 void process_trial(MeasuredTrial& t);
+/// The options a processed trial was processed with: metric_options(t.info) with the cut-off and
+/// the hold its metrics record as applied (process_trial's fallback to the fixed scales included),
+/// so that a record processed beside it (a model's record of the same drop) is processed alike,
+/// whether the trial was processed now or read back from an imported database.
+MetricOptions applied_options(const MeasuredTrial& t);
 
 /// Processing a verb imposes on every trial it reads (Trial::time_scale, Trial::end_rule; empty:
 /// each trial's own), for a sensitivity of a result to the processing.

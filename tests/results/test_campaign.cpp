@@ -177,6 +177,36 @@ TEST(Campaign, ReadBackFromSqliteFitsExactlyAsFromTheFolder) {
   for (Eigen::Index j = 0; j < a.coef.size(); ++j) EXPECT_NEAR(b.coef(j), a.coef(j), 1e-9 * std::abs(a.coef(j)));
 }
 
+// A lab record too short for its drop-scaled filter is processed in the paper's fixed scales; a
+// record processed beside it (the model's record that predicts its apeak as measured) must be
+// processed in those scales too, whether the trial was processed now or read back from SQLite.
+TEST(Campaign, ATrialProcessedInTheFixedScalesIsProcessedAgainInThem) {
+  TempDir d;
+  SynthOptions o;
+  o.gravity_m_s2 = {0.1};  // records sized in seconds: 10-30 ms of free fall, 0.1 s of rest
+  o.repeats = 1;
+  o.seed = 5;
+  ASSERT_EQ(write_synthetic_campaign(d.str(), parse_model("base"), o), 8);
+  const Campaign c = load_campaign(d.str(), kPaperCutoff_hz, {"froude", ""});
+  const Campaign back = load_campaign_any(stored_in_sqlite(d, c));
+  ASSERT_EQ(back.trials.size(), c.trials.size());
+  int fell_back = 0;
+  for (std::size_t i = 0; i < c.trials.size(); ++i) {
+    const MeasuredTrial& t = c.trials[i];
+    const MetricOptions applied = applied_options(t);
+    const Metrics again = process_trace(t.raw, applied).metrics;
+    EXPECT_EQ(again.apeak_m_s2, t.processed.metrics.apeak_m_s2) << t.info.trial_id;
+    EXPECT_EQ(again.tstop_s, t.processed.metrics.tstop_s) << t.info.trial_id;
+    EXPECT_EQ(applied_options(back.trials[i]).cutoff_hz, applied.cutoff_hz) << t.info.trial_id;
+    EXPECT_EQ(applied_options(back.trials[i]).end_hold_s, applied.end_hold_s) << t.info.trial_id;
+    if (t.processed.metrics.note.find("fixed scales") == std::string::npos) continue;
+    ++fell_back;
+    EXPECT_EQ(applied.cutoff_hz, kPaperCutoff_hz) << t.info.trial_id;
+    EXPECT_LT(metric_options(t.info).cutoff_hz, 0.2 * kPaperCutoff_hz) << t.info.trial_id;  // asked: 50 Hz
+  }
+  EXPECT_GE(fell_back, 3);
+}
+
 // A database imported before a metric had its column: it is read with that metric at its default,
 // and storing into it adds the column (no rows lost).
 TEST(Campaign, AnOlderMetricsTableGainsTheNewColumnsWhenStoredInto) {
