@@ -267,9 +267,12 @@ std::string sweep_folder(const char* folder) {
   return (std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "data" / "gravity_sweep" / folder).string();
 }
 
-/// Mean zstop (m) of a folder's drops at each design Froude number (rounded to 0.1), processed in
-/// the drops' own scales.
-std::map<double, double> zstop_by_froude(const std::vector<const char*>& folders) {
+/// Mean of a metric (m) of a folder's drops at each design Froude number (rounded to 0.1),
+/// processed in the drops' own scales: zstop from the first contact by default, or from the bed's
+/// mean surface (Metrics::zstop_surface_m).
+std::map<double, double> zstop_by_froude(
+    const std::vector<const char*>& folders,
+    double gravsweep::results::Metrics::*depth = &gravsweep::results::Metrics::zstop_m) {
   using namespace gravsweep::results;
   std::map<double, std::vector<double>> z;
   for (const char* f : folders) {
@@ -277,7 +280,7 @@ std::map<double, double> zstop_by_froude(const std::vector<const char*>& folders
     reprocess_campaign(c, {"froude", ""});
     for (const auto& t : c.trials) {
       const double fr = t.processed.metrics.vc_m_s / std::sqrt(t.info.gravity_m_s2 * t.info.projectile_diameter_m);
-      z[std::round(fr * 10) / 10].push_back(t.processed.metrics.zstop_m);
+      z[std::round(fr * 10) / 10].push_back(t.processed.metrics.*depth);
     }
   }
   std::map<double, double> mean;
@@ -287,6 +290,18 @@ std::map<double, double> zstop_by_froude(const std::vector<const char*>& folders
     mean[fr] = s / static_cast<double>(v.size());
   }
   return mean;
+}
+
+/// The deep bed's three folders (GRAVITY.md, "Confinement, Fr 2 to 10"): one per campaign.
+const std::vector<const char*> kDeepBed{"g0.01_deep", "g0.01_deep_fr10", "g0.01_deep_fr2_3"};
+
+/// A fitted constant of `gravsweep model fit ... --format csv`: {value, standard error}.
+std::pair<double, double> fitted(const std::vector<std::map<std::string, std::string>>& rows, const std::string& name) {
+  for (const auto& r : rows)
+    if (r.count("parameter") && r.at("parameter") == name)
+      return {std::stod(r.at("value")), std::stod(r.at("std_error"))};
+  ADD_FAILURE() << "no fitted " << name;
+  return {0, 1};
 }
 
 /// Every drop of a deep-bed folder stops at least 2 D above the floor (the fill height is the
@@ -358,7 +373,7 @@ TEST(GravitySweep, ADeeperWiderBedLetsTheFroudeFiveProjectileSinkDeeperThanAnyBe
   expect_two_diameters_above_the_floor("g0.01_deep");
 }
 
-// The same deep bed at Fr 10 (GRAVITY.md, "Confinement at Fr 5 and 10"): on the sweep's 21 cm bed
+// The same deep bed at Fr 10 (GRAVITY.md, "Confinement, Fr 2 to 10"): on the sweep's 21 cm bed
 // the projectile stops under 1 D above the floor, on the deep bed 2 D above it, and sinks about a
 // fifth deeper, several times the two sites' spread (2.5 %). The scaled law fitted on the 21 cm
 // beds lies a few % deep of the confined drops but falls short of the unconfined one, beyond 10 %.
@@ -385,4 +400,74 @@ TEST(GravitySweep, AtFroudeTenTheDeepBedLetsTheProjectileSinkAFifthDeeperAndTheL
   std::printf("Fr 10 zstop: the law %.1f mm\n", 1e3 * law_zstop_m);
   EXPECT_GT(law_zstop_m, sweep.at(10.0)) << "deep of the confined drops";
   EXPECT_LT(law_zstop_m, 0.9 * deep.at(10.0)) << "short of the unconfined drop by more than 10 %";
+}
+
+// The deep bed from Fr 2 to 10 (GRAVITY.md, "Confinement, Fr 2 to 10"): the shift in zstop against
+// the sweep's 21 cm bed grows as the floor comes nearer the stop (1.6 D at Fr 2, 1.3 D at Fr 5,
+// under 1 D at Fr 10), from the first contact and from the bed's mean surface alike. At Fr 2 it
+// depends on the reference (the deep bed's sites stand 4 mm above its mean surface); at Fr 10 it
+// is a sixth or more by either.
+TEST(GravitySweep, TheDeepBedsShiftGrowsAsTheFloorNearsTheStop) {
+  using gravsweep::results::Metrics;
+  for (auto depth : {&Metrics::zstop_m, &Metrics::zstop_surface_m}) {
+    const auto sweep = zstop_by_froude({"g0.01"}, depth), deep = zstop_by_froude(kDeepBed, depth);
+    ASSERT_TRUE(deep.count(2.0) && deep.count(3.0) && deep.count(5.0) && deep.count(10.0)) << "Fr 2, 3, 5, 10";
+    const double d2 = deep.at(2.0) / sweep.at(2.0) - 1, d5 = deep.at(5.0) / sweep.at(5.0) - 1,
+                 d10 = deep.at(10.0) / sweep.at(10.0) - 1;
+    std::printf("deep / sweep's bed - 1 (%s): Fr 2 %+.1f %%, Fr 5 %+.1f %%, Fr 10 %+.1f %%\n",
+                depth == &Metrics::zstop_m ? "from the first contact" : "from the mean surface", 100 * d2, 100 * d5,
+                100 * d10);
+    EXPECT_LT(d2, d5);
+    EXPECT_LT(d5, d10);
+    EXPECT_GT(d2, -0.02);
+    EXPECT_LT(d2, 0.12);
+    EXPECT_GT(d10, 0.15);
+  }
+  expect_two_diameters_above_the_floor("g0.01_deep_fr2_3");
+}
+
+// The law on an unconfined bed (GRAVITY.md, "Confinement, Fr 2 to 10"): fitted on the 21 cm beds
+// of the five levels, it is deep of the deep bed's drops at Fr 2 and 3 and short at Fr 10, its error
+// falling along Fr: the misses by Froude number are its form. Fitted on each bed's drops of Fr 2-10
+// at 0.01 m/s2, the container leaves phi and kappa within their errors and raises 1/d1 (the drag).
+TEST(GravitySweep, OnTheDeepBedTheLawsErrorChangesSignAlongFroudeAndTheContainerMovesTheDrag) {
+  const auto deep = zstop_by_froude(kDeepBed);
+  const gravsweep::test::TempDir tmp;
+  const std::string law = (tmp.path / "law.json").string(), plot = (tmp.path / "error_falls.png").string();
+  std::string out;
+  csv_rows("model fit" + sweep_levels() + " --model scaled_base+gravity_depth_friction --resamples 30 --plot '" + plot +
+               "' --save '" + law + "'",
+           out);
+  const auto rows =
+      csv_rows("model predict --law '" + law + "' --gravity 0.01 --speed 0.063246 0.094868 0.158114 0.316228", out);
+  ASSERT_EQ(rows.size(), 4u) << out;
+  double previous = 1e9;
+  for (const auto& r : rows) {
+    const double fr = std::round(std::stod(r.at("impact_froude")) * 10) / 10;
+    ASSERT_TRUE(deep.count(fr)) << "Fr " << fr;
+    const double err = std::stod(r.at("zstop_m")) / deep.at(fr) - 1;
+    std::printf("Fr %.0f: the law %+.1f %% of the deep bed\n", fr, 100 * err);
+    EXPECT_LT(err, previous) << "Fr " << fr;
+    previous = err;
+    if (fr <= 3) EXPECT_GT(err, 0.05) << "Fr " << fr;
+    if (fr >= 10) EXPECT_LT(err, -0.10) << "Fr " << fr;
+  }
+
+  std::string deep_folders;
+  for (const char* f : kDeepBed) deep_folders += level_folder(f);
+  const std::string model = " --model scaled_base+gravity_depth_friction --no-plot";
+  const auto unconfined = csv_rows("model fit" + deep_folders + model, out);
+  const auto confined = csv_rows(
+      "model fit" + level_folder("g0.01") + level_folder("g0.01_axis") + " --where 'impact_froude>=1.9'" + model, out);
+  for (const char* name : {"scaled_base.phi", "gravity_depth_friction.kappa_kg_m", "scaled_base.inv_d1_1_m"}) {
+    const auto [u, su] = fitted(unconfined, name);
+    const auto [c, sc] = fitted(confined, name);
+    const double z = (c - u) / std::hypot(su, sc);
+    std::printf("%s: deep bed %.3g +- %.2g, 21 cm bed %.3g +- %.2g: %.1f SE\n", name, u, su, c, sc, z);
+    if (std::string(name) == "scaled_base.inv_d1_1_m") {
+      EXPECT_GT(z, 2.5) << "the container raises the drag";
+    } else {
+      EXPECT_LT(std::abs(z), 2.0) << name;
+    }
+  }
 }
