@@ -293,7 +293,7 @@ std::map<double, double> zstop_by_froude(
 }
 
 /// The deep bed's three folders (GRAVITY.md, "Confinement, Fr 2 to 10"): one per campaign.
-const std::vector<const char*> kDeepBed{"g0.01_deep", "g0.01_deep_fr10", "g0.01_deep_fr2_3"};
+const std::vector<const char*> kDeepBed{"g0.01_deep", "g0.01_deep_fr10", "g0.01_deep_fr2_3", "g0.01_deep_fr10_site2"};
 
 /// A fitted constant of `gravsweep model fit ... --format csv`: {value, standard error}.
 std::pair<double, double> fitted(const std::vector<std::map<std::string, std::string>>& rows, const std::string& name) {
