@@ -292,7 +292,7 @@ std::map<double, double> zstop_by_froude(
   return mean;
 }
 
-/// The deep bed's three folders (GRAVITY.md, "Confinement, Fr 2 to 10"): one per campaign.
+/// The deep bed's four folders (GRAVITY.md, "Confinement, Fr 2 to 10"): one per export.
 const std::vector<const char*> kDeepBed{"g0.01_deep", "g0.01_deep_fr10", "g0.01_deep_fr2_3", "g0.01_deep_fr10_site2"};
 
 /// A fitted constant of `gravsweep model fit ... --format csv`: {value, standard error}.
@@ -302,6 +302,17 @@ std::pair<double, double> fitted(const std::vector<std::map<std::string, std::st
       return {std::stod(r.at("value")), std::stod(r.at("std_error"))};
   ADD_FAILURE() << "no fitted " << name;
   return {0, 1};
+}
+
+/// Fits the scaled law on the five levels' 21 cm beds and saves it in `dir` (`model fit --save`,
+/// 30 bootstrap resamples); returns the law file's path, for `model predict --law`.
+std::string fitted_sweep_law(const std::filesystem::path& dir) {
+  const std::string law = (dir / "law.json").string();
+  std::string out;
+  csv_rows("model fit" + sweep_levels() + " --model scaled_base+gravity_depth_friction --resamples 30 --plot '" +
+               (dir / "error_falls.png").string() + "' --save '" + law + "'",
+           out);
+  return law;
 }
 
 /// Every drop of a deep-bed folder stops at least 2 D above the floor (the fill height is the
@@ -389,11 +400,8 @@ TEST(GravitySweep, AtFroudeTenTheDeepBedLetsTheProjectileSinkAFifthDeeperAndTheL
 
   // The law fitted on the five levels' 21 cm beds, applied to this drop (`model predict`).
   const gravsweep::test::TempDir tmp;
-  const std::string law = (tmp.path / "law.json").string();
+  const std::string law = fitted_sweep_law(tmp.path);
   std::string out;
-  csv_rows("model fit" + sweep_levels() + " --model scaled_base+gravity_depth_friction --resamples 30 --plot '" +
-               (tmp.path / "error_falls.png").string() + "' --save '" + law + "'",
-           out);
   const auto rows = csv_rows("model predict --law '" + law + "' --gravity 0.01 --speed 0.316228", out);
   ASSERT_EQ(rows.size(), 1u) << out;
   const double law_zstop_m = std::stod(rows[0].at("zstop_m"));
@@ -433,11 +441,8 @@ TEST(GravitySweep, TheDeepBedsShiftGrowsAsTheFloorNearsTheStop) {
 TEST(GravitySweep, OnTheDeepBedTheLawsErrorChangesSignAlongFroudeAndTheContainerMovesTheDrag) {
   const auto deep = zstop_by_froude(kDeepBed);
   const gravsweep::test::TempDir tmp;
-  const std::string law = (tmp.path / "law.json").string(), plot = (tmp.path / "error_falls.png").string();
+  const std::string law = fitted_sweep_law(tmp.path);
   std::string out;
-  csv_rows("model fit" + sweep_levels() + " --model scaled_base+gravity_depth_friction --resamples 30 --plot '" + plot +
-               "' --save '" + law + "'",
-           out);
   const auto rows =
       csv_rows("model predict --law '" + law + "' --gravity 0.01 --speed 0.063246 0.094868 0.158114 0.316228", out);
   ASSERT_EQ(rows.size(), 4u) << out;
