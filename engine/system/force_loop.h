@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "engine/system/finish_queue.h"
 #include "engine/system/hertz_batch.h"
 #include "engine/system/thread_rows.h"
 #include "engine/core/particles.h"
@@ -337,8 +338,8 @@ void wall_loop(ForceContext& c, const ThreadRows& rows, Vec3* F, Vec3* T, long l
 struct alignas(64) ThreadTally {
   long long contacts = 0, wall_contacts = 0;
   double energy_J = 0;
-  // ForceContext::timing set: seconds of the pair and wall loops, of waiting at the barrier after
-  // them, and of the sums and end of step.
+  // ForceContext::timing set: seconds of the pair and wall loops, of waiting for a ready block
+  // after them (FinishQueue), and of the sums and end of step.
   double pair_loops_s = 0, pair_barrier_s = 0, sums_s = 0;
   OverlapFailure worst;
   StepFindings found;
@@ -362,7 +363,7 @@ GRAVSWEEP_INLINE void add_thread_sums(const ForceContext& c, const std::size_t* 
 /// One force evaluation: particle-particle and particle-wall contacts, each thread on its rows
 /// (cut by work, balanced_cut) into its own buffer; the buffers summed with gravity in a fixed
 /// order (deterministic for a given thread count); then, inside the same parallel region, the
-/// integrator's end of step on each thread's share of the particles when c.finish is set.
+/// integrator's end of step on the same blocks when c.finish is set (FinishQueue).
 template <class Law, class Rolling>
 void force_loop(ForceContext& c) {
   Particles& p = c.p;
@@ -375,6 +376,7 @@ void force_loop(ForceContext& c) {
   const bool timed = c.timing != nullptr;
   const double region_start_s = timed ? omp_get_wtime() : 0;
   int team = 1;
+  FinishQueue queue(c.threads);
 
 #pragma omp parallel num_threads(c.threads)
   {
@@ -411,15 +413,18 @@ void force_loop(ForceContext& c) {
     }
     wall_loop<Law, Rolling>(c, rows, F, T, mine.wall_contacts, mine.energy_J, mine.worst);
     const double loops_end_s = timed ? omp_get_wtime() : 0;
-    // Sum the thread buffers in a fixed order and add gravity (same parallel region), each thread
-    // on an even share of the particles; then finish the step on that same share (no barrier:
-    // a particle's update reads only its own sums).
-#pragma omp barrier
-    const double sums_start_s = timed ? omp_get_wtime() : 0;
-    const auto [lo, hi] = even_share(n, t, nt);
+    queue.mark_done(t);
+    // Sum the thread buffers in a fixed order and add gravity (same parallel region), block by
+    // block as they become ready; then finish the step on the same block (a particle's update
+    // reads only its own sums).
     StepFindings& found = mine.found;
-    for (std::size_t b = lo; b < hi; b += kFinishBlock) {
-      const std::size_t e = std::min(hi, b + kFinishBlock);
+    double waited_s = 0;
+    for (;;) {
+      const std::size_t b = queue.next_block.fetch_add(1, std::memory_order_relaxed) * kFinishBlock;
+      if (b >= n) break;
+      const std::size_t e = std::min(n, b + kFinishBlock);
+      const double wait_start_s = timed ? omp_get_wtime() : 0;
+      if (queue.wait_ready(first.data(), nt, e) && timed) waited_s += omp_get_wtime() - wait_start_s;
       for (std::size_t i = b; i < e; ++i) {
         // The same expression as with a buffer for thread 0 (gravity first, then each thread's
         // sum): contraction into FMAs and rounding stay those of the former layout.
@@ -436,8 +441,8 @@ void force_loop(ForceContext& c) {
     }
     if (timed) {
       mine.pair_loops_s = loops_end_s - work_start_s;
-      mine.pair_barrier_s = sums_start_s - loops_end_s;
-      mine.sums_s = omp_get_wtime() - sums_start_s;
+      mine.pair_barrier_s = waited_s;
+      mine.sums_s = omp_get_wtime() - loops_end_s - waited_s;
     }
   }
   if (timed) {

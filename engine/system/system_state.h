@@ -23,12 +23,12 @@ struct Domain {
 /// Where the threads' time in the force region goes, summed over the regions run while a
 /// System::set_region_timing target is set (`gravsweep bench`): the region's wall time, the
 /// thread-seconds of work in it (pair and wall loops, then the sums and the end of step), and the
-/// team size. 1 - busy_s / (threads * wall_s) is the share spent waiting at its barriers (the
-/// one between the loops and the sums, and the region's end) and forking the team.
+/// team size. 1 - busy_s / (threads * wall_s) is the share spent waiting (for a block of the sums
+/// that another thread's loops still hold, and at the region's end) and forking the team.
 struct RegionTiming {
   double wall_s = 0;
   double busy_s = 0;
-  double pair_barrier_wait_s = 0;  ///< thread-seconds at the barrier after the pair and wall loops
+  double pair_barrier_wait_s = 0;  ///< thread-seconds waiting after the pair and wall loops for a ready block
   /// Seconds of the pair and wall loops per thread (the first kTimedThreads): which one waits.
   static constexpr int kTimedThreads = 8;
   std::array<double, kTimedThreads> pair_loops_s{};

@@ -52,7 +52,7 @@ struct BenchRow {
   double neighbour_builds;
   double force_region_share;          ///< of the timed wall time, in the force region (pairs, walls, sums, end of step)
   double wait_share;                  ///< of the force region's thread-time, waiting at its barriers (RegionTiming)
-  double pair_barrier_share;          ///< of it, at the barrier after the pair and wall loops (their imbalance)
+  double pair_barrier_share;          ///< of it, after the pair and wall loops waiting for a ready block
   std::vector<double> pair_loops_us;  ///< per thread, microseconds of pair and wall loops a step
 };
 
@@ -207,8 +207,10 @@ void run_bench(const BenchOptions& o) {
   print_host(host);
   fmt::print(
       "force_region_pct: the step's wall time in the force region (pair and wall loops, force sums, end of step);\n"
-      "barrier_wait_pct: the force region's thread-time spent waiting at its barriers or forking the team;\n"
-      "pair_barrier_pct: the part of it at the barrier after the pair and wall loops (their imbalance).\n");
+      "barrier_wait_pct: the force region's thread-time spent waiting (for a block of the force sums, at the\n"
+      "  region's end) or forking the team;\n"
+      "pair_barrier_pct: the part of it after the pair and wall loops, waiting for a block of the sums that\n"
+      "  another thread's loops still hold (their imbalance, less the blocks finished meanwhile).\n");
   fmt::print("\n{} steps at dt = {} s, Table 1 Chrono set (hertz + sunday rolling, mu_r = 0.09).\n", o.steps, o.dt_s);
   // The barrier wait of the threads moves the 2-thread figure by 10 % (main.cpp, BENCHMARKS.md).
   const char* policy = std::getenv("OMP_WAIT_POLICY");

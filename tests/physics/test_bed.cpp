@@ -170,7 +170,10 @@ TEST(Bed, ARelaxationRunsItsMinimumTimeEvenPastTheCap) {
 
 // 1 and 2 threads agree on a settled 500-grain bed after 1,000 steps: the only difference is the
 // order in which per-thread force buffers are summed (round-off), so positions agree to 1e-9 m
-// (2e-7 of a grain radius). The same thread count twice gives bit-identical results. The step's
+// (2e-7 of a grain radius). The same thread count twice gives bit-identical results, though the
+// blocks of the force sums and end of step go to whichever thread asks first (force_loop.h,
+// FinishQueue): a block finished before a thread that can still read or write it is done would
+// show here as bits that differ between two runs. The step's
 // counters, tallied per thread and combined after the parallel region (force_loop.h,
 // ThreadTally), count every thread's share: the same contacts and wall contacts for 1, 2 and 3
 // threads, the same elastic energy to round-off, and the same bits for 3 threads twice.
@@ -203,6 +206,7 @@ TEST(Threads, OneAndTwoThreadsAgree) {
               one.x_m.size(), one.stats.contacts, one.stats.wall_contacts);
   EXPECT_LT(worst, 1e-9);
   for (std::size_t i = 0; i < two.x_m.size(); ++i) ASSERT_EQ(two.x_m[i], two_again.x_m[i]) << "particle " << i;
+  for (std::size_t i = 0; i < three.x_m.size(); ++i) ASSERT_EQ(three.x_m[i], three_again.x_m[i]) << "particle " << i;
   for (const Run* r : {&two, &three}) {
     EXPECT_EQ(r->stats.contacts, one.stats.contacts);
     EXPECT_EQ(r->stats.wall_contacts, one.stats.wall_contacts);

@@ -75,19 +75,19 @@ TEST(Failure, NaNVelocityIsReported) {
   }
 }
 
-// With two threads the end of step runs inside the force loop on each thread's share, in blocks
-// (force_loop.h, kFinishBlock): the first bad particle of all shares is the one reported, whichever
-// thread and block found it, and the step's findings do not leak into the next step.
+// With two threads the end of step runs inside the force loop in blocks handed to whichever thread
+// asks first (force_loop.h, FinishQueue): the first bad particle of all blocks is the one reported,
+// whichever thread and block found it, and the step's findings do not leak into the next step.
 TEST(Failure, FirstBadParticleOfAllThreadSharesIsReported) {
   auto cfg = no_gravity();
   cfg.threads = 2;
   System s(cfg);
-  const int n = 1500;  // several blocks of the end-of-step loop in each thread's share
+  const int n = 1500;  // several blocks of the end-of-step loop
   for (int i = 0; i < n; ++i)
     s.particles.add(Vec3(0.011 * (i % 40), 0.011 * (i / 40), 0), 0.005, 1.3e-3, 0, SizeClass::grain);
   s.advance(2);
-  s.particles.velocity_m_s[1300].y() = std::numeric_limits<double>::quiet_NaN();  // thread 1's share
-  s.particles.velocity_m_s[700].x() = std::numeric_limits<double>::infinity();    // thread 0's share, a later block
+  s.particles.velocity_m_s[1300].y() = std::numeric_limits<double>::quiet_NaN();  // a late block
+  s.particles.velocity_m_s[700].x() = std::numeric_limits<double>::infinity();    // an earlier block
   try {
     s.step();
     FAIL() << "expected NumericalFailure";
