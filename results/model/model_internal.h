@@ -42,10 +42,12 @@ inline int fold_count(const std::vector<int>& f) {
   for (const int k : f) n = k + 1 > n ? k + 1 : n;
   return n;
 }
-/// Fits on one fold's training trials (`train`) and fills the held-out trials' entries of `h`.
+/// Fits on one fold's training trials (`train`) and fills the held-out trials' entries of `h`,
+/// and no other: the folds run on parallel threads, each on its own entries of the same `h`.
 using FoldFit = std::function<void(const std::vector<bool>& train, HeldOut& h)>;
 /// The loop of every grouped K-fold cross-validation (fold_of): `fit_fold` once per fold that
-/// holds a trial out, on a HeldOut sized to the campaign's trials (NaN until filled).
+/// holds a trial out, on a HeldOut sized to the campaign's trials (NaN until filled); the folds
+/// in parallel (OpenMP, as many threads as cores), the result independent of the thread count.
 HeldOut over_folds(const Campaign& c, int folds, unsigned seed, const FoldFit& fit_fold);
 
 /// One forward step over the generated family (search_generated.cpp). The form is the one that,

@@ -3,6 +3,8 @@
 // form out of many is itself what the held-out test judges.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <exception>
 #include <limits>
 
 #include "results/model/generated.h"
@@ -37,8 +39,8 @@ double mean_relative_gain(const std::vector<double>& before, const std::vector<d
 }
 
 struct Screened {
-  const TermInfo* term;
-  double gain;              ///< in-sample mean relative gain over `current`
+  const TermInfo* term = nullptr;
+  double gain = 0;          ///< in-sample mean relative gain over `current`
   std::vector<double> mse;  ///< per-trial in-sample trace MSE with the form
 };
 
@@ -49,17 +51,31 @@ struct Screening {
   std::vector<double> current_mse;  ///< per-trial in-sample trace MSE of `current`
   std::vector<Screened> ranked;
 };
+/// The forms are fitted in parallel (OpenMP), each into its own slot, so the ranking is the same
+/// on any number of threads; an error is rethrown after the loop, the first form's first.
 Screening screen(const ModelSpec& current, const Campaign& c, const std::vector<bool>& mask, bool per_gravity = true) {
   Screening out{fit_model(current, c, mask), {}, {}};
   out.current_mse = trial_mses(out.current, c, mask);
-  for (const auto& name : generated_family()) {
-    if (current.has(name)) continue;
-    ModelSpec s = current;
-    const TermInfo* t = generated_term(name);
-    s.terms.push_back({t, per_gravity, 1.0});
-    auto mse = trial_mses(fit_model(s, c, mask), c, mask);
-    out.ranked.push_back({t, mean_relative_gain(out.current_mse, mse), std::move(mse)});
+  std::vector<const TermInfo*> forms;
+  for (const auto& name : generated_family())
+    if (!current.has(name)) forms.push_back(generated_term(name));
+  out.ranked.resize(forms.size());
+  std::vector<std::exception_ptr> failed(forms.size());
+  const auto n_forms = static_cast<std::ptrdiff_t>(forms.size());
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::ptrdiff_t k = 0; k < n_forms; ++k) {
+    const auto j = static_cast<std::size_t>(k);
+    try {
+      ModelSpec s = current;
+      s.terms.push_back({forms[j], per_gravity, 1.0});
+      auto mse = trial_mses(fit_model(s, c, mask), c, mask);
+      out.ranked[j] = {forms[j], mean_relative_gain(out.current_mse, mse), std::move(mse)};
+    } catch (...) {
+      failed[j] = std::current_exception();
+    }
   }
+  for (const auto& e : failed)
+    if (e) std::rethrow_exception(e);
   std::stable_sort(out.ranked.begin(), out.ranked.end(),
                    [](const Screened& a, const Screened& b) { return a.gain > b.gain; });
   return out;
