@@ -292,8 +292,9 @@ std::map<double, double> zstop_by_froude(
   return mean;
 }
 
-/// The deep bed's four folders (GRAVITY.md, "Confinement, Fr 2 to 10"): one per export.
-const std::vector<const char*> kDeepBed{"g0.01_deep", "g0.01_deep_fr10", "g0.01_deep_fr2_3", "g0.01_deep_fr10_site2"};
+/// The deep bed's five folders (GRAVITY.md, "Confinement, Fr 2 to 10"): one per export.
+const std::vector<const char*> kDeepBed{"g0.01_deep", "g0.01_deep_fr10", "g0.01_deep_fr2_3", "g0.01_deep_fr10_site2",
+                                        "g0.01_deep_fr2_site3"};
 
 /// A fitted constant of `gravsweep model fit ... --format csv`: {value, standard error}.
 std::pair<double, double> fitted(const std::vector<std::map<std::string, std::string>>& rows, const std::string& name) {
