@@ -477,3 +477,44 @@ TEST(GravitySweep, OnTheDeepBedTheLawsErrorChangesSignAlongFroudeAndTheContainer
     }
   }
 }
+
+// At 0.01 m/s2 the traces of both beds (the 21 cm drops and the deep bed's) name a drag linear in
+// the speed as the missing term (held-out trace error down 12 %, better on 18 of 21 drops,
+// p = 0.0011 against the 0.0014 seven candidates need). It is a term of the traces, not of the zstop
+// misses along Fr: added to the law fitted on the five levels' 21 cm beds it moves the law's zstop
+// at Fr 2 and 10 by under 3 %, so the law still errs deep at Fr 2 and short at Fr 10 on the deep bed.
+TEST(GravitySweep, AtOneHundredthGTheTracesNameALinearDragThatLeavesTheMissesAlongFroude) {
+  std::string folders;
+  for (const char* f : kDeepBed) folders += level_folder(f);
+  const auto r =
+      gravsweep::testing::run_gravsweep("model rank" + folders + level_folder("g0.01") + level_folder("g0.01_axis") +
+                                            " --baseline scaled_base+gravity_depth_friction",
+                                        false);
+  ASSERT_EQ(r.code, 0) << r.out;
+  std::printf("%s", r.out.c_str());
+  EXPECT_NE(r.out.find("Verdict: missing effect: viscous_drag ("), std::string::npos) << r.out;
+
+  const gravsweep::test::TempDir tmp;
+  const auto deep = zstop_by_froude(kDeepBed);
+  auto law_zstop = [&](const std::string& model, const char* name) {
+    const std::string law = (tmp.path / name).string();
+    std::string out;
+    csv_rows("model fit" + sweep_levels() + " --model " + model + " --resamples 30 --no-plot --save '" + law + "'",
+             out);
+    const auto rows = csv_rows("model predict --law '" + law + "' --gravity 0.01 --speed 0.063246 0.316228", out);
+    EXPECT_EQ(rows.size(), 2u) << out;
+    std::map<double, double> z;
+    for (const auto& row : rows) z[std::round(std::stod(row.at("impact_froude")))] = std::stod(row.at("zstop_m"));
+    return z;
+  };
+  const auto without = law_zstop("scaled_base+gravity_depth_friction", "law.json");
+  const auto with = law_zstop("scaled_base+gravity_depth_friction+viscous_drag", "law_drag.json");
+  for (const double fr : {2.0, 10.0}) {
+    ASSERT_TRUE(without.count(fr) && with.count(fr) && deep.count(fr)) << "Fr " << fr;
+    std::printf("Fr %.0f: the law %.1f mm, with the linear drag %.1f mm, the deep bed %.1f mm\n", fr,
+                1e3 * without.at(fr), 1e3 * with.at(fr), 1e3 * deep.at(fr));
+    EXPECT_LT(std::abs(with.at(fr) / without.at(fr) - 1), 0.03) << "Fr " << fr;
+  }
+  EXPECT_GT(with.at(2.0) / deep.at(2.0) - 1, 0.05) << "still deep at Fr 2";
+  EXPECT_LT(with.at(10.0) / deep.at(10.0) - 1, -0.05) << "still short at Fr 10";
+}
