@@ -214,7 +214,8 @@ def collapse(inputs, where: str | None = None, time_scale: str | None = None,
 
 
 def fit(inputs, model: str, baseline: str | None = None, where: str | None = None, **options) -> dict:
-    """`gravsweep model fit`: {'parameters': DataFrame, 'errors': DataFrame} (held-out errors)."""
+    """`gravsweep model fit`: {'parameters': DataFrame, 'errors': DataFrame} (held-out errors; and
+    'projectiles' with leave_out="projectile")."""
     args = ["model", "fit", *_inputs(inputs), "--model", model, "--no-plot", "--format", "json"]
     if baseline:
         args += ["--baseline", baseline]
@@ -222,16 +223,25 @@ def fit(inputs, model: str, baseline: str | None = None, where: str | None = Non
         args += ["--where", where]
     for k, v in options.items():
         args += [f"--{k.replace('_', '-')}", str(v)]
-    docs = _json_documents(run_cli(args))
-    return {"parameters": pd.DataFrame(docs[0]), "errors": pd.DataFrame(docs[1] if len(docs) > 1 else [])}
+    doc = json.loads(run_cli(args))
+    out = {"parameters": pd.DataFrame(doc["parameters"]), "errors": pd.DataFrame(doc["held_out_errors"])}
+    if "projectiles_held_out" in doc:
+        out["projectiles"] = pd.DataFrame(doc["projectiles_held_out"])
+    return out
 
 
-def rank(inputs, scaled: bool = False, where: str | None = None) -> list:
-    """`gravsweep model rank --format json`: the ranking's JSON documents."""
+def rank(inputs, scaled: bool = False, where: str | None = None, baseline: str | None = None) -> dict:
+    """`gravsweep model rank --format json`: {'baseline': str, 'residual_axes': DataFrame,
+    'candidates': DataFrame (round, rank, term, mean_rel_improvement_pct, trials_better, trials,
+    p_signed_rank, significant), 'verdict': str}."""
     args = ["model", "rank", *_inputs(inputs), "--format", "json"] + (["--scaled"] if scaled else [])
+    if baseline:
+        args += ["--baseline", baseline]
     if where:
         args += ["--where", where]
-    return _json_documents(run_cli(args))
+    doc = json.loads(run_cli(args))
+    return {"baseline": doc["baseline"], "residual_axes": pd.DataFrame(doc["residual_axes"]),
+            "candidates": pd.DataFrame(doc["candidates"]), "verdict": doc["verdict"]}
 
 
 def predict(law: str | os.PathLike, gravity, speed, diameter: float = 0.1, mass: float = 1.0,

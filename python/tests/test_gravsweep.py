@@ -76,6 +76,10 @@ def test_fit_predict_and_infer_through_the_cli():
     assert set(f["parameters"].parameter) == {"scaled_base.phi", "scaled_base.inv_d1_1_m",
                                              "gravity_depth_friction.kappa_kg_m"}
     assert (f["errors"].model == "scaled_base+gravity_depth_friction").any()
+    r = gravsweep.rank([SWEEP / "g9.81", SWEEP / "g0.1"], baseline="scaled_base")  # one JSON document
+    assert r["baseline"] == "scaled_base" and r["verdict"]
+    assert {"round", "rank", "term", "p_signed_rank", "significant"} <= set(r["candidates"].columns)
+    assert "depth_m" in set(r["residual_axes"].axis)
     p = gravsweep.predict(LAW, gravity=[1.62, 0.01], speed=0.3)
     assert list(p.range) == ["inside", "inside"]
     assert (p.zstop_lo_m < p.zstop_m).all() and (p.zstop_m < p.zstop_hi_m).all()

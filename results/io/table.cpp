@@ -108,15 +108,17 @@ std::string Table::csv() const {
   return out;
 }
 
-std::string Table::json() const {
+nlohmann::json Table::json_value() const {
   nlohmann::json a = nlohmann::json::array();
   for (const auto& r : rows_) {
     nlohmann::json o = nlohmann::json::object();
     for (std::size_t j = 0; j < cols_.size(); ++j) o[cols_[j]] = r.value.empty() ? cell_json(r.text[j]) : r.value[j];
     a.push_back(std::move(o));
   }
-  return a.dump(2) + "\n";
+  return a;
 }
+
+std::string Table::json() const { return json_value().dump(2) + "\n"; }
 
 std::string Table::render_html() const {
   std::string out = "<table>\n<tr>";

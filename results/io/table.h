@@ -60,6 +60,8 @@ class Table {
   [[nodiscard]] std::string csv() const;
   /// An array with one object per row, keyed by column.
   [[nodiscard]] std::string json() const;
+  /// The same array as a value, for a verb that prints several tables as one JSON document.
+  [[nodiscard]] nlohmann::json json_value() const;
   /// An HTML <table> (cells escaped; numeric cells right-aligned by the page's style).
   [[nodiscard]] std::string render_html() const;
   void print(const std::string& format) const;

@@ -54,7 +54,7 @@ results::ModelSpec model_of(const std::string& text) {
   }
 }
 
-void print_residual_axes(const std::vector<results::AxisResidual>& axes, const std::string& format) {
+results::Table residual_axes_table(const std::vector<results::AxisResidual>& axes) {
   results::Table t({"axis", "eta2", "split_half_r", "trials_slope_up", "trials_slope_down", "sign_test_p",
                     "mean_residual_over_g_by_bin"});
   for (const auto& a : axes) {
@@ -66,7 +66,11 @@ void print_residual_axes(const std::vector<results::AxisResidual>& axes, const s
            trial_level ? "-" : std::to_string(a.trials_positive), trial_level ? "-" : std::to_string(a.trials_negative),
            trial_level ? "-" : results::num(a.slope_sign_trials_p, 2), bins});
   }
-  t.print(format);
+  return t;
+}
+
+void print_residual_axes(const std::vector<results::AxisResidual>& axes, const std::string& format) {
+  residual_axes_table(axes).print(format);
 }
 
 }  // namespace gravsweep::cli

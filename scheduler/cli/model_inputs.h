@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "results/io/table.h"
 #include "results/model/model_spec.h"
 #include "results/model/residual_axes.h"
 
@@ -31,7 +32,9 @@ results::Campaign load_model_campaign(const ModelInputs& o, std::size_t min_tria
 /// A model from its term list ('base+depth_friction') or a JSON spec file; UsageError when unknown.
 results::ModelSpec model_of(const std::string& text);
 
-/// Residual a_meas - a_model in units of g along each axis (results::residual_axes), as a table.
+/// Residual a_meas - a_model in units of g along each axis (results::residual_axes), as a table
+/// (axis, eta^2, split-half r, slope signs, bins), and that table printed.
+results::Table residual_axes_table(const std::vector<results::AxisResidual>& axes);
 void print_residual_axes(const std::vector<results::AxisResidual>& axes, const std::string& format);
 
 }  // namespace gravsweep::cli

@@ -4,8 +4,10 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -59,12 +61,12 @@ void save_law(const FitOptions& o, const results::ModelSpec& spec, const results
         law.levels);
 }
 
-void print_params(const results::FittedModel& m, const std::string& format) {
+results::Table params_table(const results::FittedModel& m) {
   results::Table t({"parameter", "value", "std_error", "unit_note"});
   for (Eigen::Index j = 0; j < m.coef.size(); ++j)
     t.add({m.column_names[static_cast<std::size_t>(j)], num(m.coef(j)), num(std::sqrt(std::max(0.0, m.cov(j, j))), 2),
            "SE cluster-robust over trials"});
-  t.print(format);
+  return t;
 }
 
 results::Table error_table(const std::vector<results::ComparedModel>& cm) {
@@ -175,16 +177,11 @@ int projectile_count(const results::Campaign& c) {
   return n;
 }
 
-void run_fit(const FitOptions& o) {
+/// The held-out errors in `table` or `csv`: the table of errors before and after, each projectile's
+/// when it is held out, and (table) why an error does not fall.
+void print_errors(const FitOptions& o, const results::Campaign& c, const std::vector<results::ComparedModel>& cm,
+                  int folds) {
   const bool table = o.in.format == "table";
-  const auto c = load_model_campaign(o.in);
-  const auto base = model_of(o.baseline);
-  const auto spec = model_of(o.model);
-  const auto fm = results::fit_model(spec, c);
-  if (table) fmt::print("Model {} fitted on {} trials ({} samples):\n", spec.name(), fm.trials_used, fm.samples_used);
-  print_params(fm, o.in.format);
-  const int folds = o.leave_out == "projectile" ? results::kLeaveOneProjectileOut : o.folds;
-  const auto cm = results::compare_models(c, {base, spec}, folds);
   if (table && folds == results::kLeaveOneProjectileOut)
     fmt::print("\nHeld-out errors (leave one projectile out: {} projectiles by diameter and mass), before and after:\n",
                projectile_count(c));
@@ -197,6 +194,36 @@ void run_fit(const FitOptions& o) {
     projectile_table(c, cm).print(o.in.format);
   }
   if (table) explain_rises(cm);
+}
+
+/// `--format json`: one document with the constants and the held-out errors (and each projectile's
+/// when projectiles are held out), so that a script reads it with one parse.
+void print_fit_json(const results::ModelSpec& spec, const results::FittedModel& fm, const results::Campaign& c,
+                    const std::vector<results::ComparedModel>& cm, bool by_projectile) {
+  nlohmann::json out = {{"model", spec.name()},
+                        {"trials", fm.trials_used},
+                        {"samples", fm.samples_used},
+                        {"parameters", params_table(fm).json_value()},
+                        {"held_out_errors", error_table(cm).json_value()}};
+  if (by_projectile) out["projectiles_held_out"] = projectile_table(c, cm).json_value();
+  std::fputs((out.dump(2) + "\n").c_str(), stdout);
+}
+
+void run_fit(const FitOptions& o) {
+  const bool table = o.in.format == "table";
+  const auto c = load_model_campaign(o.in);
+  const auto base = model_of(o.baseline);
+  const auto spec = model_of(o.model);
+  const auto fm = results::fit_model(spec, c);
+  const int folds = o.leave_out == "projectile" ? results::kLeaveOneProjectileOut : o.folds;
+  const auto cm = results::compare_models(c, {base, spec}, folds);
+  if (o.in.format == "json") {
+    print_fit_json(spec, fm, c, cm, folds == results::kLeaveOneProjectileOut);
+  } else {
+    if (table) fmt::print("Model {} fitted on {} trials ({} samples):\n", spec.name(), fm.trials_used, fm.samples_used);
+    params_table(fm).print(o.in.format);
+    print_errors(o, c, cm, folds);
+  }
   if (!o.save.empty()) save_law(o, spec, c);
   if (o.no_plot || o.plot.empty()) return;
   const std::filesystem::path png = std::filesystem::absolute(o.plot);
@@ -223,7 +250,8 @@ void setup_model_fit(CLI::App& model) {
       "applies to a gravity, speed, diameter and mass of one's own: its constants and their\n"
       "covariance, --resamples bootstrap resamples of them (whole drops, within each level), its\n"
       "error by Froude number (held out by gravity level) and the ranges it was fitted on\n"
-      "(docs/formats/law.md).");
+      "(docs/formats/law.md). --format json prints one document: {model, trials, samples, parameters:\n"
+      "[...], held_out_errors: [...], and projectiles_held_out: [...] with --leave-out projectile}.");
   add_model_inputs(sub, o->in);
   sub->add_option("--model", o->model, "model: 'base+depth_friction' or a JSON spec file")->capture_default_str();
   sub->add_option("--baseline", o->baseline, "the 'before' model")->capture_default_str();

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "results/model/discover.h"
@@ -27,7 +28,9 @@ struct RankOptions {
   double min_improvement = 0.03;
 };
 
-void print_ranking(const results::Discovery& d, const std::string& format) {
+/// The candidates of every round, the generated form's test and the screened forms (the first
+/// six in `table`, all otherwise).
+results::Table ranking_table(const results::Discovery& d, const std::string& format) {
   results::Table t(
       {"round", "rank", "term", "mean_rel_improvement_pct", "trials_better", "trials", "p_signed_rank", "significant"});
   for (std::size_t r = 0; r < d.rounds.size(); ++r)
@@ -50,7 +53,12 @@ void print_ranking(const results::Discovery& d, const std::string& format) {
     const auto& c = d.generated_screened[i];
     t.add({"screened", std::to_string(i + 1), c.term, num(100 * c.mean_rel_improvement, 3), "-", "-", "-", "-"});
   }
-  t.print(format);
+  return t;
+}
+
+void print_ranking(const results::Discovery& d, const std::string& format) {
+  ranking_table(d, format).print(format);
+  const std::size_t shown = format == "table" ? std::min<std::size_t>(6, d.generated_screened.size()) : 0;
   if (format == "table" && shown < d.generated_screened.size())
     fmt::print(
         "(round 'generated': the held-out test of choosing a form, nested CV; 'screened': in-sample gain of "
@@ -62,6 +70,14 @@ void run_rank(const RankOptions& o) {
   const bool table = o.in.format == "table";
   const auto c = load_model_campaign(o.in);
   const auto d = results::discover(c, model_of(o.baseline), o.folds, o.alpha, o.min_improvement);
+  if (o.in.format == "json") {  // one document: the two tables and the verdict
+    const nlohmann::json out = {{"baseline", d.baseline},
+                                {"residual_axes", residual_axes_table(d.residual_before).json_value()},
+                                {"candidates", ranking_table(d, o.in.format).json_value()},
+                                {"verdict", d.verdict}};
+    std::fputs((out.dump(2) + "\n").c_str(), stdout);
+    return;
+  }
   if (table) fmt::print("Where {} fails (residual a_meas - a_model in units of g):\n", d.baseline);
   print_residual_axes(d.residual_before, o.in.format);
   if (table) fmt::print("\nCandidate terms by held-out improvement:\n");
@@ -93,7 +109,8 @@ void setup_model_rank(CLI::App& model) {
       "over a generated family of forms (z^a |v|^b, exp(-z/l), 1-exp(-z/l) and their products with\n"
       "z, |v|, v^2; each per gravity level or shared) and a significant one is reported by its\n"
       "formula, never by a physical name, with the held-out errors without and with it; fit it\n"
-      "like a named term: --model 'base+z^1*v^1'.\n\n"
+      "like a named term: --model 'base+z^1*v^1'. --format json prints one document:\n"
+      "{baseline, residual_axes: [...], candidates: [...], verdict}.\n\n"
       "Examples:\n  gravsweep model rank ../shared/data/measurements/depth-friction-dev\n"
       "  gravsweep model rank campaign.db          # the drops of `gravsweep submit` + `work`\n"
       "  gravsweep model rank data/reproduction/chrono_1g --where 'impact_speed_m_s<0.5'  # one regime\n"

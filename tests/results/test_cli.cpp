@@ -256,3 +256,26 @@ TEST(Cli, ModelFitRefusesATrialOutsidePhysicalRangesNamingIt) {
     EXPECT_NE(r.out.find("x.db"), std::string::npos) << mass << ": " << r.out;
   }
 }
+
+// `--format json` is one JSON document a script reads with one parse, also for the verbs that
+// print several tables: model fit (constants and held-out errors) and model rank (residual axes,
+// candidates and the verdict). They were a run of documents, which no JSON reader takes.
+TEST(Cli, ModelFitAndRankPrintOneJsonDocument) {
+  TempDir d;
+  const std::string c = d.str() + "/c";
+  ASSERT_EQ(run("synth --out '" + c + "' --gravity 9.81,0.1 --speeds 0.2,0.5,1.0 --repeats 2").code, 0);
+  const auto fit = run("model fit '" + c + "' --model base+depth_friction --no-plot --format json");
+  ASSERT_EQ(fit.code, 0) << fit.out;
+  const auto f = nlohmann::json::parse(fit.out);  // throws on a second document
+  EXPECT_EQ(f.at("model"), "base+depth_friction");
+  EXPECT_EQ(f.at("trials"), 12);
+  EXPECT_FALSE(f.at("parameters").empty());
+  EXPECT_EQ(f.at("held_out_errors").size(), 3u) << f.dump();  // the paper's Eq. 2-4, baseline, model
+  const auto rank = run("model rank '" + c + "' --format json");
+  ASSERT_EQ(rank.code, 0) << rank.out;
+  const auto r = nlohmann::json::parse(rank.out);
+  EXPECT_EQ(r.at("baseline"), "base");
+  EXPECT_FALSE(r.at("residual_axes").empty());
+  EXPECT_FALSE(r.at("candidates").empty());
+  EXPECT_FALSE(r.at("verdict").get<std::string>().empty());
+}
