@@ -25,6 +25,15 @@ Run run(const std::string& args, bool merge_stderr = false) {
   return gravsweep::testing::run_gravsweep(args, merge_stderr);
 }
 
+/// A synthetic campaign (`gravsweep synth`, `levels`: --gravity's list) of speeds 0.2, 0.5 and 1 m/s,
+/// two repeats, in DIR/c; returns its path ("" and a failure when synth fails).
+std::string synth_campaign(const TempDir& d, const std::string& levels) {
+  const std::string c = d.str() + "/c";
+  const auto r = run("synth --out '" + c + "' --gravity " + levels + " --speeds 0.2,0.5,1.0 --repeats 2");
+  EXPECT_EQ(r.code, 0) << r.out;
+  return r.code == 0 ? c : "";
+}
+
 }  // namespace
 
 TEST(Cli, ImportsTheDevCampaignIntoSqlite) {
@@ -97,8 +106,8 @@ TEST(Cli, HelpTeachesWithExamples) {
 
 TEST(Cli, ModelCollapsePrintsItsNumbersAndDrawsTheFroudeFigure) {
   TempDir d;
-  const std::string c = d.str() + "/c";
-  ASSERT_EQ(run("synth --out '" + c + "' --gravity 9.81,0.1 --speeds 0.2,0.5,1.0 --repeats 2").code, 0);
+  const std::string c = synth_campaign(d, "9.81,0.1");
+  ASSERT_FALSE(c.empty());
   const auto r = run("model collapse '" + c + "' --plot '" + d.str() + "/collapse.png' --format csv");
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("metric,levels,trials,common_scatter_pct,within_scatter_pct,between_levels_pct,collapse_ratio"),
@@ -119,8 +128,8 @@ TEST(Cli, ModelCollapsePrintsItsNumbersAndDrawsTheFroudeFigure) {
 
 TEST(Cli, ModelLoloPrintsOneRowPerHeldOutLevelAndRefusesAPerLevelLaw) {
   TempDir d;
-  const std::string c = d.str() + "/c";
-  ASSERT_EQ(run("synth --out '" + c + "' --gravity 9.81,1.62,0.1 --speeds 0.2,0.5,1.0 --repeats 2").code, 0);
+  const std::string c = synth_campaign(d, "9.81,1.62,0.1");
+  ASSERT_FALSE(c.empty());
   const auto r = run("model lolo '" + c + "' --format csv");
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_EQ(r.out.rfind("held_out_g_m_s2,trials,fitted_g_m_s2,range,", 0), 0u) << r.out;
@@ -262,8 +271,8 @@ TEST(Cli, ModelFitRefusesATrialOutsidePhysicalRangesNamingIt) {
 // candidates and the verdict). They were a run of documents, which no JSON reader takes.
 TEST(Cli, ModelFitAndRankPrintOneJsonDocument) {
   TempDir d;
-  const std::string c = d.str() + "/c";
-  ASSERT_EQ(run("synth --out '" + c + "' --gravity 9.81,0.1 --speeds 0.2,0.5,1.0 --repeats 2").code, 0);
+  const std::string c = synth_campaign(d, "9.81,0.1");
+  ASSERT_FALSE(c.empty());
   const auto fit = run("model fit '" + c + "' --model base+depth_friction --no-plot --format json");
   ASSERT_EQ(fit.code, 0) << fit.out;
   const auto f = nlohmann::json::parse(fit.out);  // throws on a second document
