@@ -30,16 +30,6 @@ struct StepFindings {
   double max_displacement2_m2 = 0;
 };
 
-/// Particles [first, second) of n, thread t's even share of nt (the split of schedule(static)):
-/// the force sums and the end of step of a particle fall to the same thread.
-inline std::pair<std::size_t, std::size_t> even_share(std::size_t n, int t, int nt) {
-  const auto cut = [&](int k) {
-    return n / static_cast<std::size_t>(nt) * static_cast<std::size_t>(k) +
-           std::min(n % static_cast<std::size_t>(nt), static_cast<std::size_t>(k));
-  };
-  return {cut(t), cut(t + 1)};
-}
-
 /// Checks made on every particle in the integrator's last loop of a step, so the state is read
 /// once: non-finite values, a centre outside the domain, and the largest displacement since the
 /// neighbour list was built (drives the rebuild).

@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <exception>
 #include <numeric>
 #include <random>
 
@@ -98,27 +97,17 @@ HeldOut detail::over_folds(const Campaign& c, int folds, unsigned seed, const Fo
   h.trace_mse.assign(c.trials.size(), NAN);
   h.pred.assign(c.trials.size(), Prediction{});
   const auto f = fold_of(c, folds, seed);
-  const int n_folds = fold_count(f);
-  // The folds are fitted in parallel: each writes only its held-out trials' entries, so the
-  // result is the same, bit for bit, on any number of threads. An error is rethrown after the
-  // loop, the first fold's first (an exception may not leave an OpenMP region).
-  std::vector<std::exception_ptr> failed(static_cast<std::size_t>(n_folds));
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int k = 0; k < n_folds; ++k) {
-    try {
-      std::vector<bool> train(c.trials.size());
-      bool any = false;
-      for (std::size_t i = 0; i < train.size(); ++i) {
-        train[i] = f[i] != k;
-        any = any || !train[i];
-      }
-      if (any) fit_fold(train, h);
-    } catch (...) {
-      failed[static_cast<std::size_t>(k)] = std::current_exception();
+  // The folds are fitted in parallel, each writing only its held-out trials' entries.
+  parallel_for_each_index(static_cast<std::size_t>(fold_count(f)), [&](std::size_t fold) {
+    const int k = static_cast<int>(fold);
+    std::vector<bool> train(c.trials.size());
+    bool any = false;
+    for (std::size_t i = 0; i < train.size(); ++i) {
+      train[i] = f[i] != k;
+      any = any || !train[i];
     }
-  }
-  for (const auto& e : failed)
-    if (e) std::rethrow_exception(e);
+    if (any) fit_fold(train, h);
+  });
   return h;
 }
 

@@ -1,6 +1,8 @@
 // Helpers shared by the files of results/model/ (fit.cpp, cross_validation.cpp, table3.cpp,
 // discover.cpp, ...); not API.
 #pragma once
+#include <cstddef>
+#include <exception>
 #include <functional>
 #include <vector>
 
@@ -13,6 +15,25 @@
 #include "results/model/term.h"
 
 namespace gravsweep::results::detail {
+
+/// body(i) for every i in [0, n), on OpenMP threads (dynamic, one index at a time): for loops
+/// whose iterations write only their own slots, so the result is the same on any thread count. An
+/// exception may not leave an OpenMP region: the lowest index's is rethrown after the loop.
+template <class Body>
+void parallel_for_each_index(std::size_t n, Body&& body) {
+  std::vector<std::exception_ptr> failed(n);
+  const auto count = static_cast<std::ptrdiff_t>(n);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::ptrdiff_t k = 0; k < count; ++k) {
+    try {
+      body(static_cast<std::size_t>(k));
+    } catch (...) {
+      failed[static_cast<std::size_t>(k)] = std::current_exception();
+    }
+  }
+  for (const auto& e : failed)
+    if (e) std::rethrow_exception(e);
+}
 
 /// The state of trial t at sample k.
 TermContext context(const MeasuredTrial& t, std::size_t k);

@@ -3,8 +3,6 @@
 // form out of many is itself what the held-out test judges.
 #include <algorithm>
 #include <cmath>
-#include <cstddef>
-#include <exception>
 #include <limits>
 
 #include "results/model/generated.h"
@@ -51,8 +49,7 @@ struct Screening {
   std::vector<double> current_mse;  ///< per-trial in-sample trace MSE of `current`
   std::vector<Screened> ranked;
 };
-/// The forms are fitted in parallel (OpenMP), each into its own slot, so the ranking is the same
-/// on any number of threads; an error is rethrown after the loop, the first form's first.
+/// The forms are fitted in parallel (parallel_for_each_index), each into its own slot.
 Screening screen(const ModelSpec& current, const Campaign& c, const std::vector<bool>& mask, bool per_gravity = true) {
   Screening out{fit_model(current, c, mask), {}, {}};
   out.current_mse = trial_mses(out.current, c, mask);
@@ -60,22 +57,12 @@ Screening screen(const ModelSpec& current, const Campaign& c, const std::vector<
   for (const auto& name : generated_family())
     if (!current.has(name)) forms.push_back(generated_term(name));
   out.ranked.resize(forms.size());
-  std::vector<std::exception_ptr> failed(forms.size());
-  const auto n_forms = static_cast<std::ptrdiff_t>(forms.size());
-#pragma omp parallel for schedule(dynamic, 1)
-  for (std::ptrdiff_t k = 0; k < n_forms; ++k) {
-    const auto j = static_cast<std::size_t>(k);
-    try {
-      ModelSpec s = current;
-      s.terms.push_back({forms[j], per_gravity, 1.0});
-      auto mse = trial_mses(fit_model(s, c, mask), c, mask);
-      out.ranked[j] = {forms[j], mean_relative_gain(out.current_mse, mse), std::move(mse)};
-    } catch (...) {
-      failed[j] = std::current_exception();
-    }
-  }
-  for (const auto& e : failed)
-    if (e) std::rethrow_exception(e);
+  parallel_for_each_index(forms.size(), [&](std::size_t j) {
+    ModelSpec s = current;
+    s.terms.push_back({forms[j], per_gravity, 1.0});
+    auto mse = trial_mses(fit_model(s, c, mask), c, mask);
+    out.ranked[j] = {forms[j], mean_relative_gain(out.current_mse, mse), std::move(mse)};
+  });
   std::stable_sort(out.ranked.begin(), out.ranked.end(),
                    [](const Screened& a, const Screened& b) { return a.gain > b.gain; });
   return out;

@@ -28,8 +28,12 @@ struct RankOptions {
   double min_improvement = 0.03;
 };
 
-/// The candidates of every round, the generated form's test and the screened forms (the first
-/// six in `table`, all otherwise).
+/// How many screened forms the ranking shows: the first six in `table`, all otherwise.
+std::size_t screened_shown(const results::Discovery& d, const std::string& format) {
+  return format == "table" ? std::min<std::size_t>(6, d.generated_screened.size()) : d.generated_screened.size();
+}
+
+/// The candidates of every round, the generated form's test and the screened forms shown.
 results::Table ranking_table(const results::Discovery& d, const std::string& format) {
   results::Table t(
       {"round", "rank", "term", "mean_rel_improvement_pct", "trials_better", "trials", "p_signed_rank", "significant"});
@@ -47,9 +51,7 @@ results::Table ranking_table(const results::Discovery& d, const std::string& for
     t.add({"generated", "1", g.term, num(100 * g.mean_rel_improvement, 3), std::to_string(g.trials_better),
            std::to_string(g.trials), num(g.p_value, 2), g.significant ? "yes" : "no"});
   }
-  const std::size_t shown =
-      format == "table" ? std::min<std::size_t>(6, d.generated_screened.size()) : d.generated_screened.size();
-  for (std::size_t i = 0; i < shown; ++i) {
+  for (std::size_t i = 0; i < screened_shown(d, format); ++i) {
     const auto& c = d.generated_screened[i];
     t.add({"screened", std::to_string(i + 1), c.term, num(100 * c.mean_rel_improvement, 3), "-", "-", "-", "-"});
   }
@@ -58,7 +60,7 @@ results::Table ranking_table(const results::Discovery& d, const std::string& for
 
 void print_ranking(const results::Discovery& d, const std::string& format) {
   ranking_table(d, format).print(format);
-  const std::size_t shown = format == "table" ? std::min<std::size_t>(6, d.generated_screened.size()) : 0;
+  const std::size_t shown = screened_shown(d, format);
   if (format == "table" && shown < d.generated_screened.size())
     fmt::print(
         "(round 'generated': the held-out test of choosing a form, nested CV; 'screened': in-sample gain of "
