@@ -46,12 +46,39 @@ struct Particles {
     torque_N_m.push_back(Vec3::Zero());
     radius_m.push_back(radius);
     mass_kg.push_back(mass);
-    inv_mass_1_kg.push_back(fixed ? 0.0 : 1.0 / mass);
-    const double inertia = 0.4 * mass * radius * radius;  // solid sphere
-    inv_inertia_1_kg_m2.push_back(fixed ? 0.0 : 1.0 / inertia);
+    inv_mass_1_kg.push_back(fixed ? 0.0 : free_inv_mass_1_kg(mass));
+    inv_inertia_1_kg_m2.push_back(fixed ? 0.0 : free_inv_inertia_1_kg_m2(mass, radius));
     material.push_back(material_id);
     size_class.push_back(cls);
     return static_cast<ParticleIndex>(position_m.size() - 1);
+  }
+
+  /// Completes the particles from index `first` on whose state (position, velocity, spin) and
+  /// properties (radius, mass, material) were filled column by column, as a saved bed is read
+  /// back: free solid spheres of class `cls`, with add()'s inverse mass and inertia, whose force
+  /// evaluation reads the saved velocities (as after set_velocity), no force yet. The same state
+  /// as add() and set_velocity() give, bit for bit.
+  void complete_columns(std::size_t first, SizeClass cls) {
+    const std::size_t n = size();
+    for (auto* v : {&eval_velocity_m_s, &eval_omega_rad_s, &force_N, &torque_N_m}) v->resize(first);
+    for (auto* v : {&inv_mass_1_kg, &inv_inertia_1_kg_m2}) v->resize(first);
+    size_class.resize(first);
+    for (std::size_t i = first; i < n; ++i) {
+      eval_velocity_m_s.push_back(velocity_m_s[i]);
+      eval_omega_rad_s.push_back(omega_rad_s[i]);
+      force_N.push_back(Vec3::Zero());
+      torque_N_m.push_back(Vec3::Zero());
+      inv_mass_1_kg.push_back(free_inv_mass_1_kg(mass_kg[i]));
+      inv_inertia_1_kg_m2.push_back(free_inv_inertia_1_kg_m2(mass_kg[i], radius_m[i]));
+      size_class.push_back(cls);
+    }
+  }
+
+  static double free_inv_mass_1_kg(double mass_kg_) { return 1.0 / mass_kg_; }
+  /// A solid sphere's I = 2/5 m r^2, inverted.
+  static double free_inv_inertia_1_kg_m2(double mass_kg_, double radius_m_) {
+    const double inertia = 0.4 * mass_kg_ * radius_m_ * radius_m_;
+    return 1.0 / inertia;
   }
 
   /// Sets the state velocities of particle i and the copies the force evaluation reads (so a

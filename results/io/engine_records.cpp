@@ -1,8 +1,11 @@
 // Engine state <-> file records (see engine_records.h).
 #include "results/io/engine_records.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "engine/scenario/bed.h"
 #include "engine/scenario/paper_params.h"
@@ -15,8 +18,6 @@ namespace {
 void push3(std::vector<double>& out, const Vec3& v) {
   for (int k = 0; k < 3; ++k) out.push_back(v[k]);
 }
-
-Vec3 row3(const std::vector<double>& a, std::size_t i) { return Vec3(a[3 * i], a[3 * i + 1], a[3 * i + 2]); }
 
 /// The state of particles [begin, end) as a snapshot's point set.
 void gather_points(const Particles& p, const std::vector<int>& contacts, std::size_t begin, std::size_t end,
@@ -31,33 +32,23 @@ void gather_points(const Particles& p, const std::vector<int>& contacts, std::si
 
 }  // namespace
 
-BedData bed_grains_of(const System& sys) {
-  BedData b;
-  const auto& pt = sys.particles;
-  for (std::size_t i = 0; i < pt.size(); ++i) {
-    if (pt.size_class[i] != SizeClass::grain) continue;
-    push3(b.position_m, pt.position_m[i]);
-    push3(b.velocity_m_s, pt.velocity_m_s[i]);
-    push3(b.omega_rad_s, pt.omega_rad_s[i]);
-    b.radius_m.push_back(pt.radius_m[i]);
-    b.mass_kg.push_back(pt.mass_kg[i]);
-    b.material.push_back(pt.material[i]);
-  }
+BedFacts bed_facts_of(const System& sys) {
+  BedFacts f;
   for (const auto& w : sys.walls)
-    if (w.kind == WallKind::cylinder) b.wall_height_m = w.height_m;
-  b.time_s = sys.time_s();
-  return b;
+    if (w.kind == WallKind::cylinder) f.wall_height_m = w.height_m;
+  f.time_s = sys.time_s();
+  return f;
 }
 
-void load_bed(System& sys, const BedData& bed) {
-  for (std::size_t i = 0; i < bed.size(); ++i) {
-    const ParticleIndex k =
-        sys.particles.add(row3(bed.position_m, i), bed.radius_m[i], bed.mass_kg[i], bed.material[i], SizeClass::grain);
-    sys.particles.set_velocity(k, row3(bed.velocity_m_s, i), row3(bed.omega_rad_s, i));
-  }
+BedFacts load_bed(System& sys, const std::filesystem::path& bed) {
+  if (sys.particles.size() != 0)
+    throw std::invalid_argument(fmt::format("bed {}: loaded into a system that already holds {} particles",
+                                            bed.string(), sys.particles.size()));
+  const BedFacts f = read_bed(bed, sys.particles);
   ContainerSpec cs;
-  cs.diameter_m = bed.container_diameter_m;
-  add_container_walls(sys, cs, bed.wall_height_m, kWallMaterial);
+  cs.diameter_m = f.container_diameter_m;
+  add_container_walls(sys, cs, f.wall_height_m, kWallMaterial);
+  return f;
 }
 
 TraceData trace_columns_of(const DropResult& dr, double nominal_rate_hz) {
@@ -115,7 +106,7 @@ BedSummary bed_summary_of(const System& sys, const BedReport& rep, const BedRest
   return r;
 }
 
-DemFigures dem_figures_of(const TraceData& td, const DropResult& dr, const BedData& bed,
+DemFigures dem_figures_of(const TraceData& td, const DropResult& dr, const BedFacts& bed, std::size_t bed_grains,
                           std::optional<double> t_start_s, double lateral_offset_m) {
   DemFigures d;
   d.max_depth_m = td.depth_m.empty() ? 0.0 : *std::max_element(td.depth_m.begin(), td.depth_m.end());
@@ -132,7 +123,7 @@ DemFigures dem_figures_of(const TraceData& td, const DropResult& dr, const BedDa
   d.dt_s = td.dt_s;
   d.sample_rate_hz = td.sample_rate_hz;
   d.gravity_m_s2 = td.gravity_m_s2;
-  d.grains = static_cast<long long>(bed.size());
+  d.grains = static_cast<long long>(bed_grains);
   d.surface_height_m = bed.surface_height_m;
   d.release_speed_m_s = dr.release_speed_m_s;
   d.release_height_above_surface_m = dr.release_height_m - bed.surface_height_m;

@@ -4,6 +4,7 @@
 // facts a file carries beyond the engine's state (scenario, keys, versions).
 #pragma once
 #include <cstddef>
+#include <filesystem>
 #include <optional>
 
 #include "engine/scenario/bed.h"
@@ -16,13 +17,14 @@
 
 namespace gravsweep::results {
 
-/// The grains of `sys` (its projectile and walls left out), the cylinder wall's height and the
-/// simulated time, as a bed file's record; the facts of the preparation are the caller's.
-BedData bed_grains_of(const System& sys);
+/// The facts of a bed file that `sys` itself holds: its cylinder wall's height and the simulated
+/// time; the facts of the preparation are the caller's. Its grains are `sys.particles` (write_bed).
+BedFacts bed_facts_of(const System& sys);
 
-/// Puts a saved bed (grains, bit-exact state, no contact history) and its container walls into
-/// `sys`, whose config holds the contact parameters.
-void load_bed(System& sys, const BedData& bed);
+/// Reads a saved bed into `sys`, which holds no particle yet and whose config holds the contact
+/// parameters: its grains straight into the System's particles (bit-exact state, no contact
+/// history; read_bed's checks and errors) and its container walls. Returns the bed's facts.
+BedFacts load_bed(System& sys, const std::filesystem::path& bed);
 
 /// The drop's samples as trace columns, with its release facts and stop flag; the sample rate is
 /// the samples' own (`nominal_rate_hz` for a trace of one sample).
@@ -38,8 +40,9 @@ BedSummary bed_summary_of(const System& sys, const BedReport& rep, const BedRest
                           double at_rest_for_impacts_above_m_s);
 
 /// The DEM figures of a drop from its trace (depths below the bed's surface), its result and the
-/// bed; `t_start_s` is the paper's collision start (none: duration_to_rest_s is absent).
-DemFigures dem_figures_of(const TraceData& td, const DropResult& dr, const BedData& bed,
+/// bed it was dropped on (its facts and its number of grains); `t_start_s` is the paper's collision
+/// start (none: duration_to_rest_s is absent).
+DemFigures dem_figures_of(const TraceData& td, const DropResult& dr, const BedFacts& bed, std::size_t bed_grains,
                           std::optional<double> t_start_s, double lateral_offset_m);
 
 }  // namespace gravsweep::results

@@ -175,11 +175,12 @@ Metrics draw_fig2(const Fig2Request& rq) {
   return m;
 }
 
-/// The bed of Fig. 1, read or refused with the file named.
-BedData fig1_bed(const std::string& path) {
+/// The bed of Fig. 1 (its grains into `grains`: their positions and radii are drawn), read or
+/// refused with the file named.
+BedFacts fig1_bed(const std::string& path, Particles& grains) {
   if (!fs::exists(path)) throw ConfigError(fmt::format("no bed file at '{}'", path));
   try {
-    return read_bed(path);
+    return read_bed(path, grains);
   } catch (const std::exception& e) {
     throw ConfigError(fmt::format("{}: not a readable gravsweep bed.h5 ({})", path, e.what()));
   }
@@ -202,7 +203,7 @@ TraceData fig1_trace(const std::string& path) {
 /// Fig. 1 (b): the projectile where the record ends, over the grains of the drop's last snapshot
 /// (written by `write_grains` as rest.csv) or, without snapshots, the grains as prepared.
 template <class WriteGrains, class Projectile>
-json fig1_rest_panel(const Fig1Request& rq, const BedData& bed, const TraceData& td, WriteGrains write_grains,
+json fig1_rest_panel(const Fig1Request& rq, std::size_t bed_grains, const TraceData& td, WriteGrains write_grains,
                      Projectile projectile, std::string& what) {
   const std::size_t k = td.size() - 1;
   json panel{{"title", fmt::format("(b) {} at t = {:.0f} ms, {:.2f} cm deep",
@@ -213,9 +214,11 @@ json fig1_rest_panel(const Fig1Request& rq, const BedData& bed, const TraceData&
   if (fs::exists(snaps)) {
     try {
       const Snapshot s = read_snapshot(snaps, -1);
-      if (s.grains.size() != bed.size())
-        throw ConfigError(fmt::format("{}: {} grains, the bed has {}", snaps, s.grains.size(), bed.size()));
-      write_grains("rest.csv", s.grains.position_m);
+      if (s.grains.size() != bed_grains)
+        throw ConfigError(fmt::format("{}: {} grains, the bed has {}", snaps, s.grains.size(), bed_grains));
+      const std::vector<double>& at_rest = s.grains.position_m;  // (N, 3) row-major
+      write_grains("rest.csv",
+                   [&](std::size_t i) { return Vec3(at_rest[3 * i], at_rest[3 * i + 1], at_rest[3 * i + 2]); });
       panel["grains"] = "rest.csv";
       what += fmt::format(", grains at rest from {}", snaps);
     } catch (const h5::H5Error& e) {
@@ -234,17 +237,22 @@ std::string draw_fig1(const Fig1Request& rq) {
     throw ConfigError(fmt::format("--at '{}': expected release or rest", rq.at));
   if (!rq.at.empty() && rq.trace.empty()) throw ConfigError("--at needs --trace (the projectile's record)");
   if (!fs::exists(rq.bed)) throw ConfigError(fmt::format("no bed file at '{}'", rq.bed));
-  const BedData bed = fig1_bed(rq.bed);
+  Particles grains;
+  const BedFacts bed = fig1_bed(rq.bed, grains);
   const TraceData td = fig1_trace(rq.trace);
   ScratchDir tmp("fig1");
-  auto write_grains = [&](const std::string& name, const std::vector<double>& pos) {
+  // Each grain at the position `position_of` gives it, with its radius and its distance from the
+  // axis as prepared (r0_m).
+  auto write_grains = [&](const std::string& name, const auto& position_of) {
     std::ofstream f(tmp.path / name);
     f << "x_m,y_m,z_m,radius_m,r0_m\n";
-    for (std::size_t i = 0; i < bed.size(); ++i)
-      f << fmt::format("{},{},{},{},{}\n", pos[3 * i], pos[3 * i + 1], pos[3 * i + 2], bed.radius_m[i],
-                       std::hypot(bed.position_m[3 * i], bed.position_m[3 * i + 1]));
+    for (std::size_t i = 0; i < grains.size(); ++i) {
+      const Vec3 p = position_of(i);
+      f << fmt::format("{},{},{},{},{}\n", p[0], p[1], p[2], grains.radius_m[i],
+                       std::hypot(grains.position_m[i][0], grains.position_m[i][1]));
+    }
   };
-  write_grains("bed.csv", bed.position_m);
+  write_grains("bed.csv", [&](std::size_t i) { return grains.position_m[i]; });
   json panels = json::array();
   const double R = 0.5 * td.projectile_diameter_m;
   auto projectile = [&](std::size_t k) {
@@ -255,7 +263,7 @@ std::string draw_fig1(const Fig1Request& rq) {
                 {"t_s", td.t_s[k]},
                 {"depth_m", td.depth_m[k]}};
   };
-  std::string what = fmt::format("{} grains", bed.size());
+  std::string what = fmt::format("{} grains", grains.size());
   if (rq.trace.empty()) panels.push_back(json{{"title", "prepared bed"}, {"grains", "bed.csv"}});
   if (!rq.trace.empty() && rq.at != "rest")
     panels.push_back(json{{"title", fmt::format("(a) release, {:.1f} cm above the surface",
@@ -263,13 +271,13 @@ std::string draw_fig1(const Fig1Request& rq) {
                           {"grains", "bed.csv"},
                           {"projectile", projectile(0)}});
   if (!rq.trace.empty() && rq.at != "release")
-    panels.push_back(fig1_rest_panel(rq, bed, td, write_grains, projectile, what));
+    panels.push_back(fig1_rest_panel(rq, grains.size(), td, write_grains, projectile, what));
   const json spec{{"out", fs::absolute(rq.out).string()},
                   {"panels", panels},
                   {"container_diameter_m", bed.container_diameter_m},
                   {"wall_height_m", bed.wall_height_m},
                   {"surface_height_m", bed.surface_height_m},
-                  {"title", fmt::format("{}: {} grains, fill {:.1f} cm, g = {:g} m/s2", rq.bed, bed.size(),
+                  {"title", fmt::format("{}: {} grains, fill {:.1f} cm, g = {:g} m/s2", rq.bed, grains.size(),
                                         100 * bed.fill_height_m, bed.gravity_m_s2)}};
   plot(tmp, "bed", spec, rq.out);
   return what;

@@ -14,8 +14,6 @@
 #include "engine/scenario/bed.h"
 #include "engine/scenario/paper_params.h"
 #include "engine/scenario/tile.h"
-#include "results/io/bed_file.h"
-#include "results/io/engine_records.h"
 #include "scheduler/pipeline/impact_job.h"
 #include "scheduler/cli/bench_checkpoint.h"
 #include "scheduler/cli/bench_host.h"
@@ -129,7 +127,7 @@ std::unique_ptr<System> make_bed(double container_diameter_m, const BenchOptions
 std::unique_ptr<System> load_bed_file(const std::string& path) {
   auto sys = std::make_unique<System>(chrono_table1_config());
   std::string unverified;
-  results::load_bed(*sys, pipeline::read_user_bed(path, &unverified));
+  pipeline::load_user_bed(*sys, path, &unverified);
   if (!unverified.empty()) std::fprintf(stderr, "warning: %s\n", unverified.c_str());
   return sys;
 }

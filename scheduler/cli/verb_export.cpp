@@ -70,7 +70,7 @@ std::map<std::string, int> check_provenance(const std::vector<std::string>& vers
 /// The beds of the drops to export, by bed job (one read each), and their count per code version,
 /// refusing (UsageError) a bed from a dirty build unless --allow-dirty, as check_provenance refuses
 /// a drop: a drop of a clean build on a bed of uncommitted code is not reproducible either.
-using BedsByJob = std::map<std::string, std::optional<results::BedData>>;
+using BedsByJob = std::map<std::string, std::optional<results::BedFacts>>;
 std::map<std::string, int> check_bed_provenance(const BedsByJob& beds, const ExportOptions& o) {
   std::map<std::string, int> count;
   std::vector<std::string> dirty;
@@ -103,8 +103,8 @@ std::vector<std::string> trials_header() {
 std::string num(double v) { return std::isfinite(v) ? fmt::format("{}", v) : std::string(); }
 
 /// The bed a drop used: its recorded path, or the bed job's output in this campaign.
-std::optional<results::BedData> bed_of(db::Database& db, const queue::CampaignPaths& paths,
-                                       const results::TraceData& td, const std::string& bed_job) {
+std::optional<results::BedFacts> bed_of(db::Database& db, const queue::CampaignPaths& paths,
+                                        const results::TraceData& td, const std::string& bed_job) {
   std::vector<fs::path> candidates{td.bed_file};
   if (const std::string out = queue::done_output_path(db, bed_job); !out.empty()) candidates.push_back(paths.abs(out));
   for (const auto& p : candidates) {
@@ -134,7 +134,7 @@ double write_trace_csv(const fs::path& path, const results::TraceData& td, doubl
 /// One trials.csv row: the trial record of the drop (read_dem_trial: the same facts and
 /// processing settings the model verbs use), pointing at the exported trace and its rate.
 std::vector<std::string> trial_row(const std::string& job, const std::string& sweep, const fs::path& trace_path,
-                                   const results::TraceData& td, const std::optional<results::BedData>& bed,
+                                   const results::TraceData& td, const std::optional<results::BedFacts>& bed,
                                    double rate_hz) {
   results::Trial ti = results::read_dem_trial({job, job, trace_path}).info;
   ti.trace_file = "traces/" + job + ".csv";

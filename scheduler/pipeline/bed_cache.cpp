@@ -23,7 +23,7 @@ std::optional<json> take_cached_bed(const fs::path& cache, const std::string& be
         fmt::format("bed cache: {} has no checksum file {}: it cannot be verified; delete it or "
                     "restore its checksum file",
                     cached.string(), bed_checksum_path(cached).string()));
-  results::BedData bed;
+  results::BedFacts bed;
   try {
     bed = read_user_bed(cached, nullptr);  // checksum verified here
     require_bed_key(bed, job_scenario(scenario), cached);

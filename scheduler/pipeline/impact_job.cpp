@@ -49,7 +49,7 @@ double slowest_impact_at_rest_m_s(const BedRestState& r, const AtRestCriterion& 
 }
 
 /// Refuses a bed whose grains still move too fast for this drop's impact (/at_rest), with the figures.
-void require_at_rest(const System& sys, const results::BedData& bed, const ScenarioParams& p,
+void require_at_rest(const System& sys, const results::BedFacts& bed, const ScenarioParams& p,
                      const std::filesystem::path& bed_path) {
   const AtRestCriterion& c = p.at_rest;
   SurfaceWindow window;  // the whole bed, or the part about the impact axis
@@ -115,7 +115,7 @@ namespace {
 BedJobResult write_prepared_bed(const System& sys, const BedReport& rep, const ScenarioParams& p, const json& s,
                                 const std::filesystem::path& bed_out, double wall_s, JobCheckpointer& ckpt,
                                 const std::atomic<bool>* stop) {
-  results::BedData b = results::bed_grains_of(sys);
+  results::BedFacts b = results::bed_facts_of(sys);
   const BedRestState rest = bed_rest_state(sys, rep.surface_height_m, p.bed.grains.diameter_m);
   b.container_diameter_m = p.bed.container.diameter_m;
   b.fill_height_m = p.bed.fill_height_m;
@@ -129,7 +129,7 @@ BedJobResult write_prepared_bed(const System& sys, const BedReport& rep, const S
   results::set_checkpoint_counts(r, ckpt.counts());
   b.report_json = results::to_json(r).dump();
   check_stop(stop, "bed preparation");
-  results::write_bed(bed_out, b);
+  results::write_bed(bed_out, sys.particles, b);
   ckpt.finished();
   return BedJobResult{bed_out, r};
 }
@@ -179,7 +179,12 @@ void write_bed_checksum(const std::filesystem::path& bed, const std::filesystem:
   std::filesystem::rename(tmp, path);
 }
 
-results::BedData read_user_bed(const std::filesystem::path& bed, std::string* unverified) {
+namespace {
+
+/// Checks a bed named by the user against its checksum file (see read_user_bed), then reads it by
+/// `read`, its errors as ConfigError naming the file.
+template <class Read>
+results::BedFacts verified_bed(const std::filesystem::path& bed, std::string* unverified, const Read& read) {
   constexpr std::size_t kHexDigits = 64;
   std::error_code ec;
   if (!std::filesystem::is_regular_file(bed, ec))
@@ -206,13 +211,23 @@ results::BedData read_user_bed(const std::filesystem::path& bed, std::string* un
         bed.string(), sum_path.string());
   }
   try {
-    return results::read_bed(bed);
+    return read(bed);
   } catch (const std::exception& e) {  // HDF5 layer: cut short, random bytes, missing datasets
     throw ConfigError(fmt::format("bed {}: not a readable gravsweep bed file: {}", bed.string(), e.what()));
   }
 }
 
-void require_bed_key(const results::BedData& bed, const json& scenario, const std::filesystem::path& bed_path) {
+}  // namespace
+
+results::BedFacts read_user_bed(const std::filesystem::path& bed, std::string* unverified) {
+  return verified_bed(bed, unverified, [](const std::filesystem::path& b) { return results::read_bed(b); });
+}
+
+results::BedFacts load_user_bed(System& sys, const std::filesystem::path& bed, std::string* unverified) {
+  return verified_bed(bed, unverified, [&](const std::filesystem::path& b) { return results::load_bed(sys, b); });
+}
+
+void require_bed_key(const results::BedFacts& bed, const json& scenario, const std::filesystem::path& bed_path) {
   const json want = bed_key_of_validated(scenario);
   json have;
   try {
@@ -233,12 +248,12 @@ namespace {
 
 /// The drop's grain snapshots (/output/snapshot_interval_s > 0; none otherwise): the grains keep
 /// the order of bed.h5, the projectile comes last. `snaps` receives the writer.
-DropSnapshots snapshot_hooks(const ScenarioParams& p, const results::BedData& bed,
+DropSnapshots snapshot_hooks(const ScenarioParams& p, const std::vector<double>& grain_radius_m,
                              const std::filesystem::path& trace_out, std::unique_ptr<results::SnapshotWriter>& snaps) {
   DropSnapshots ds;
   if (!(p.snapshot_interval_s > 0)) return ds;
   snaps =
-      std::make_unique<results::SnapshotWriter>(results::snapshot_path_for(trace_out), bed.radius_m,
+      std::make_unique<results::SnapshotWriter>(results::snapshot_path_for(trace_out), grain_radius_m,
                                                 0.5 * p.projectile.diameter_m, p.snapshot_interval_s, build_version());
   ds.interval_s = p.snapshot_interval_s;
   ds.write = [w = snaps.get()](const System& sy, ParticleIndex ip, double t_s) {
@@ -250,7 +265,7 @@ DropSnapshots snapshot_hooks(const ScenarioParams& p, const results::BedData& be
 /// The drop's samples as trace columns, with the facts a reader of the trace needs (scenario, bed
 /// key and file, code version).
 results::TraceData trace_of(const DropResult& dr, const ScenarioParams& p, const json& validated,
-                            const results::BedData& bed, const std::filesystem::path& bed_in) {
+                            const results::BedFacts& bed, const std::filesystem::path& bed_in) {
   results::TraceData td = results::trace_columns_of(dr, p.sample_rate_hz);
   td.dt_s = p.drop_config.dt_s;
   td.gravity_m_s2 = p.gravity_m_s2;
@@ -289,18 +304,17 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   const json s = job_scenario(scenario);
   ScenarioParams p = scenario_params(s);
   if (threads > 0) p.drop_config.threads = threads;
-  const results::BedData bed = results::read_bed(bed_in);
+  // The bed in a fresh system: bit-exact state, no contact history (as after any restart).
+  System sys(p.drop_config);
+  const results::BedFacts bed = results::load_bed(sys, bed_in);
+  const std::size_t bed_grains = sys.particles.size();
   require_bed_key(bed, s, bed_in);
   check_stop(stop, "drop");
   const auto t0 = std::chrono::steady_clock::now();
-
-  // Rebuild the bed in a fresh system: bit-exact state, no contact history (as after any restart).
-  System sys(p.drop_config);
-  results::load_bed(sys, bed);
   require_at_rest(sys, bed, p, bed_in);
 
   std::unique_ptr<results::SnapshotWriter> snaps;
-  const DropSnapshots ds = snapshot_hooks(p, bed, trace_out, snaps);
+  const DropSnapshots ds = snapshot_hooks(p, sys.particles.radius_m, trace_out, snaps);
   JobCheckpointer ckpt(checkpointing, "drop",
                        checkpointing.path.empty() ? json() : drop_identity(s, bed_in, sys.threads()), stop);
   const auto drop = [&] {
@@ -323,7 +337,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   if (!metrics) m["metrics_error"] = metrics_error;
   const std::optional<double> t_start = metrics ? std::optional<double>(metrics->t_start_s) : std::nullopt;
   results::DemFigures dem = results::dem_figures_of(
-      td, dr, bed, t_start, std::hypot(p.projectile.lateral_offset_x_m, p.projectile.lateral_offset_y_m));
+      td, dr, bed, bed_grains, t_start, std::hypot(p.projectile.lateral_offset_x_m, p.projectile.lateral_offset_y_m));
   dem.threads = sys.threads();
   dem.wall_time_s = wall_s;
   results::set_checkpoint_counts(dem, ckpt.counts());

@@ -76,15 +76,18 @@ std::filesystem::path bed_checksum_path(const std::filesystem::path& bed);
 /// `named` empty: bed_checksum_path(bed).
 void write_bed_checksum(const std::filesystem::path& bed, const std::filesystem::path& named = {});
 
-/// A bed named on the command line (`run --bed`, `bench --bed`), read and verified: throws
-/// ConfigError naming the file (exit 2) when it is missing, not a gravsweep bed, cut short or
-/// corrupt, or does not match its checksum file. A bed without a checksum file (written before
-/// gravsweep recorded one, or copied without it) is read unverified and `*unverified` says why.
-results::BedData read_user_bed(const std::filesystem::path& bed, std::string* unverified);
+/// A bed named on the command line (`run --bed`, `bench --bed`) or found in the bed cache, read and
+/// verified, its facts returned: throws ConfigError naming the file (exit 2) when it is missing,
+/// not a gravsweep bed, cut short or corrupt, or does not match its checksum file. A bed without a
+/// checksum file (written before gravsweep recorded one, or copied without it) is read unverified
+/// and `*unverified` says why.
+results::BedFacts read_user_bed(const std::filesystem::path& bed, std::string* unverified);
+/// The same, the bed loaded into `sys` (results::load_bed: a System holding no particle yet).
+results::BedFacts load_user_bed(System& sys, const std::filesystem::path& bed, std::string* unverified);
 
 /// Throws ConfigError naming `bed_path` and the first differing field (JSON pointer) when the bed
 /// was prepared for another bed key than `scenario`'s (as validate_scenario() returns it).
-void require_bed_key(const results::BedData& bed, const nlohmann::json& scenario,
+void require_bed_key(const results::BedFacts& bed, const nlohmann::json& scenario,
                      const std::filesystem::path& bed_path);
 
 }  // namespace gravsweep::pipeline

@@ -472,23 +472,26 @@ namespace {
 
 /// Packing fraction of a bed's core (axis distance < 12 cm, 2-8 cm above the floor; Table 1's bulk
 /// densities: 0.585-0.597 for pkdgrav, 0.57-0.585 for Chrono), by the engine's own measure.
-double core_packing_fraction(const gravsweep::results::BedData& b) {
-  gravsweep::Particles p;
-  for (std::size_t i = 0; i < b.radius_m.size(); ++i)
-    p.add(gravsweep::Vec3(b.position_m[3 * i], b.position_m[3 * i + 1], b.position_m[3 * i + 2]), b.radius_m[i],
-          b.mass_kg[i], 0, gravsweep::SizeClass::grain);
-  return gravsweep::core_packing_fraction(p, 0.12, 0.02, 0.08);
+double core_packing_fraction(const gravsweep::Particles& grains) {
+  return gravsweep::core_packing_fraction(grains, 0.12, 0.02, 0.08);
+}
+
+/// The grains of a committed bed file.
+gravsweep::Particles grains_of(const std::filesystem::path& bed) {
+  gravsweep::Particles grains;
+  gravsweep::results::read_bed(bed, grains);
+  return grains;
 }
 
 /// Grains faster than `speed_m_s`, and how many of them lie in the bottom two layers (centre below
 /// 1.5 diameters; a close-packed second layer sits at 1.32).
-std::pair<int, int> fast_grains(const gravsweep::results::BedData& b, double speed_m_s) {
+std::pair<int, int> fast_grains(const gravsweep::Particles& g, double speed_m_s) {
   int fast = 0, at_floor = 0;
-  for (std::size_t i = 0; i < b.radius_m.size(); ++i) {
-    const double s = std::hypot(b.velocity_m_s[3 * i], b.velocity_m_s[3 * i + 1], b.velocity_m_s[3 * i + 2]);
-    if (s <= speed_m_s) continue;
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const gravsweep::Vec3& v = g.velocity_m_s[i];
+    if (std::hypot(v[0], v[1], v[2]) <= speed_m_s) continue;
     ++fast;
-    if (b.position_m[3 * i + 2] < 3 * b.radius_m[i]) ++at_floor;
+    if (g.position_m[i].z() < 3 * g.radius_m[i]) ++at_floor;
   }
   return {fast, at_floor};
 }
@@ -502,8 +505,8 @@ std::pair<int, int> fast_grains(const gravsweep::results::BedData& b, double spe
 TEST(Reproduction, ThePkdgravBedIsOrderedWithItsFastGrainsAtTheFloor) {
   namespace fs = std::filesystem;
   const fs::path beds = fs::path(GRAVSWEEP_SOURCE_DIR) / "data/reproduction/beds";
-  const auto pkd = gravsweep::results::read_bed(beds / "ef2d61bc91083ece4a6c.h5");     // part 5, 9,333 grains
-  const auto chrono = gravsweep::results::read_bed(beds / "bc8dcb3a1b26b1148049.h5");  // Chrono bed, 12 cm (part 3)
+  const auto pkd = grains_of(beds / "ef2d61bc91083ece4a6c.h5");     // part 5, 9,333 grains
+  const auto chrono = grains_of(beds / "bc8dcb3a1b26b1148049.h5");  // Chrono bed, 12 cm (part 3)
   const double phi_pkd = core_packing_fraction(pkd), phi_chrono = core_packing_fraction(chrono);
   const auto [fast_pkd, floor_pkd] = fast_grains(pkd, 1e-2);
   const auto [fast_chrono, floor_chrono] = fast_grains(chrono, 1e-3);
@@ -520,14 +523,14 @@ TEST(Reproduction, ThePkdgravBedIsOrderedWithItsFastGrainsAtTheFloor) {
 
 /// The floor grains of a bed (centre within 1 % of a radius of the floor at z = 0) faster than
 /// `speed_m_s`, and the fastest spin about the vertical among them (rad/s).
-std::pair<int, double> fast_floor_grains(const gravsweep::results::BedData& b, double speed_m_s) {
+std::pair<int, double> fast_floor_grains(const gravsweep::Particles& g, double speed_m_s) {
   int fast = 0;
   double spin_z = 0;
-  for (std::size_t i = 0; i < b.radius_m.size(); ++i) {
-    const double* v = &b.velocity_m_s[3 * i];
-    if (b.position_m[3 * i + 2] >= 1.01 * b.radius_m[i] || std::hypot(v[0], v[1], v[2]) <= speed_m_s) continue;
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const gravsweep::Vec3& v = g.velocity_m_s[i];
+    if (g.position_m[i].z() >= 1.01 * g.radius_m[i] || std::hypot(v[0], v[1], v[2]) <= speed_m_s) continue;
     ++fast;
-    spin_z = std::max(spin_z, std::abs(b.omega_rad_s[3 * i + 2]));
+    spin_z = std::max(spin_z, std::abs(g.omega_rad_s[i].z()));
   }
   return {fast, spin_z};
 }
@@ -542,8 +545,9 @@ std::pair<int, double> fast_floor_grains(const gravsweep::results::BedData& b, d
 TEST(Reproduction, ThePkdgravBedComesToRestOnceItsSlidersAreHeldAtTheLimit) {
   namespace fs = std::filesystem;
   const fs::path beds = fs::path(GRAVSWEEP_SOURCE_DIR) / "data/reproduction/beds";
-  const auto latched = gravsweep::results::read_bed(beds / "2ea3209e0f33f5075120.h5");  // 8,533 grains
-  const auto held = gravsweep::results::read_bed(beds / "6d841ee06ff86eaf48d9.h5");     // 8,538 grains
+  const auto latched = grains_of(beds / "2ea3209e0f33f5075120.h5");  // 8,533 grains
+  gravsweep::Particles held;
+  const auto held_facts = gravsweep::results::read_bed(beds / "6d841ee06ff86eaf48d9.h5", held);  // 8,538 grains
   const auto [fast_before, spin_before] = fast_floor_grains(latched, 1e-2);
   const auto [fast_after, spin_after] = fast_floor_grains(held, 1e-3);
   const auto [fast_anywhere, floor_unused] = fast_grains(held, 1e-3);
@@ -555,7 +559,7 @@ TEST(Reproduction, ThePkdgravBedComesToRestOnceItsSlidersAreHeldAtTheLimit) {
   EXPECT_GE(fast_before, 5);
   EXPECT_GT(spin_before, 5.0) << "the latched twisting springs spun the floor grains about the vertical";
   EXPECT_EQ(fast_anywhere, 0);
-  const auto report = nlohmann::json::parse(held.report_json);
+  const auto report = nlohmann::json::parse(held_facts.report_json);
   EXPECT_EQ(report.at("settle_end"), "criteria");
   EXPECT_LT(report.at("rms_speed_m_s").get<double>(), 1e-5);
   EXPECT_LT(report.at("at_rest_for_impacts_above_m_s").get<double>(), 0.2) << "part 5's slowest impact";

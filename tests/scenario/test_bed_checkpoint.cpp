@@ -72,12 +72,13 @@ TEST_F(BedJobCheckpoint, StoppedTwiceTheBedIsTheUninterruptedOne) {
   EXPECT_FALSE(fs::exists(ckpt())) << "the checkpoint is removed once the bed is written";
   EXPECT_EQ(report->at("checkpoint_resumes"), 2);
   EXPECT_EQ(report->at("resumed_at_s"), second.position_s);
-  const results::BedData a = results::read_bed(reference()), b = results::read_bed(dir_.path / "resumed.h5");
-  EXPECT_EQ(a.position_m, b.position_m);
-  EXPECT_EQ(a.velocity_m_s, b.velocity_m_s);
-  EXPECT_EQ(a.omega_rad_s, b.omega_rad_s);
-  EXPECT_EQ(a.surface_height_m, b.surface_height_m);
-  EXPECT_EQ(a.time_s, b.time_s);
+  Particles a, b;
+  const results::BedFacts fa = results::read_bed(reference(), a), fb = results::read_bed(dir_.path / "resumed.h5", b);
+  EXPECT_TRUE(a.position_m == b.position_m);
+  EXPECT_TRUE(a.velocity_m_s == b.velocity_m_s);
+  EXPECT_TRUE(a.omega_rad_s == b.omega_rad_s);
+  EXPECT_EQ(fa.surface_height_m, fb.surface_height_m);
+  EXPECT_EQ(fa.time_s, fb.time_s);
 }
 
 TEST_F(BedJobCheckpoint, ADropCheckpointAtABedJobsPathIsDiscarded) {
@@ -91,7 +92,10 @@ TEST_F(BedJobCheckpoint, ADropCheckpointAtABedJobsPathIsDiscarded) {
   EXPECT_NE(warnings_[0].find(ckpt().string()), std::string::npos) << warnings_[0];
   EXPECT_NE(warnings_[0].find("a drop checkpoint, this job is a bed"), std::string::npos) << warnings_[0];
   EXPECT_EQ(report->at("checkpoint_resumes"), 0);
-  EXPECT_EQ(results::read_bed(reference()).position_m, results::read_bed(dir_.path / "restarted.h5").position_m);
+  Particles a, b;
+  results::read_bed(reference(), a);
+  results::read_bed(dir_.path / "restarted.h5", b);
+  EXPECT_TRUE(a.position_m == b.position_m);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <stdexcept>
 
 #include "results/io/bed_file.h"
 #include "results/io/hdf5.h"
@@ -15,29 +16,35 @@
 namespace gravsweep {
 namespace {
 
-results::BedData sample_bed() {
-  results::BedData b;
+/// Five grains whose values test the round trip's bits (1/3 and steps of 1e-17 in a position).
+Particles sample_grains() {
+  Particles g;
   for (int i = 0; i < 5; ++i) {
+    Vec3 p, v, w;
     for (int k = 0; k < 3; ++k) {
-      b.position_m.push_back(0.01 * i + 1e-17 * k + 1.0 / 3.0);
-      b.velocity_m_s.push_back(-1e-6 * (i + k));
-      b.omega_rad_s.push_back(0.1 * k);
+      p[k] = 0.01 * i + 1e-17 * k + 1.0 / 3.0;
+      v[k] = -1e-6 * (i + k);
+      w[k] = 0.1 * k;
     }
-    b.radius_m.push_back(0.005 + 1e-5 * i);
-    b.mass_kg.push_back(1.3e-3);
-    b.material.push_back(0);
+    const ParticleIndex j = g.add(p, 0.005 + 1e-5 * i, 1.3e-3, 0, SizeClass::grain);
+    g.set_velocity(j, v, w);
   }
-  b.container_diameter_m = 0.315;
-  b.wall_height_m = 0.2;
-  b.fill_height_m = 0.1;
-  b.surface_height_m = 0.1003;
-  b.gravity_m_s2 = 9.81;
-  b.time_s = 1.25;
-  b.bed_key_json = R"({"k":1})";
-  b.scenario_json = R"({"name":"x"})";
-  b.report_json = R"({"grains_kept":5})";
-  b.code_version = "test";
-  return b;
+  return g;
+}
+
+results::BedFacts sample_facts() {
+  results::BedFacts f;
+  f.container_diameter_m = 0.315;
+  f.wall_height_m = 0.2;
+  f.fill_height_m = 0.1;
+  f.surface_height_m = 0.1003;
+  f.gravity_m_s2 = 9.81;
+  f.time_s = 1.25;
+  f.bed_key_json = R"({"k":1})";
+  f.scenario_json = R"({"name":"x"})";
+  f.report_json = R"({"grains_kept":5})";
+  f.code_version = "test";
+  return f;
 }
 
 results::TraceData sample_trace() {
@@ -62,19 +69,34 @@ results::TraceData sample_trace() {
   return d;
 }
 
+// The grains read back are the engine's particles as add() and set_velocity() make them, bit for
+// bit: the state a drop from the bed in memory starts from.
 TEST(Hdf5Io, BedRoundTripIsBitExact) {
   test::TempDir dir;
-  const auto b = sample_bed();
-  results::write_bed(dir.path / "bed.h5", b);
-  const auto r = results::read_bed(dir.path / "bed.h5");
-  EXPECT_EQ(r.position_m, b.position_m);
-  EXPECT_EQ(r.velocity_m_s, b.velocity_m_s);
-  EXPECT_EQ(r.omega_rad_s, b.omega_rad_s);
-  EXPECT_EQ(r.radius_m, b.radius_m);
-  EXPECT_EQ(r.material, b.material);
-  EXPECT_EQ(r.surface_height_m, b.surface_height_m);
-  EXPECT_EQ(r.bed_key_json, b.bed_key_json);
-  EXPECT_EQ(r.report_json, b.report_json);
+  const Particles g = sample_grains();
+  const results::BedFacts f = sample_facts();
+  results::write_bed(dir.path / "bed.h5", g, f);
+  Particles r;
+  r.add(Vec3(1, 2, 3), 0.1, 1.0, 0, SizeClass::projectile);  // replaced by the file's grains
+  const results::BedFacts rf = results::read_bed(dir.path / "bed.h5", r);
+  ASSERT_EQ(r.size(), g.size());
+  EXPECT_TRUE(r.position_m == g.position_m);
+  EXPECT_TRUE(r.velocity_m_s == g.velocity_m_s);
+  EXPECT_TRUE(r.omega_rad_s == g.omega_rad_s);
+  EXPECT_TRUE(r.eval_velocity_m_s == g.eval_velocity_m_s);
+  EXPECT_TRUE(r.eval_omega_rad_s == g.eval_omega_rad_s);
+  EXPECT_TRUE(r.force_N == g.force_N);
+  EXPECT_TRUE(r.torque_N_m == g.torque_N_m);
+  EXPECT_EQ(r.radius_m, g.radius_m);
+  EXPECT_EQ(r.mass_kg, g.mass_kg);
+  EXPECT_EQ(r.inv_mass_1_kg, g.inv_mass_1_kg);
+  EXPECT_EQ(r.inv_inertia_1_kg_m2, g.inv_inertia_1_kg_m2);
+  EXPECT_EQ(r.material, g.material);
+  EXPECT_TRUE(r.size_class == g.size_class);
+  EXPECT_EQ(rf.surface_height_m, f.surface_height_m);
+  EXPECT_EQ(rf.time_s, f.time_s);
+  EXPECT_EQ(rf.bed_key_json, f.bed_key_json);
+  EXPECT_EQ(rf.report_json, f.report_json);
   // No temporary left behind.
   int files = 0;
   for (const auto& e : std::filesystem::directory_iterator(dir.path)) {
@@ -82,28 +104,24 @@ TEST(Hdf5Io, BedRoundTripIsBitExact) {
     ++files;
   }
   EXPECT_EQ(files, 1);
+  // A bed file holds grains only.
+  Particles with_projectile = g;
+  with_projectile.add(Vec3(0, 0, 0.3), 0.02, 0.1, 2, SizeClass::projectile);
+  EXPECT_THROW(results::write_bed(dir.path / "not_a_bed.h5", with_projectile, f), std::invalid_argument);
 }
 
 // A bed is kept and shared by many drops: its larger arrays are deflated (chunked, shuffled), as
 // they were before its layout became one visit function; a checkpoint's stay contiguous.
 TEST(Hdf5Io, ABedsLargeArraysAreStoredCompressed) {
   test::TempDir dir;
-  results::BedData b = sample_bed();
-  for (int i = 0; i < 3000; ++i) {  // 3,005 grains: (3005, 3) positions, 9,015 values
-    for (int k = 0; k < 3; ++k) {
-      b.position_m.push_back(0.001 * (i % 100) + 0.01 * k);
-      b.velocity_m_s.push_back(0);
-      b.omega_rad_s.push_back(0);
-    }
-    b.radius_m.push_back(0.005);
-    b.mass_kg.push_back(1.3e-3);
-    b.material.push_back(0);
-  }
-  results::write_bed(dir.path / "bed.h5", b);
+  Particles g = sample_grains();
+  for (int i = 0; i < 3000; ++i)  // 3,005 grains: (3005, 3) positions, 9,015 values
+    g.add(Vec3(0.001 * (i % 100), 0.01, 0.02), 0.005, 1.3e-3, 0, SizeClass::grain);
+  results::write_bed(dir.path / "bed.h5", g, sample_facts());
   auto f = results::h5::File::open_read(dir.path / "bed.h5");
-  auto g = results::h5::open_group(f.id(), "grains");
+  auto grains = results::h5::open_group(f.id(), "grains");
   for (const char* name : {"position_m", "velocity_m_s", "omega_rad_s"}) {  // 4,096 values or more
-    const hid_t ds = H5Dopen2(g, name, H5P_DEFAULT);
+    const hid_t ds = H5Dopen2(grains, name, H5P_DEFAULT);
     ASSERT_GE(ds, 0) << name;
     const hid_t plist = H5Dget_create_plist(ds);
     EXPECT_EQ(H5Pget_layout(plist), H5D_CHUNKED) << name;
@@ -111,12 +129,14 @@ TEST(Hdf5Io, ABedsLargeArraysAreStoredCompressed) {
     H5Pclose(plist);
     H5Dclose(ds);
   }
-  EXPECT_EQ(results::read_bed(dir.path / "bed.h5").position_m, b.position_m);
+  Particles back;
+  results::read_bed(dir.path / "bed.h5", back);
+  EXPECT_TRUE(back.position_m == g.position_m);
 }
 
 TEST(Hdf5Io, EveryDatasetHasUnits) {
   test::TempDir dir;
-  results::write_bed(dir.path / "bed.h5", sample_bed());
+  results::write_bed(dir.path / "bed.h5", sample_grains(), sample_facts());
   results::write_trace(dir.path / "trace.h5", sample_trace());
   {
     auto f = results::h5::File::open_read(dir.path / "bed.h5");
@@ -187,7 +207,7 @@ TEST(Hdf5Io, ErrorsNameTheFileAndTheMissingPiece) {
     }
   }
   // Writing into a missing folder fails cleanly.
-  EXPECT_THROW(results::write_bed(dir.path / "no" / "bed.h5", sample_bed()), results::h5::H5Error);
+  EXPECT_THROW(results::write_bed(dir.path / "no" / "bed.h5", sample_grains(), sample_facts()), results::h5::H5Error);
 }
 
 TEST(Hdf5Io, ReadableWithH5py) {
@@ -195,7 +215,7 @@ TEST(Hdf5Io, ReadableWithH5py) {
   if (std::system("/usr/bin/python3 -c 'import h5py' 2>/dev/null") != 0)
     GTEST_SKIP() << "python3-h5py (deploy/debian-packages.txt) is not installed";
   test::TempDir dir;
-  results::write_bed(dir.path / "bed.h5", sample_bed());
+  results::write_bed(dir.path / "bed.h5", sample_grains(), sample_facts());
   results::write_trace(dir.path / "trace.h5", sample_trace());
   const std::string cmd = std::string(py) + " -c \"import h5py, json; b = h5py.File('" +
                           (dir.path / "bed.h5").string() + "'); t = h5py.File('" + (dir.path / "trace.h5").string() +

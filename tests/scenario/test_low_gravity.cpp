@@ -23,10 +23,10 @@ using pipeline::run_bed_job;
 using pipeline::run_drop_job;
 
 /// Index of the highest grain of a bed.
-std::size_t highest_grain(const results::BedData& bed) {
+std::size_t highest_grain(const Particles& grains) {
   std::size_t top = 0;
-  for (std::size_t i = 1; i < bed.size(); ++i)
-    if (bed.position_m[3 * i + 2] > bed.position_m[3 * top + 2]) top = i;
+  for (std::size_t i = 1; i < grains.size(); ++i)
+    if (grains.position_m[i].z() > grains.position_m[top].z()) top = i;
   return top;
 }
 
@@ -42,10 +42,10 @@ TEST(AtRest, ABedWhoseSurfaceStillMovesIsRefusedWithItsFigures) {
   EXPECT_LT(b.report.at_rest_for_impacts_above_m_s.value(), 1.0);
   EXPECT_NO_THROW(run_drop_job(test::tiny_scenario(), b.bed_path, dir.path / "ok.h5", 1, {}, nullptr));
   // ... but not once its top grain moves at 5 cm/s (5 % of the impact speed; 1 % allowed).
-  results::BedData bed = results::read_bed(b.bed_path);
-  const std::size_t top = highest_grain(bed);
-  bed.velocity_m_s[3 * top] = 0.05;
-  write_bed(dir.path / "moving.h5", bed);
+  Particles grains;
+  const results::BedFacts bed = results::read_bed(b.bed_path, grains);
+  grains.velocity_m_s[highest_grain(grains)].x() = 0.05;
+  write_bed(dir.path / "moving.h5", grains, bed);
   try {
     run_drop_job(test::tiny_scenario(), dir.path / "moving.h5", dir.path / "never.h5", 1, {}, nullptr);
     FAIL() << "a bed moving at 5 % of the impact speed was accepted";
@@ -65,12 +65,13 @@ TEST(AtRest, ABedWhoseSurfaceStillMovesIsRefusedWithItsFigures) {
 
 /// The surface grain (centre within 2 grain diameters of the surface) farthest from the container
 /// axis (outermost) or nearest to it.
-std::size_t surface_grain(const results::BedData& bed, bool outermost) {
+std::size_t surface_grain(const Particles& grains, const results::BedFacts& bed, bool outermost) {
   std::size_t best = 0;
   double best_r = outermost ? -1.0 : 1e9;
-  for (std::size_t i = 0; i < bed.size(); ++i) {
-    const double r = std::hypot(bed.position_m[3 * i], bed.position_m[3 * i + 1]);
-    if (bed.position_m[3 * i + 2] < bed.surface_height_m - 0.02 || (outermost ? r <= best_r : r >= best_r)) continue;
+  for (std::size_t i = 0; i < grains.size(); ++i) {
+    const Vec3& p = grains.position_m[i];
+    const double r = std::hypot(p.x(), p.y());
+    if (p.z() < bed.surface_height_m - 0.02 || (outermost ? r <= best_r : r >= best_r)) continue;
     best = i;
     best_r = r;
   }
@@ -80,8 +81,9 @@ std::size_t surface_grain(const results::BedData& bed, bool outermost) {
 /// A short drop (2 ms) of the tiny scenario on `bed` (written to dir/wall.h5): refused while the
 /// whole bed counts, accepted when only the grains within half a projectile diameter of the impact
 /// axis do (/at_rest/surface_radius_D 0.5). Returns the scenario with that window.
-json refused_on_the_whole_bed_accepted_about_the_axis(const fs::path& dir, const results::BedData& bed) {
-  write_bed(dir / "wall.h5", bed);
+json refused_on_the_whole_bed_accepted_about_the_axis(const fs::path& dir, const Particles& grains,
+                                                      const results::BedFacts& bed) {
+  write_bed(dir / "wall.h5", grains, bed);
   json s = test::tiny_scenario();
   s["stop"]["max_time_s"] = 0.002;
   EXPECT_THROW(run_drop_job(s, dir / "wall.h5", dir / "never.h5", 1, {}, nullptr), ConfigError);
@@ -97,15 +99,16 @@ json refused_on_the_whole_bed_accepted_about_the_axis(const fs::path& dir, const
 TEST(AtRest, ASurfaceRadiusCountsOnlyTheGrainsAboutTheImpactAxis) {
   test::TempDir dir;
   const auto b = run_bed_job(test::tiny_scenario(), dir.path / "bed.h5", 1, {}, nullptr);
-  results::BedData bed = results::read_bed(b.bed_path);
-  const std::size_t wall = surface_grain(bed, true), central = surface_grain(bed, false);
-  ASSERT_GT(std::hypot(bed.position_m[3 * wall], bed.position_m[3 * wall + 1]), 0.035) << "a grain at the wall";
-  bed.velocity_m_s[3 * wall] = 0.012;  // 1.2 % of the 1 m/s impact (1 % allowed; the RMS stays below 0.1 %)
-  const json s = refused_on_the_whole_bed_accepted_about_the_axis(dir.path, bed);
-  bed.velocity_m_s[3 * wall] = 0;
-  bed.velocity_m_s[3 * central] = 0.012;  // within 1 cm of the axis, so within 1.5 cm of the impact's
-  ASSERT_LT(std::hypot(bed.position_m[3 * central], bed.position_m[3 * central + 1]), 0.01);
-  write_bed(dir.path / "central.h5", bed);
+  Particles grains;
+  const results::BedFacts bed = results::read_bed(b.bed_path, grains);
+  const std::size_t wall = surface_grain(grains, bed, true), central = surface_grain(grains, bed, false);
+  ASSERT_GT(std::hypot(grains.position_m[wall].x(), grains.position_m[wall].y()), 0.035) << "a grain at the wall";
+  grains.velocity_m_s[wall].x() = 0.012;  // 1.2 % of the 1 m/s impact (1 % allowed; the RMS stays below 0.1 %)
+  const json s = refused_on_the_whole_bed_accepted_about_the_axis(dir.path, grains, bed);
+  grains.velocity_m_s[wall].x() = 0;
+  grains.velocity_m_s[central].x() = 0.012;  // within 1 cm of the axis, so within 1.5 cm of the impact's
+  ASSERT_LT(std::hypot(grains.position_m[central].x(), grains.position_m[central].y()), 0.01);
+  write_bed(dir.path / "central.h5", grains, bed);
   try {
     run_drop_job(s, dir.path / "central.h5", dir.path / "never.h5", 1, {}, nullptr);
     FAIL() << "a grain moving at 1.2 % of the impact speed near the impact axis was accepted";
@@ -123,19 +126,23 @@ TEST(AtRest, ASurfaceRadiusCountsOnlyTheGrainsAboutTheImpactAxis) {
 TEST(AtRest, TheRmsSpeedCountsTheSameColumnAboutTheImpactAxis) {
   test::TempDir dir;
   const auto b = run_bed_job(test::tiny_scenario(), dir.path / "bed.h5", 1, {}, nullptr);
-  results::BedData bed = results::read_bed(b.bed_path);
+  Particles grains;
+  const results::BedFacts bed = results::read_bed(b.bed_path, grains);
   constexpr double kWindow_m = 0.02, kCreep_m_s = 0.003;
+  const auto axis_distance_m = [&](std::size_t i) {
+    return std::hypot(grains.position_m[i].x(), grains.position_m[i].y());
+  };
   std::size_t outside = 0;
-  for (std::size_t i = 0; i < bed.size(); ++i)
-    if (std::hypot(bed.position_m[3 * i], bed.position_m[3 * i + 1]) > kWindow_m) {
-      bed.velocity_m_s[3 * i] = kCreep_m_s;
+  for (std::size_t i = 0; i < grains.size(); ++i)
+    if (axis_distance_m(i) > kWindow_m) {
+      grains.velocity_m_s[i].x() = kCreep_m_s;
       ++outside;
     }
-  ASSERT_GT(static_cast<double>(outside) / static_cast<double>(bed.size()), 0.2) << "whole-bed RMS above 0.1 %";
-  const json s = refused_on_the_whole_bed_accepted_about_the_axis(dir.path, bed);
-  for (std::size_t i = 0; i < bed.size(); ++i)
-    bed.velocity_m_s[3 * i] = std::hypot(bed.position_m[3 * i], bed.position_m[3 * i + 1]) > kWindow_m ? 0 : kCreep_m_s;
-  write_bed(dir.path / "column.h5", bed);
+  ASSERT_GT(static_cast<double>(outside) / static_cast<double>(grains.size()), 0.2) << "whole-bed RMS above 0.1 %";
+  const json s = refused_on_the_whole_bed_accepted_about_the_axis(dir.path, grains, bed);
+  for (std::size_t i = 0; i < grains.size(); ++i)
+    grains.velocity_m_s[i].x() = axis_distance_m(i) > kWindow_m ? 0 : kCreep_m_s;
+  write_bed(dir.path / "column.h5", grains, bed);
   try {
     run_drop_job(s, dir.path / "column.h5", dir.path / "never.h5", 1, {}, nullptr);
     FAIL() << "a column moving at 0.3 % of the impact speed about the impact axis was accepted";

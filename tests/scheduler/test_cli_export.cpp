@@ -35,9 +35,10 @@ int stamp_beds(const std::filesystem::path& files_root, const std::string& versi
   for (const auto& e : std::filesystem::recursive_directory_iterator(files_root)) {
     if (e.path().extension() != ".h5" || e.path().parent_path().filename() == "traces") continue;
     try {
-      auto bed = results::read_bed(e.path());
+      Particles grains;
+      results::BedFacts bed = results::read_bed(e.path(), grains);
       bed.code_version = version;
-      results::write_bed(e.path(), bed);
+      results::write_bed(e.path(), grains, bed);
       ++n;
     } catch (const std::exception&) {  // not a bed file
     }
