@@ -38,14 +38,6 @@ std::vector<std::vector<std::size_t>> Campaign::trials_by_level() const {
   return out;
 }
 
-MetricOptions applied_options(const MeasuredTrial& t) {
-  MetricOptions o = metric_options(t.info);
-  const Metrics& m = t.processed.metrics;
-  if (m.cutoff_hz > 0) o.cutoff_hz = m.cutoff_hz;
-  if (m.end_hold_s > 0) o.end_hold_s = m.end_hold_s;
-  return o;
-}
-
 void process_trial(MeasuredTrial& t) {
   t.raw.source = t.info.source;
   MetricOptions o = metric_options(t.info);
@@ -66,6 +58,7 @@ void process_trial(MeasuredTrial& t) {
         "record is too short for its drop-scaled filter ({})",
         t.processed.metrics.note.empty() ? "" : "; ", o.cutoff_hz, o.end_hold_s, e.what());
   }
+  t.options = o;
   // Fit window: inside the collision, two filter edge widths clear of contact and stop.
   const auto& p = t.processed;
   const std::size_t w = 2 * (1 + static_cast<std::size_t>(std::ceil(p.sample_rate_hz / o.cutoff_hz)));

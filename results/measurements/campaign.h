@@ -21,11 +21,17 @@ namespace gravsweep::results {
 
 struct TraceData;
 
-/// A trial with its raw and processed trace.
+/// A trial with its raw and processed trace, and the options it was processed with.
 struct MeasuredTrial {
   Trial info;
   Trace raw;
   ProcessedTrace processed;
+  /// What `processed` was processed with: set once, by process_trial (metric_options(info), or the
+  /// paper's fixed scales when a short lab record falls back to them), or read back with an
+  /// imported campaign (load_campaign_db). Anything processed beside the trial takes these (the
+  /// model's record that predicts its apeak as measured, the re-integrated line of Fig. 2), so it
+  /// is processed alike without working out again what was applied.
+  MetricOptions options;
   /// Samples used by trace-level fits: inside the collision, clear of the filter's transient.
   std::size_t fit_begin = 0, fit_end = 0;  ///< [begin, end)
   /// A CSV trace only: the file line of each sample and the 1-based column of accel_m_s2, so
@@ -43,14 +49,10 @@ struct Campaign {
   [[nodiscard]] std::vector<std::vector<std::size_t>> trials_by_level() const;
 };
 
-/// The one processing entry: options from the trial (metric_options), bias removal from the
-/// source, the fit window, a clipped record (mark_clipping). Throws std::invalid_argument with the reason.
+/// The one processing entry: options from the trial (metric_options; kept as t.options), bias
+/// removal from the source, the fit window, a clipped record (mark_clipping). Throws
+/// std::invalid_argument with the reason.
 void process_trial(MeasuredTrial& t);
-/// The options a processed trial was processed with: metric_options(t.info) with the cut-off and
-/// the hold its metrics record as applied (process_trial's fallback to the fixed scales included),
-/// so that a record processed beside it (a model's record of the same drop) is processed alike,
-/// whether the trial was processed now or read back from an imported database.
-MetricOptions applied_options(const MeasuredTrial& t);
 
 /// Processing a verb imposes on every trial it reads (Trial::time_scale, Trial::end_rule; empty:
 /// each trial's own), for a sensitivity of a result to the processing.

@@ -334,10 +334,24 @@ Trial trial_of_row(db::Statement& q, const std::vector<std::string>& cols) {
   return j.get<Trial>();
 }
 
-/// The metrics columns of a row, from column b on, in metric_columns() order (null: the default).
+/// The options a stored trial was processed with: its facts' (metric_options) with the cut-off and
+/// the hold its metrics record as applied (process_trial's fallback to the fixed scales included).
+/// A row without them was imported before they were recorded, when every trial was processed in
+/// the paper's fixed scales: the trial's own cut-off and the paper's hold.
+MetricOptions stored_options(const MeasuredTrial& t, bool recorded) {
+  MetricOptions o = metric_options(t.info);
+  const Metrics& m = t.processed.metrics;
+  o.cutoff_hz = recorded ? m.cutoff_hz : t.info.filter_cutoff_hz;
+  o.end_hold_s = recorded ? m.end_hold_s : kPaperEndHold_s;
+  return o;
+}
+
+/// The metrics columns of a row, from column b on, in metric_columns() order (null: the default),
+/// and the options they record (stored_options).
 void read_metrics(db::Database& db, db::Statement& q, int b, MeasuredTrial& t) {
   auto& m = t.processed.metrics;
   int c = b;
+  bool recorded = true;  // the cut-off and the hold applied
   for (const auto& f : metric_fields()) {
     if (!q.is_null(c)) {
       if (f.number)
@@ -346,9 +360,12 @@ void read_metrics(db::Database& db, db::Statement& q, int b, MeasuredTrial& t) {
         m.*f.flag = q.get_int(c) != 0;
       else
         m.*f.text = q.get_text(c);
+    } else if (f.number == &Metrics::cutoff_hz || f.number == &Metrics::end_hold_s) {
+      recorded = false;
     }
     ++c;
   }
+  t.options = stored_options(t, recorded);
   for (const auto& col : kProcessingColumns) {
     if (q.is_null(c) && col.required)
       throw std::runtime_error(

@@ -174,7 +174,7 @@ Prediction predict(const FittedModel& m, const MeasuredTrial& t, const std::vect
   // within it) is left out; when none can be, the unfiltered peak stays.
   std::vector<bool> in_collision;
   const Trace clean = model_record_marked(m, t, in_collision);
-  const MetricOptions o = applied_options(t);
+  const MetricOptions& o = t.options;
   const double g = t.info.gravity_m_s2;
   double sum = 0;
   int n = 0;

@@ -96,7 +96,7 @@ Fig2Record load_record(const std::string& path) {
     bare.source = TraceSource::lab;
     bare.velocity_down_m_s.clear();
     bare.depth_m.clear();
-    MetricOptions o = applied_options(r.trial);
+    MetricOptions o = r.trial.options;
     o.impact_speed_m_s = p.metrics.vc_m_s;
     try {
       const ProcessedTrace q = process_trace(bare, o);

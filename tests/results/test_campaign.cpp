@@ -193,18 +193,45 @@ TEST(Campaign, ATrialProcessedInTheFixedScalesIsProcessedAgainInThem) {
   int fell_back = 0;
   for (std::size_t i = 0; i < c.trials.size(); ++i) {
     const MeasuredTrial& t = c.trials[i];
-    const MetricOptions applied = applied_options(t);
+    const MetricOptions& applied = t.options;
     const Metrics again = process_trace(t.raw, applied).metrics;
     EXPECT_EQ(again.apeak_m_s2, t.processed.metrics.apeak_m_s2) << t.info.trial_id;
     EXPECT_EQ(again.tstop_s, t.processed.metrics.tstop_s) << t.info.trial_id;
-    EXPECT_EQ(applied_options(back.trials[i]).cutoff_hz, applied.cutoff_hz) << t.info.trial_id;
-    EXPECT_EQ(applied_options(back.trials[i]).end_hold_s, applied.end_hold_s) << t.info.trial_id;
+    EXPECT_EQ(applied.cutoff_hz, t.processed.metrics.cutoff_hz) << t.info.trial_id;
+    EXPECT_EQ(back.trials[i].options.cutoff_hz, applied.cutoff_hz) << t.info.trial_id;
+    EXPECT_EQ(back.trials[i].options.end_hold_s, applied.end_hold_s) << t.info.trial_id;
+    EXPECT_EQ(back.trials[i].options.gravity_m_s2, applied.gravity_m_s2) << t.info.trial_id;
     if (t.processed.metrics.note.find("fixed scales") == std::string::npos) continue;
     ++fell_back;
     EXPECT_EQ(applied.cutoff_hz, kPaperCutoff_hz) << t.info.trial_id;
     EXPECT_LT(metric_options(t.info).cutoff_hz, 0.2 * kPaperCutoff_hz) << t.info.trial_id;  // asked: 50 Hz
   }
   EXPECT_GE(fell_back, 3);
+}
+
+// A database imported before the cut-off and the hold applied were recorded (when every trial was
+// processed in the paper's fixed scales): its trials are read back with the fixed scales as the
+// options they were processed with, not with the drop-scaled ones their facts would give today.
+TEST(Campaign, ATrialImportedBeforeItsCutoffWasRecordedHasTheFixedScales) {
+  TempDir d;
+  SynthOptions o;
+  o.gravity_m_s2 = {0.1};
+  o.repeats = 1;
+  o.seed = 5;
+  ASSERT_EQ(write_synthetic_campaign(d.str(), parse_model("base"), o), 8);
+  const Campaign c = load_campaign(d.str(), kPaperCutoff_hz, {"froude", ""});
+  const std::string dbfile = stored_in_sqlite(d, c);
+  int scaled = 0;
+  for (const MeasuredTrial& t : load_campaign_any(dbfile).trials) scaled += t.options.cutoff_hz < kPaperCutoff_hz;
+  EXPECT_GT(scaled, 0) << "some trials processed in their drop's scales";
+  db::Database(dbfile).exec(
+      "ALTER TABLE trial_metrics DROP COLUMN cutoff_hz; ALTER TABLE trial_metrics DROP COLUMN end_hold_s");
+  const Campaign old = load_campaign_any(dbfile);
+  ASSERT_EQ(old.trials.size(), c.trials.size());
+  for (const MeasuredTrial& t : old.trials) {
+    EXPECT_EQ(t.options.cutoff_hz, t.info.filter_cutoff_hz) << t.info.trial_id;
+    EXPECT_EQ(t.options.end_hold_s, kPaperEndHold_s) << t.info.trial_id;
+  }
 }
 
 // A database imported before a metric had its column: it is read with that metric at its default,
