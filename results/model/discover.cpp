@@ -75,25 +75,73 @@ std::string strongest_axis(const std::vector<AxisResidual>& axes) {
       best->axis, best->eta2, best->split_half_r);
 }
 
+/// How the force of a term shared by all levels goes with gravity at Froude-similar states (the
+/// same z/D and Fr = v / sqrt(g D), D = 10 cm, m = 1 kg): the power p of g in the ratio of its
+/// force at 9.81 and 0.0981 m/s2 (1: Froude-scaled, it follows g; 0: it does not).
+double force_power_of_g(const ModelTerm& mt) {
+  constexpr double kG1 = 9.81, kG2 = 0.0981, kD = 0.1;
+  const auto force = [&](double g) {
+    TermContext c;
+    c.g_m_s2 = g;
+    c.diameter_m = kD;
+    c.mass_kg = 1.0;
+    c.fill_height_m = 2 * kD;
+    c.z_m = 0.3 * kD;
+    c.v_m_s = c.vc_m_s = std::sqrt(g * kD);
+    const FittedModel one = [&] {
+      FittedModel m;
+      m.spec.terms = {mt};
+      m.gravity_levels = {g};
+      m.coef = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(mt.term->params.size()));
+      return m;
+    }();
+    return one.force(c);
+  };
+  const double f1 = force(kG1), f2 = force(kG2);
+  return f1 != 0 && f2 / f1 > 0 ? std::log(f2 / f1) / std::log(kG2 / kG1) : NAN;
+}
+
+/// The power q of g that makes a term shared by all levels Froude-scaled: with its constant carried
+/// by (g / 9.81 m/s2)^q its force goes as g at Froude-similar states (q = 1 - force_power_of_g;
+/// Sunday et al. 2021 II: the drag of a Froude-similar collision scales as m g). A viscous drag
+/// b v needs q = 1/2 (v goes as sqrt(g D)); a depth friction k z needs q = 1; a v^2 drag needs 0.
+/// Rounded to hundredths, as a spec writes it; NaN when the force does not go as a power of g.
+double froude_power(const ModelTerm& shared) {
+  const double p = force_power_of_g(shared);
+  return std::isfinite(p) ? std::round(100.0 * (1.0 - p)) / 100.0 : NAN;
+}
+
 /// The named terms to try beside `current`, each in the sharing it is tried in. Per level: every
 /// registered term not in `current` (baselines aside) in its own sharing. Gravity-scaled (a
 /// baseline that is one law for all levels): every such term as one law for all levels too, a
 /// per-level term in its two forms, its constant shared by all levels ("depth_friction:shared":
 /// does not follow g) and carried by g ("immersion_drag:g^1"; where a registered term is that form,
-/// TermInfo::gravity_form, it stands in for it, and a term whose g-form is a baseline is not tried).
-/// A term identifiable only across projectile diameters is tried when `several_diameters`.
-std::vector<ModelTerm> named_candidates(const ModelSpec& current, bool gravity_scaled, bool several_diameters) {
+/// TermInfo::gravity_form, it stands in for it, and a term whose g-form is a baseline is not tried),
+/// and every term also in its Froude-scaled form when that is another (froude_power: a viscous
+/// drag's constant carried by g^0.5). A term identifiable only across projectile diameters is
+/// tried when `several_diameters`; a form carried by a power of g only when `several_levels` (at one
+/// gravity level it is the shared form again, and would only cost the others Bonferroni power).
+std::vector<ModelTerm> named_candidates(const ModelSpec& current, bool gravity_scaled, bool several_diameters,
+                                        bool several_levels) {
   std::vector<ModelTerm> named;
   for (const auto& term : term_registry()) {
     if (current.has(term.name) || term.baseline_only) continue;
     if (term.across_diameters && !several_diameters) continue;
-    if (!gravity_scaled || !term.per_gravity) {
+    if (!gravity_scaled) {
       named.push_back({&term, term.per_gravity, 1.0});
       continue;
     }
-    if (!term.gravity_form.empty() && find_term(term.gravity_form).baseline_only) continue;
+    if (term.per_gravity && !term.gravity_form.empty() && find_term(term.gravity_form).baseline_only) continue;
     named.push_back({&term, false, 1.0});
-    if (term.gravity_form.empty()) named.push_back({&term, false, 1.0, 1.0});
+    if (!several_levels) continue;
+    if (term.per_gravity && term.gravity_form.empty()) named.push_back({&term, false, 1.0, 1.0});
+    // Its Froude-scaled form where that is neither the shared form (q = 0) nor the one carried
+    // by g (q = 1, tried above for a per-level term; for a shared constant force it is the
+    // baseline's phi m g): one constant for all levels cannot act alike at every level when the
+    // term's force does not follow g (a viscous drag: b v with one b is 100 times weaker, against
+    // m g, at 9.81 than at 0.001 m/s2 in Froude-similar collisions).
+    const double q = froude_power({&term, false, 1.0});
+    if (std::isfinite(q) && std::abs(q) > 0.02 && std::abs(q - 1.0) > 0.02) named.push_back({&term, false, 1.0, q});
   }
   return named;
 }
@@ -171,32 +219,6 @@ std::string generated_equivalent_to(const Candidate& winner, const ModelSpec& cu
   const auto ranked = rank_candidates(current, c, {{form, !gravity_scaled, 1.0}}, folds, alpha, min_improvement);
   if (ranked.empty() || !ranked.front().significant) return "";
   return held_out_equal(winner, ranked.front()) ? "c * " + form->name : "";
-}
-
-/// How the force of a term shared by all levels goes with gravity at Froude-similar states (the
-/// same z/D and Fr = v / sqrt(g D), D = 10 cm, m = 1 kg): the power p of g in the ratio of its
-/// force at 9.81 and 0.0981 m/s2 (1: Froude-scaled, it follows g; 0: it does not).
-double force_power_of_g(const ModelTerm& mt) {
-  constexpr double kG1 = 9.81, kG2 = 0.0981, kD = 0.1;
-  const auto force = [&](double g) {
-    TermContext c;
-    c.g_m_s2 = g;
-    c.diameter_m = kD;
-    c.mass_kg = 1.0;
-    c.fill_height_m = 2 * kD;
-    c.z_m = 0.3 * kD;
-    c.v_m_s = c.vc_m_s = std::sqrt(g * kD);
-    const FittedModel one = [&] {
-      FittedModel m;
-      m.spec.terms = {mt};
-      m.gravity_levels = {g};
-      m.coef = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(mt.term->params.size()));
-      return m;
-    }();
-    return one.force(c);
-  };
-  const double f1 = force(kG1), f2 = force(kG2);
-  return f1 != 0 && f2 / f1 > 0 ? std::log(f2 / f1) / std::log(kG2 / kG1) : NAN;
 }
 
 /// What the sharing of a term tried in the scaled mode says about gravity.
@@ -313,9 +335,11 @@ Discovery discover(const Campaign& c, const ModelSpec& baseline, int folds, doub
     return std::abs(t.info.projectile_diameter_m - c.trials.front().info.projectile_diameter_m) >
            1e-9 * t.info.projectile_diameter_m;
   });
+  const bool several_levels = c.gravity_levels().size() > 1;
   for (int round = 0; round < max_rounds; ++round) {
-    const auto cands = rank_candidates(current, c, named_candidates(current, d.gravity_scaled, several_diameters),
-                                       folds, alpha, min_improvement);
+    const auto cands =
+        rank_candidates(current, c, named_candidates(current, d.gravity_scaled, several_diameters, several_levels),
+                        folds, alpha, min_improvement);
     d.rounds.push_back(cands);
     if (cands.empty() || !cands.front().significant) break;
     d.equivalent.push_back(equivalent_to_winner(cands));

@@ -123,7 +123,9 @@ void setup_model_rank(CLI::App& model) {
   sub->add_flag_callback(
       "--scaled", [o]() { o->baseline = "scaled_base"; },
       "scaled mode: start from one gravity-scaled law for every level (scaled_base: phi m g + m v^2/d1) and "
-      "rank only terms that are one law for all levels too, so an effect whose size does not follow g "
+      "rank only terms that are one law for all levels too: each with one constant for every g, a per-level "
+      "term also with its constant carried by g, and each also in its Froude-scaled form, whose force goes as "
+      "m g at equal Froude number (viscous_drag:g^0.5), so an effect whose size does not follow g "
       "(e.g. cohesion) is found instead of absorbed level by level; same as --baseline scaled_base");
   sub->add_option("--folds", o->folds, "cross-validation folds")->check(CLI::Range(2, 100))->capture_default_str();
   sub->add_option("--alpha", o->alpha, "family-wise significance level")->capture_default_str();
