@@ -7,7 +7,11 @@
 #   deploy/gravity-sweep.sh status   progress with ETA
 #   deploy/gravity-sweep.sh export   finished levels -> data/gravity_sweep/ (measurement format, 2 kHz)
 #   deploy/gravity-sweep.sh table    data/gravity_sweep/results.csv: every committed folder's drops in one
-#                                    table (the union of their columns, a column `folder` first)
+#                                    table (the union of their columns, a column `folder` first), the
+#                                    metrics recomputed from the committed traces by this build's
+#                                    processing (each drop in its own scales; `processed_by` names the
+#                                    build), so that every row has one definition; each folder's own
+#                                    results.csv keeps the worker's record as it ran
 #
 # Environment: GRAVSWEEP_CAMPAIGN (default runs/gravity_sweep/sweep.db), GRAVSWEEP_BIN (default
 # build/scheduler/gravsweep), WORKERS (1), THREADS (2), SPECS (the folder of level specs, default
@@ -53,13 +57,29 @@ case "${1:-}" in
     du -sh "$data"
     ;;
   table)
-    # The committed folders' result rows in one table; a drop in two folders is refused.
-    /usr/bin/python3 - "$data" <<'PY'
-import csv, glob, os, sys
-data = sys.argv[1]
+    # The committed folders' result rows in one table; a drop in two folders is refused. The
+    # metric columns are this build's processing of the committed traces (measurements import).
+    /usr/bin/python3 - "$data" "$gs" <<'PY'
+import csv, glob, os, sqlite3, subprocess, sys, tempfile
+data, gs = sys.argv[1], sys.argv[2]
+version = subprocess.run([gs, "--version"], capture_output=True, text=True, check=True).stdout.strip()
+processed_cols = ["vc_m_s", "apeak_m_s2", "zstop_m", "tstop_s", "rebound", "start_depth_m", "zstop_surface_m",
+                  "cutoff_hz", "end_hold_s", "t_start_s", "t_end_s", "depth_at_end_m", "final_depth_m", "note"]
+def processed(folder_dir):
+    """The folder's trials processed by this build: {trial_id: {column: value}}."""
+    with tempfile.TemporaryDirectory() as tmp:
+        db = os.path.join(tmp, "m.db")
+        subprocess.run([gs, "measurements", "import", folder_dir, "--db", db, "--format", "csv"],
+                       check=True, stdout=subprocess.DEVNULL)
+        con = sqlite3.connect(db)
+        con.row_factory = sqlite3.Row
+        out = {r["trial_id"]: {c: r[c] for c in processed_cols} for r in con.execute("SELECT * FROM trial_metrics")}
+        con.close()
+        return out
 rows, cols, seen = [], ["folder"], {}
 for path in sorted(glob.glob(os.path.join(data, "g*", "results.csv"))):
     folder = os.path.basename(os.path.dirname(path))
+    metrics = processed(os.path.dirname(path))
     with open(path, newline="") as f:
         reader = csv.DictReader(f)
         for name in reader.fieldnames:
@@ -69,12 +89,18 @@ for path in sorted(glob.glob(os.path.join(data, "g*", "results.csv"))):
             if r["job_id"] in seen:
                 sys.exit(f"{path}: drop {r['job_id']} is also in {seen[r['job_id']]}")
             seen[r["job_id"]] = folder
-            rows.append(dict(r, folder=folder))
+            m = metrics.get(r["job_id"], {})
+            r.update({c: ("" if m.get(c) is None else m[c]) for c in processed_cols})
+            rows.append(dict(r, folder=folder, processed_by=version))
+for c in processed_cols + ["processed_by"]:
+    if c not in cols:
+        cols.append(c)
 with open(os.path.join(data, "results.csv"), "w", newline="") as f:
     w = csv.DictWriter(f, fieldnames=cols, restval="")
     w.writeheader()
     w.writerows(rows)
-print(f"{len(rows)} drops from {len(set(seen.values()))} folders -> {os.path.join(data, 'results.csv')}")
+print(f"{len(rows)} drops from {len(set(seen.values()))} folders -> {os.path.join(data, 'results.csv')}, "
+      f"metrics processed by {version}")
 PY
     ;;
   *)

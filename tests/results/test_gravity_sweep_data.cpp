@@ -227,3 +227,46 @@ TEST(GravitySweep, AboveFroudeOneTheFiveLevelsCollapseAndTheStepHoldsAtThreeMetr
     EXPECT_NEAR(coarse / fine, 1.0, 0.005) << site.first << " m/s, seed " << site.second;
   }
 }
+
+// data/gravity_sweep/results.csv is every committed drop in one table with one definition: its
+// metrics are the processing of the committed traces (each drop in its own scales), so a change
+// to the processing that is not followed by `deploy/gravity-sweep.sh table` fails here, and so
+// does a folder left out of the table.
+TEST(GravitySweep, TheResultsTableIsTheProcessingOfEveryCommittedDrop) {
+  using namespace gravsweep::results;
+  const auto dir = std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "data" / "gravity_sweep";
+  std::ifstream in(dir / "results.csv");
+  ASSERT_TRUE(in) << "no " << (dir / "results.csv");
+  CsvReader csv(in);
+  std::vector<std::string> header, cells;
+  int line = 0;
+  ASSERT_TRUE(csv.next(header, line));
+  std::map<std::string, std::map<std::string, std::string>> table;  // by job id
+  while (csv.next(cells, line)) {
+    std::map<std::string, std::string> row;
+    for (std::size_t i = 0; i < header.size() && i < cells.size(); ++i) row[header[i]] = cells[i];
+    table[row.at("job_id")] = row;
+  }
+  std::size_t trials = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (!std::filesystem::exists(entry.path() / "trials.csv")) continue;
+    const std::string folder = entry.path().filename().string();
+    Campaign c = load_campaign(entry.path().string());
+    reprocess_campaign(c, {"froude", ""});
+    ASSERT_TRUE(c.issues.empty()) << folder;
+    for (const auto& t : c.trials) {
+      ++trials;
+      SCOPED_TRACE(folder + " " + t.info.trial_id);
+      ASSERT_EQ(table.count(t.info.trial_id), 1u);
+      const auto& row = table.at(t.info.trial_id);
+      EXPECT_EQ(row.at("folder"), folder);
+      const Metrics& m = t.processed.metrics;
+      for (const auto& [column, value] :
+           {std::pair{"zstop_m", m.zstop_m}, std::pair{"tstop_s", m.tstop_s}, std::pair{"apeak_m_s2", m.apeak_m_s2},
+            std::pair{"vc_m_s", m.vc_m_s}, std::pair{"zstop_surface_m", m.zstop_surface_m},
+            std::pair{"cutoff_hz", m.cutoff_hz}, std::pair{"end_hold_s", m.end_hold_s}})
+        EXPECT_NEAR(std::stod(row.at(column)), value, 1e-6 * std::abs(value) + 1e-12) << column;
+    }
+  }
+  EXPECT_EQ(trials, table.size()) << "a row of results.csv in no committed folder";
+}
