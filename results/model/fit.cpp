@@ -175,7 +175,8 @@ FittedModel fit_unchecked(const ModelSpec& spec, const Campaign& c, const std::v
   std::vector<int> cluster(rows);
   Eigen::Index r = 0;
   std::vector<double> row(static_cast<std::size_t>(L.cols));
-  const bool one_law = one_law_for_all_levels(spec) || spec.trial_force_units;
+  const bool own_force = spec.residual_units == ResidualUnits::trial_force ||
+                         (spec.residual_units == ResidualUnits::automatic && one_law_for_all_levels(spec));
   for (int ti : used) {
     const MeasuredTrial& t = c.trials[static_cast<std::size_t>(ti)];
     const int gi = m.gravity_index(t.info.gravity_m_s2);
@@ -183,8 +184,8 @@ FittedModel fit_unchecked(const ModelSpec& spec, const Campaign& c, const std::v
     // Trials weighted equally. A law for one gravity level at a time takes residuals in units of
     // g (its trials' forces span a few m g); one law for all levels takes each trial's residuals in
     // units of its own force (trial_force_scale_m_s2), as its trials span Froude 0.2-10 and forces
-    // from m g to 300 m g.
-    const double scale_m_s2 = one_law ? trial_force_scale_m_s2(t) : t.info.gravity_m_s2;
+    // from m g to 300 m g (ModelSpec::residual_units).
+    const double scale_m_s2 = own_force ? trial_force_scale_m_s2(t) : t.info.gravity_m_s2;
     const double wt = count[static_cast<std::size_t>(ti)] / (n_t * scale_m_s2 * scale_m_s2);
     for (std::size_t k = t.fit_begin; k < t.fit_end; ++k, ++r) {
       const TermContext ctx = context(t, k);

@@ -53,15 +53,7 @@ double error_pct(double predicted, double measured) {
 
 LevelOutTrial predict_held_out(const FittedModel& law, const MeasuredTrial& t,
                                const std::vector<const std::vector<double>*>& fluct) {
-  LevelOutTrial r;
-  r.impact_froude = t.info.impact_speed_m_s / std::sqrt(t.info.gravity_m_s2 * t.info.projectile_diameter_m);
-  r.pred = predict(law, t, fluct);
-  if (!r.pred.stopped) return r;
-  const auto& m = t.processed.metrics;
-  if (clip_exclusion(t, ClippedMetric::zstop).empty()) r.zstop_err_pct = error_pct(r.pred.zstop_m, m.zstop_m);
-  r.tstop_err_pct = error_pct(r.pred.tstop_s, m.tstop_s);
-  if (clip_exclusion(t, ClippedMetric::apeak).empty()) r.apeak_err_pct = error_pct(r.pred.apeak_m_s2, m.apeak_m_s2);
-  return r;
+  return signed_errors(t, predict(law, t, fluct));
 }
 
 /// "zstop 12.3 % > 10 %: the quasi-static regime misses (quasi-static, impact Fr < 0.8: 18.0 % over 4
@@ -124,47 +116,6 @@ std::pair<double, double> prediction_sd_pct(const FittedModel& law, const Trial&
   if (!p.stopped) return {NAN, NAN};
   return {100 * std::sqrt(std::max(0.0, dz.dot(law.cov * dz))) / p.zstop_m,
           100 * std::sqrt(std::max(0.0, dt.dot(law.cov * dt))) / p.tstop_s};
-}
-
-/// The held-out drops grouped by the design's Froude number (froude_groups), with their signed
-/// mean errors.
-std::vector<LevelOutFroude> by_froude(const std::vector<LevelOutTrial>& per_trial) {
-  std::vector<const LevelOutTrial*> drops;
-  std::vector<double> ln_fr;
-  for (const auto& t : per_trial)
-    if (std::isfinite(t.impact_froude) && t.impact_froude > 0) {
-      drops.push_back(&t);
-      ln_fr.push_back(std::log(t.impact_froude));
-    }
-  const std::vector<int> group = froude_groups(ln_fr);
-  const int n_groups = group.empty() ? 0 : *std::max_element(group.begin(), group.end()) + 1;
-  std::vector<std::vector<const LevelOutTrial*>> groups(static_cast<std::size_t>(n_groups));
-  for (std::size_t k = 0; k < drops.size(); ++k) groups[static_cast<std::size_t>(group[k])].push_back(drops[k]);
-  std::vector<LevelOutFroude> out;
-  for (const auto& grp : groups) {
-    LevelOutFroude f;
-    f.drops = static_cast<int>(grp.size());
-    double fr = 0, z = 0, t = 0;
-    int nz = 0, nt = 0;
-    for (const auto* p : grp) {
-      fr += p->impact_froude;
-      if (std::isfinite(p->zstop_err_pct)) {
-        z += p->zstop_err_pct, ++nz;
-        f.zstop_min_err_pct =
-            std::isfinite(f.zstop_min_err_pct) ? std::min(f.zstop_min_err_pct, p->zstop_err_pct) : p->zstop_err_pct;
-        f.zstop_max_err_pct =
-            std::isfinite(f.zstop_max_err_pct) ? std::max(f.zstop_max_err_pct, p->zstop_err_pct) : p->zstop_err_pct;
-      }
-      if (std::isfinite(p->tstop_err_pct)) t += p->tstop_err_pct, ++nt;
-    }
-    f.froude = fr / static_cast<double>(grp.size());
-    if (nz) f.zstop_mean_err_pct = z / nz;
-    if (nt) f.tstop_mean_err_pct = t / nt;
-    f.misses = std::abs(f.zstop_mean_err_pct) > kLevelOutZstopTargetPct ||
-               std::abs(f.tstop_mean_err_pct) > kLevelOutTstopTargetPct;
-    out.push_back(f);
-  }
-  return out;
 }
 
 /// "; but Fr 10 misses (zstop -22.1 %, tstop +3.0 % over 2 drops)" for every Froude number whose
@@ -242,6 +193,71 @@ LevelOutRow hold_out(const ModelSpec& spec, const Campaign& c, double g_m_s2, co
 }
 
 }  // namespace
+
+LevelOutTrial signed_errors(const MeasuredTrial& t, const Prediction& p) {
+  LevelOutTrial r;
+  r.impact_froude = t.info.impact_speed_m_s / std::sqrt(t.info.gravity_m_s2 * t.info.projectile_diameter_m);
+  r.pred = p;
+  if (!r.pred.stopped) return r;
+  const auto& m = t.processed.metrics;
+  if (clip_exclusion(t, ClippedMetric::zstop).empty()) r.zstop_err_pct = error_pct(r.pred.zstop_m, m.zstop_m);
+  r.tstop_err_pct = error_pct(r.pred.tstop_s, m.tstop_s);
+  if (clip_exclusion(t, ClippedMetric::apeak).empty()) r.apeak_err_pct = error_pct(r.pred.apeak_m_s2, m.apeak_m_s2);
+  return r;
+}
+
+std::vector<LevelOutFroude> by_froude(const std::vector<LevelOutTrial>& per_trial) {
+  std::vector<const LevelOutTrial*> drops;
+  std::vector<double> ln_fr;
+  for (const auto& t : per_trial)
+    if (std::isfinite(t.impact_froude) && t.impact_froude > 0) {
+      drops.push_back(&t);
+      ln_fr.push_back(std::log(t.impact_froude));
+    }
+  const std::vector<int> group = froude_groups(ln_fr);
+  const int n_groups = group.empty() ? 0 : *std::max_element(group.begin(), group.end()) + 1;
+  std::vector<std::vector<const LevelOutTrial*>> groups(static_cast<std::size_t>(n_groups));
+  for (std::size_t k = 0; k < drops.size(); ++k) groups[static_cast<std::size_t>(group[k])].push_back(drops[k]);
+  std::vector<LevelOutFroude> out;
+  for (const auto& grp : groups) {
+    LevelOutFroude f;
+    f.drops = static_cast<int>(grp.size());
+    double fr = 0, z = 0, t = 0;
+    int nz = 0, nt = 0;
+    for (const auto* p : grp) {
+      fr += p->impact_froude;
+      if (std::isfinite(p->zstop_err_pct)) {
+        z += p->zstop_err_pct, ++nz;
+        f.zstop_min_err_pct =
+            std::isfinite(f.zstop_min_err_pct) ? std::min(f.zstop_min_err_pct, p->zstop_err_pct) : p->zstop_err_pct;
+        f.zstop_max_err_pct =
+            std::isfinite(f.zstop_max_err_pct) ? std::max(f.zstop_max_err_pct, p->zstop_err_pct) : p->zstop_err_pct;
+      }
+      if (std::isfinite(p->tstop_err_pct)) t += p->tstop_err_pct, ++nt;
+    }
+    f.froude = fr / static_cast<double>(grp.size());
+    if (nz) f.zstop_mean_err_pct = z / nz;
+    if (nt) f.tstop_mean_err_pct = t / nt;
+    f.misses = std::abs(f.zstop_mean_err_pct) > kLevelOutZstopTargetPct ||
+               std::abs(f.tstop_mean_err_pct) > kLevelOutTstopTargetPct;
+    out.push_back(f);
+  }
+  return out;
+}
+
+std::vector<FroudeCell> froude_cells(const Campaign& c, const std::vector<Prediction>& pred) {
+  std::vector<FroudeCell> out;
+  for (double g : c.gravity_levels()) {
+    std::vector<LevelOutTrial> level;
+    for (std::size_t i = 0; i < c.trials.size() && i < pred.size(); ++i)
+      if (same_gravity_level(c.trials[i].info.gravity_m_s2, g)) {
+        level.push_back(signed_errors(c.trials[i], pred[i]));
+        level.back().trial = i;
+      }
+    for (const auto& f : by_froude(level)) out.push_back({g, f});
+  }
+  return out;
+}
 
 std::vector<LevelOutRow> leave_level_out(const ModelSpec& spec, const Campaign& c) {
   if (!one_law_for_all_levels(spec))

@@ -74,4 +74,20 @@ std::vector<LevelOutRow> leave_level_out(const ModelSpec& law, const Campaign& c
 /// The median of |x| over the finite values (NaN when there are none).
 double median_abs(const std::vector<double>& x);
 
+/// Trial t's prediction p with its signed errors (predicted - measured, % of measured; NaN where
+/// the law's motion did not stop or a clipped record leaves the metric out) and impact Fr.
+LevelOutTrial signed_errors(const MeasuredTrial& t, const Prediction& p);
+/// The drops grouped by the design's Froude number (froude_groups), with their signed mean
+/// errors, ascending Fr.
+std::vector<LevelOutFroude> by_froude(const std::vector<LevelOutTrial>& per_trial);
+
+/// One cell of a campaign's design: a gravity level and a Froude number.
+struct FroudeCell {
+  double g_m_s2 = 0;
+  LevelOutFroude errors;
+};
+/// Every trial's prediction `pred` (one per trial; held out, from cross_validate) by gravity level
+/// (descending) and Froude number: the signed mean errors a median over all trials hides.
+std::vector<FroudeCell> froude_cells(const Campaign& c, const std::vector<Prediction>& pred);
+
 }  // namespace gravsweep::results

@@ -24,12 +24,19 @@ struct ModelTerm {
   [[nodiscard]] bool g_scaled() const { return !std::isnan(g_power); }
 };
 
+/// The units of each trial's residuals in a fit (fit_model), trials weighted equally in them.
+enum class ResidualUnits {
+  automatic,    ///< one law for all levels: trial_force; a law per level: gravity
+  trial_force,  ///< the trial's own RMS force (m times the RMS of a_up + g over its fit window)
+  gravity,      ///< m g: a fast drop's residuals count as much more as its force is larger
+};
+
 struct ModelSpec {
   std::vector<ModelTerm> terms;
-  /// Residuals of every trial in units of its own force, as one law for all levels is fitted
-  /// (fit_model), even when a term has a value per level: the scaling check frees one constant of
-  /// such a law per level and must weigh the trials as the law did.
-  bool trial_force_units = false;
+  /// automatic, unless a caller fixes them: the scaling check frees one constant of a law for all
+  /// levels per level and must weigh the trials as the law did (trial_force); `model fit --weight`
+  /// gives a law's sensitivity to the weighting.
+  ResidualUnits residual_units = ResidualUnits::automatic;
   [[nodiscard]] std::string name() const;                      ///< "base+depth_friction"
   [[nodiscard]] bool has(const std::string& term_name) const;  ///< a term of that name is in the spec
 };

@@ -146,7 +146,7 @@ std::string froude_note(const Campaign& c, const std::vector<double>& levels) {
 
 ModelSpec split_parameters(const ModelSpec& law) {
   ModelSpec s;
-  s.trial_force_units = law.trial_force_units;
+  s.residual_units = law.residual_units;
   for (const ModelTerm& t : law.terms) {
     if (t.term->params.size() < 2) {
       s.terms.push_back(t);
@@ -241,7 +241,7 @@ ScalingCheck scaling_check(const ModelSpec& law, const Campaign& c, int resample
   r.trials = static_cast<int>(c.trials.size());
   r.resamples = resamples;
   ModelSpec current = split_parameters(law);
-  current.trial_force_units = true;
+  current.residual_units = ResidualUnits::trial_force;
   const ModelSpec as_given = current;
   const FittedModel given = fit_model(as_given, c);
   const std::vector<std::vector<std::size_t>> by_level = c.trials_by_level();

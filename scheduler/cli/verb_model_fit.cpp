@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "results/model/law.h"
+#include "results/model/level_out.h"
 #include "results/model/cross_validation.h"
 #include "results/model/fit.h"
 #include "results/model/model_spec.h"
@@ -39,7 +40,16 @@ struct FitOptions {
   bool no_plot = false;
   std::string save;  ///< the law file (results/model/law.h); empty: none
   int resamples = results::kLawResamples;
+  bool per_froude = false;      ///< the held-out errors by gravity level and Froude number too
+  std::string weight = "auto";  ///< the units of each trial's residuals (ResidualUnits)
 };
+
+/// `--weight`: auto, trial-force or mg.
+results::ResidualUnits residual_units_named(const std::string& w) {
+  if (w == "trial-force") return results::ResidualUnits::trial_force;
+  if (w == "mg") return results::ResidualUnits::gravity;
+  return results::ResidualUnits::automatic;
+}
 
 /// `--save`: the law with its bootstrap, form error by Froude number and ranges.
 void save_law(const FitOptions& o, const results::ModelSpec& spec, const results::Campaign& c) {
@@ -171,6 +181,41 @@ results::Table projectile_table(const results::Campaign& c, const std::vector<re
   return t;
 }
 
+/// Each model's held-out predictions by gravity level and Froude number: the signed mean errors
+/// (predicted - measured, % of measured) a median over every trial hides, each cell flagged when
+/// beyond a target (zstop 10 %, tstop 15 %, as leave-one-level-out's).
+results::Table froude_table(const results::Campaign& c, const std::vector<results::ComparedModel>& cm) {
+  results::Table t({"model", "gravity_m_s2", "impact_fr", "drops", "zstop_mean_err_pct", "zstop_min_err_pct",
+                    "zstop_max_err_pct", "tstop_mean_err_pct", "beyond_target"});
+  for (const auto& m : cm)
+    for (const auto& [g, f] : results::froude_cells(c, m.held_out.pred))
+      t.add({m.name, num(g), num(f.froude, 3), std::to_string(f.drops), num(f.zstop_mean_err_pct, 3),
+             num(f.zstop_min_err_pct, 3), num(f.zstop_max_err_pct, 3), num(f.tstop_mean_err_pct, 3),
+             f.misses ? "yes" : "no"});
+  return t;
+}
+
+/// "model: 7 of 25 cells beyond a target (worst zstop +23.1 % at 0.1 m/s2, Fr 2)" per model.
+void print_froude_verdicts(const results::Campaign& c, const std::vector<results::ComparedModel>& cm) {
+  for (const auto& m : cm) {
+    const auto cells = results::froude_cells(c, m.held_out.pred);
+    int beyond = 0;
+    const results::FroudeCell* worst = nullptr;
+    for (const auto& cell : cells) {
+      beyond += cell.errors.misses;
+      if (std::isfinite(cell.errors.zstop_mean_err_pct) &&
+          (!worst || std::abs(cell.errors.zstop_mean_err_pct) > std::abs(worst->errors.zstop_mean_err_pct)))
+        worst = &cell;
+    }
+    if (!worst) continue;
+    fmt::print(
+        "{}: {} of {} cells beyond a target (zstop {:g} %, tstop {:g} %); worst zstop {:+.1f} % at {:g} m/s2, "
+        "Fr {:.2g}\n",
+        m.name, beyond, cells.size(), results::kLevelOutZstopTargetPct, results::kLevelOutTstopTargetPct,
+        worst->errors.zstop_mean_err_pct, worst->g_m_s2, worst->errors.froude);
+  }
+}
+
 int projectile_count(const results::Campaign& c) {
   int n = 0;
   results::projectile_index(c, &n);
@@ -193,6 +238,14 @@ void print_errors(const FitOptions& o, const results::Campaign& c, const std::ve
       fmt::print("\nEach projectile held out: mean signed error of its drops (predicted - measured, % of measured):\n");
     projectile_table(c, cm).print(o.in.format);
   }
+  if (o.per_froude) {
+    if (table)
+      fmt::print(
+          "\nBy gravity level and Froude number (held out; signed mean error, predicted - measured, % of "
+          "measured):\n");
+    froude_table(c, cm).print(o.in.format);
+    if (table) print_froude_verdicts(c, cm);
+  }
   if (table) explain_rises(cm);
 }
 
@@ -206,14 +259,16 @@ void print_fit_json(const results::ModelSpec& spec, const results::FittedModel& 
                         {"parameters", params_table(fm).json_value()},
                         {"held_out_errors", error_table(cm).json_value()}};
   if (by_projectile) out["projectiles_held_out"] = projectile_table(c, cm).json_value();
+  out["by_froude"] = froude_table(c, cm).json_value();
   std::fputs((out.dump(2) + "\n").c_str(), stdout);
 }
 
 void run_fit(const FitOptions& o) {
   const bool table = o.in.format == "table";
   const auto c = load_model_campaign(o.in);
-  const auto base = model_of(o.baseline);
-  const auto spec = model_of(o.model);
+  auto base = model_of(o.baseline);
+  auto spec = model_of(o.model);
+  base.residual_units = spec.residual_units = residual_units_named(o.weight);
   const auto fm = results::fit_model(spec, c);
   const int folds = o.leave_out == "projectile" ? results::kLeaveOneProjectileOut : o.folds;
   const auto cm = results::compare_models(c, {base, spec}, folds);
@@ -251,7 +306,10 @@ void setup_model_fit(CLI::App& model) {
       "covariance, --resamples bootstrap resamples of them (whole drops, within each level), its\n"
       "error by Froude number (held out by gravity level) and the ranges it was fitted on\n"
       "(docs/formats/law.md). --format json prints one document: {model, trials, samples, parameters:\n"
-      "[...], held_out_errors: [...], and projectiles_held_out: [...] with --leave-out projectile}.");
+      "[...], held_out_errors: [...], by_froude: [...] (the --per-froude table), and projectiles_held_out:\n"
+      "[...] with --leave-out projectile}.\n"
+      "--per-froude adds the held-out errors by gravity level and Froude number with the count of cells\n"
+      "beyond a target; --weight mg gives the law's sensitivity to the weighting of the trials.");
   add_model_inputs(sub, o->in);
   sub->add_option("--model", o->model, "model: 'base+depth_friction' or a JSON spec file")->capture_default_str();
   sub->add_option("--baseline", o->baseline, "the 'before' model")->capture_default_str();
@@ -268,6 +326,15 @@ void setup_model_fit(CLI::App& model) {
   sub->add_option("--save", o->save, "write the fitted law to this file (JSON; for `model predict`)");
   sub->add_option("--resamples", o->resamples, "bootstrap resamples of the constants saved with --save")
       ->check(CLI::Range(20, 100000))
+      ->capture_default_str();
+  sub->add_flag("--per-froude", o->per_froude,
+                "also the held-out errors by gravity level and Froude number: each cell's signed mean error and "
+                "whether it is beyond a target (zstop 10 %, tstop 15 %), which a median over all trials hides");
+  sub->add_option("--weight", o->weight,
+                  "units of each trial's residuals, trials weighted equally in them: auto (a law for all gravity "
+                  "levels: the trial's own RMS force; a law per level: m g), trial-force, or mg (a fast drop's "
+                  "residuals then count as much more as its force is larger): the law's sensitivity to the weighting")
+      ->check(CLI::IsMember({"auto", "trial-force", "mg"}))
       ->capture_default_str();
   sub->callback([o]() { run_fit(*o); });
 }

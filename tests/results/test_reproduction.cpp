@@ -227,7 +227,7 @@ TEST(Reproduction, AStifferPkdgravSpringBringsAlphaAndF0WithinTheirUncertainties
 // at 1 g (part 1b). At 0.1 m/s2 (part 2, mostly above Fr 1.5) the paper's 500 Hz processing finds
 // nothing missing; in the drop's own scales (50.5 Hz) the residuals rise with depth, which no named
 // term explains alone and a depth-weighted drag c z v^0.5 fits; on both levels together the depth
-// friction that does not follow g is named.
+// friction that does not follow g is named, then a drag linear in the speed.
 TEST(Reproduction, ModelRankFindsADepthResistanceAtBothLevels) {
   const auto one = gravsweep::testing::run_gravsweep("model rank '" + dataset("chrono_1g_sites") + "'", true);
   ASSERT_EQ(one.code, 0) << one.out;
@@ -247,6 +247,7 @@ TEST(Reproduction, ModelRankFindsADepthResistanceAtBothLevels) {
   ASSERT_EQ(both.code, 0) << both.out;
   EXPECT_NE(both.out.find("Verdict: missing effect: depth_friction"), std::string::npos) << both.out;
   EXPECT_NE(both.out.find("better on 35 of 42 trials"), std::string::npos) << both.out;
+  EXPECT_NE(both.out.find("; then viscous_drag (drag linear in speed"), std::string::npos) << both.out;
 }
 
 // Several inputs are read as one campaign (one exported dataset per gravity level): the trials of
