@@ -25,8 +25,9 @@ namespace {
 using results::num;
 
 constexpr const char* kLawHelp =
-    "the law: scaled_base (phi m g + m v^2/d1, one law for all levels) or a term list whose terms are all shared, "
-    "e.g. 'scaled_base+cohesion' or 'scaled_base+gravity_depth_friction'";
+    "the law: scaled_base (phi m g + m v^2/d1, one law for all levels) or a term list with no parameter per level: "
+    "terms shared by all levels or carried by a power of g (':g^p'), e.g. 'scaled_base+gravity_depth_friction' or "
+    "'scaled_base+gravity_depth_friction+viscous_drag:g^0.5'";
 
 struct LawOptions {
   ModelInputs in;
@@ -191,7 +192,10 @@ void setup_model_lolo(CLI::App& model) {
       "other speed-dependent term). Per drop: the share of each in the impulse and in the work, and the\n"
       "Froude number Fr = v/sqrt(g D) (D the projectile diameter) where the drag falls below the\n"
       "quasi-static part, beside the law's crossover at the surface (sqrt(phi d1/D) for scaled_base) and\n"
-      "paper II's Fr ~ 1.5.\n\n"
+      "paper II's Fr ~ 1.5. Under the table (table format): the crossover by the two whole-collision\n"
+      "definitions, the impact Fr at which the drag does half the work and the one at which it carries\n"
+      "half the impulse, each with its SD from the law's covariance (GRAVITY.md, the crossover by three\n"
+      "definitions).\n\n"
       "Examples:\n"
       "  gravsweep model regimes data/gravity_sweep/g9.81 data/gravity_sweep/g1.62\n"
       "  gravsweep model regimes campaign.db --law scaled_base+gravity_depth_friction --format json");
