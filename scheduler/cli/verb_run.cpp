@@ -162,7 +162,7 @@ void run_impact(const RunOptions& o) {
       fmt::print(
           "bed: {} grains kept of {} poured, surface at {:.2f} cm, bulk density {:.0f} kg/m3, {}, prepared in {}\n",
           b.report.grains_kept, b.report.grains_placed, 100 * b.report.surface_height_m, b.report.bulk_density_kg_m3,
-          settling_outcome(b.report, pipeline::scenario_params(scenario).bed.settle),
+          settling_outcome(b.report, pipeline::scenario_of(scenario).bed_spec().settle),
           format_duration(b.report.wall_time_s));
     } else {
       bed_path = o.bed;

@@ -43,26 +43,28 @@ std::string first_difference(const json& a, const json& b) {
   return patch.empty() ? std::string() : patch[0].value("path", std::string("/"));
 }
 
-/// The slowest impact a bed in this state is at rest for under the criterion's fractions.
-double slowest_impact_at_rest_m_s(const BedRestState& r, const AtRestCriterion& c) {
+/// The slowest impact a bed in this state is at rest for under the fractions of /at_rest.
+double slowest_impact_at_rest_m_s(const BedRestState& r, const AtRestSettings& c) {
   return std::max(r.max_surface_speed_m_s / c.surface_speed_fraction, r.rms_speed_m_s / c.rms_speed_fraction);
 }
 
-/// Refuses a bed whose grains still move too fast for this drop's impact (/at_rest), with the figures.
-void require_at_rest(const System& sys, const results::BedFacts& bed, const ScenarioParams& p,
-                     const std::filesystem::path& bed_path) {
-  const AtRestCriterion& c = p.at_rest;
-  SurfaceWindow window;  // the whole bed, or the part about the impact axis
+/// Refuses a bed whose grains still move too fast for this drop's impact (/at_rest), with the
+/// figures; `projectile` is the drop's (its start drawn: the impact axis).
+void require_at_rest(const System& sys, const results::BedFacts& bed, const Scenario& s,
+                     const ProjectileSpec& projectile, const std::filesystem::path& bed_path) {
+  const AtRestSettings& c = s.at_rest;
+  const double radius_D = c.surface_radius_D.value_or(0.0);  // 0: the whole surface
+  // The whole bed, or the part about the impact axis.
+  SurfaceWindow window;
   std::string where, there;
-  if (c.surface_radius_D > 0) {
-    window = {p.projectile.lateral_offset_x_m, p.projectile.lateral_offset_y_m,
-              c.surface_radius_D * p.projectile.diameter_m};
-    where = fmt::format(" within {:.3g} m of the impact axis (/at_rest/surface_radius_D: {:g})", window.radius_m,
-                        c.surface_radius_D);
+  if (radius_D > 0) {
+    window = {projectile.lateral_offset_x_m, projectile.lateral_offset_y_m, radius_D * projectile.diameter_m};
+    where =
+        fmt::format(" within {:.3g} m of the impact axis (/at_rest/surface_radius_D: {:g})", window.radius_m, radius_D);
     there = " there";
   }
-  const BedRestState r = bed_rest_state(sys, bed.surface_height_m, p.bed.grains.diameter_m, window);
-  const double v = c.impact_speed_m_s;
+  const BedRestState r = bed_rest_state(sys, bed.surface_height_m, s.grains.diameter_m, window);
+  const double v = s.reference_impact_speed_m_s();
   if (r.max_surface_speed_m_s < c.surface_speed_fraction * v && r.rms_speed_m_s < c.rms_speed_fraction * v) return;
   throw ConfigError(fmt::format(
       "bed {} is not at rest for an impact at {:.4g} m/s: its fastest surface grain{} moves at {:.3g} m/s (at "
@@ -112,19 +114,19 @@ namespace {
 
 /// Writes the prepared bed and its report (with the checkpoints' counts) to bed_out; removes the
 /// checkpoint once the bed is written.
-BedJobResult write_prepared_bed(const System& sys, const BedReport& rep, const ScenarioParams& p, const json& s,
+BedJobResult write_prepared_bed(const System& sys, const BedReport& rep, const Scenario& s, const json& validated,
                                 const std::filesystem::path& bed_out, double wall_s, JobCheckpointer& ckpt,
                                 const std::atomic<bool>* stop) {
   results::BedFacts b = results::bed_facts_of(sys);
-  const BedRestState rest = bed_rest_state(sys, rep.surface_height_m, p.bed.grains.diameter_m);
-  b.container_diameter_m = p.bed.container.diameter_m;
-  b.fill_height_m = p.bed.fill_height_m;
+  const BedRestState rest = bed_rest_state(sys, rep.surface_height_m, s.grains.diameter_m);
+  b.container_diameter_m = s.container.diameter_m;
+  b.fill_height_m = s.container.fill_height_m;
   b.surface_height_m = rep.surface_height_m;
-  b.gravity_m_s2 = p.gravity_m_s2;
+  b.gravity_m_s2 = s.gravity_m_s2;
   b.code_version = pipeline::build_version();
-  b.bed_key_json = bed_key_of_validated(s).dump();
-  b.scenario_json = s.dump();
-  results::BedSummary r = results::bed_summary_of(sys, rep, rest, slowest_impact_at_rest_m_s(rest, p.at_rest));
+  b.bed_key_json = bed_key_of_validated(validated).dump();
+  b.scenario_json = validated.dump();
+  results::BedSummary r = results::bed_summary_of(sys, rep, rest, slowest_impact_at_rest_m_s(rest, s.at_rest));
   r.wall_time_s = wall_s;
   results::set_checkpoint_counts(r, ckpt.counts());
   b.report_json = results::to_json(r).dump();
@@ -137,20 +139,22 @@ BedJobResult write_prepared_bed(const System& sys, const BedReport& rep, const S
 
 BedJobResult run_bed_job(const json& scenario, const std::filesystem::path& bed_out, int threads,
                          const Progress& progress, const std::atomic<bool>* stop, const Checkpointing& checkpointing) {
-  const json s = job_scenario(scenario);
-  ScenarioParams p = scenario_params(s);
+  const json validated = job_scenario(scenario);
+  const Scenario s = scenario_of(validated);
+  SystemConfig config = s.bed_config();
+  if (threads > 0) config.threads = threads;
+  const BedSpec spec = s.bed_spec();
   check_stop(stop, "bed preparation");
-  if (threads > 0) p.bed_config.threads = threads;
   const auto t0 = std::chrono::steady_clock::now();
   std::unique_ptr<System> sys;
   JobCheckpointer ckpt(
       checkpointing, "bed",
-      checkpointing.path.empty() ? json() : bed_identity(bed_key_of_validated(s), p.bed_config.threads), stop);
+      checkpointing.path.empty() ? json() : bed_identity(bed_key_of_validated(validated), config.threads), stop);
   // Sect. 2.2: mix and settle, flatten, relax; the relaxation is reported as part of "flatten".
   const auto prepare = [&] {
-    sys = std::make_unique<System>(p.bed_config);  // a fresh system for each try (a refused resume)
+    sys = std::make_unique<System>(config);  // a fresh system for each try (a refused resume)
     return prepare_bed(
-        *sys, p.bed,
+        *sys, spec,
         [&](BedPhase ph, double f, const std::string& d) {
           check_stop(stop, "bed preparation");
           if (!progress) return;
@@ -163,7 +167,7 @@ BedJobResult run_bed_job(const json& scenario, const std::filesystem::path& bed_
   };
   const BedReport rep = resume_or_start(ckpt, ckpt.resume_bed() != nullptr, prepare);
   const double wall_s = seconds_since(t0) + ckpt.prior_wall_time_s();
-  return write_prepared_bed(*sys, rep, p, s, bed_out, wall_s, ckpt, stop);
+  return write_prepared_bed(*sys, rep, s, validated, bed_out, wall_s, ckpt, stop);
 }
 
 std::filesystem::path bed_checksum_path(const std::filesystem::path& bed) { return bed.string() + ".sha256"; }
@@ -248,14 +252,14 @@ namespace {
 
 /// The drop's grain snapshots (/output/snapshot_interval_s > 0; none otherwise): the grains keep
 /// the order of bed.h5, the projectile comes last. `snaps` receives the writer.
-DropSnapshots snapshot_hooks(const ScenarioParams& p, const std::vector<double>& grain_radius_m,
+DropSnapshots snapshot_hooks(const Scenario& s, const std::vector<double>& grain_radius_m,
                              const std::filesystem::path& trace_out, std::unique_ptr<results::SnapshotWriter>& snaps) {
   DropSnapshots ds;
-  if (!(p.snapshot_interval_s > 0)) return ds;
-  snaps =
-      std::make_unique<results::SnapshotWriter>(results::snapshot_path_for(trace_out), grain_radius_m,
-                                                0.5 * p.projectile.diameter_m, p.snapshot_interval_s, build_version());
-  ds.interval_s = p.snapshot_interval_s;
+  const double interval_s = s.output.snapshot_interval_s;
+  if (!(interval_s > 0)) return ds;
+  snaps = std::make_unique<results::SnapshotWriter>(results::snapshot_path_for(trace_out), grain_radius_m,
+                                                    0.5 * s.projectile.diameter_m, interval_s, build_version());
+  ds.interval_s = interval_s;
   ds.write = [w = snaps.get()](const System& sy, ParticleIndex ip, double t_s) {
     w->append(results::snapshot_of(sy, ip, t_s));
   };
@@ -264,15 +268,15 @@ DropSnapshots snapshot_hooks(const ScenarioParams& p, const std::vector<double>&
 
 /// The drop's samples as trace columns, with the facts a reader of the trace needs (scenario, bed
 /// key and file, code version).
-results::TraceData trace_of(const DropResult& dr, const ScenarioParams& p, const json& validated,
+results::TraceData trace_of(const DropResult& dr, const Scenario& s, const json& validated,
                             const results::BedFacts& bed, const std::filesystem::path& bed_in) {
-  results::TraceData td = results::trace_columns_of(dr, p.sample_rate_hz);
-  td.dt_s = p.drop_config.dt_s;
-  td.gravity_m_s2 = p.gravity_m_s2;
+  results::TraceData td = results::trace_columns_of(dr, s.output.sample_rate_hz);
+  td.dt_s = s.dt_s;
+  td.gravity_m_s2 = s.gravity_m_s2;
   td.surface_height_m = bed.surface_height_m;
-  td.projectile_diameter_m = p.projectile.diameter_m;
-  td.projectile_mass_kg = p.projectile.mass_kg;
-  td.grain_diameter_m = p.bed.grains.diameter_m;
+  td.projectile_diameter_m = s.projectile.diameter_m;
+  td.projectile_mass_kg = s.projectile.mass_kg;
+  td.grain_diameter_m = s.grains.diameter_m;
   td.scenario_json = validated.dump();
   td.bed_key_json = bed_key_of_validated(validated).dump();
   td.bed_file = std::filesystem::absolute(bed_in).string();
@@ -301,35 +305,37 @@ std::optional<results::Metrics> paper_metrics(const results::TraceData& td, cons
 DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& bed_in,
                            const std::filesystem::path& trace_out, int threads, const Progress& progress,
                            const std::atomic<bool>* stop, const Checkpointing& checkpointing) {
-  const json s = job_scenario(scenario);
-  ScenarioParams p = scenario_params(s);
-  if (threads > 0) p.drop_config.threads = threads;
+  const json validated = job_scenario(scenario);
+  const Scenario s = scenario_of(validated);
+  SystemConfig config = s.drop_config();
+  if (threads > 0) config.threads = threads;
   // The bed in a fresh system: bit-exact state, no contact history (as after any restart).
-  System sys(p.drop_config);
+  System sys(config);
   const results::BedFacts bed = results::load_bed(sys, bed_in);
   const std::size_t bed_grains = sys.particles.size();
-  require_bed_key(bed, s, bed_in);
+  require_bed_key(bed, validated, bed_in);
   check_stop(stop, "drop");
   const auto t0 = std::chrono::steady_clock::now();
-  require_at_rest(sys, bed, p, bed_in);
+  const ProjectileSpec projectile = s.projectile_spec();
+  require_at_rest(sys, bed, s, projectile, bed_in);
 
   std::unique_ptr<results::SnapshotWriter> snaps;
-  const DropSnapshots ds = snapshot_hooks(p, sys.particles.radius_m, trace_out, snaps);
+  const DropSnapshots ds = snapshot_hooks(s, sys.particles.radius_m, trace_out, snaps);
   JobCheckpointer ckpt(checkpointing, "drop",
-                       checkpointing.path.empty() ? json() : drop_identity(s, bed_in, sys.threads()), stop);
+                       checkpointing.path.empty() ? json() : drop_identity(validated, bed_in, sys.threads()), stop);
   const auto drop = [&] {
     return drop_projectile(
-        sys, bed.surface_height_m, p.projectile, p.stop, p.sample_rate_hz,
+        sys, bed.surface_height_m, projectile, s.drop_stop(), s.output.sample_rate_hz,
         [&](double f, const std::string& d) {
           check_stop(stop, "drop");
           if (progress) progress("drop", f, ckpt.detail(d));
         },
-        ds, ckpt.drop_hooks(), p.time_step);
+        ds, ckpt.drop_hooks(), s.drop_time_step());
   };
   const DropResult dr = resume_or_start(ckpt, ckpt.resume_drop() != nullptr, drop);
   const double wall_s = seconds_since(t0) + ckpt.prior_wall_time_s();
 
-  results::TraceData td = trace_of(dr, p, s, bed, bed_in);
+  results::TraceData td = trace_of(dr, s, validated, bed, bed_in);
   std::string metrics_error;
   const std::optional<results::Metrics> metrics = paper_metrics(td, trace_out, metrics_error);
   // Nulls and metrics_error when the trace cannot be measured.
@@ -337,7 +343,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   if (!metrics) m["metrics_error"] = metrics_error;
   const std::optional<double> t_start = metrics ? std::optional<double>(metrics->t_start_s) : std::nullopt;
   results::DemFigures dem = results::dem_figures_of(
-      td, dr, bed, bed_grains, t_start, std::hypot(p.projectile.lateral_offset_x_m, p.projectile.lateral_offset_y_m));
+      td, dr, bed, bed_grains, t_start, std::hypot(projectile.lateral_offset_x_m, projectile.lateral_offset_y_m));
   dem.threads = sys.threads();
   dem.wall_time_s = wall_s;
   results::set_checkpoint_counts(dem, ckpt.counts());

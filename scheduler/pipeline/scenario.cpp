@@ -29,10 +29,11 @@ const Fields<ContainerSettings>& container_fields() {
   return f;
 }
 
-const Fields<GrainSettings>& grain_fields() {
-  static const Fields<GrainSettings> f = {{"diameter_m", "m", &GrainSettings::diameter_m},
-                                          {"diameter_spread_m", "m", &GrainSettings::diameter_spread_m},
-                                          {"density_kg_m3", "kg/m3", &GrainSettings::density_kg_m3}};
+/// /grains, read straight into the engine's GrainSpec.
+const Fields<GrainSpec>& grain_fields() {
+  static const Fields<GrainSpec> f = {{"diameter_m", "m", &GrainSpec::diameter_m},
+                                      {"diameter_spread_m", "m", &GrainSpec::diameter_spread_m},
+                                      {"density_kg_m3", "kg/m3", &GrainSpec::density_kg_m3}};
   return f;
 }
 

@@ -1,10 +1,13 @@
 // The impact scenario as a typed record (schemas/scenario.schema.json): what validate_scenario
-// returns, read once into structs, so that the engine's setup (scenario_params.cpp) and every
-// other reader take fields by name and type instead of by JSON pointer. The defaults live in one
-// place, the schema (filled by validate_scenario, with the versioned ones of scenario_defaults.h);
-// a field the schema gives no default is a std::optional here, absent when the scenario omits it.
-// Identities (job ids, bed keys, the site seed) stay computed from the JSON text a user wrote,
-// never from this record: a number's spelling (2 or 2.0) is part of them.
+// returns, read once into structs, so that every reader takes fields by name and type instead of
+// by JSON pointer. It is the one stored form of the scenario's facts: the engine's inputs
+// (SystemConfig, BedSpec, ProjectileSpec, DropStop, AdaptiveStep) are not kept beside it but made
+// from it where they are used, by its member functions (scenario_engine.cpp), and where a
+// sub-record's fields are the engine's own (/grains: GrainSpec) the record holds the engine struct.
+// The defaults live in one place, the schema (filled by validate_scenario, with the versioned ones
+// of scenario_defaults.h); a field the schema gives no default is a std::optional here, absent
+// when the scenario omits it. Identities (job ids, bed keys, the site seed) stay computed from the
+// JSON text a user wrote, never from this record: a number's spelling (2 or 2.0) is part of them.
 #pragma once
 #include <cstdint>
 #include <map>
@@ -13,6 +16,10 @@
 #include <string>
 
 #include "engine/core/material.h"
+#include "engine/scenario/bed.h"
+#include "engine/scenario/impact.h"
+#include "engine/scenario/time_step.h"
+#include "engine/system/system.h"
 
 namespace gravsweep::pipeline {
 
@@ -20,13 +27,6 @@ namespace gravsweep::pipeline {
 struct ContainerSettings {
   double diameter_m = 0;
   double fill_height_m = 0;
-};
-
-/// /grains: a uniform diameter distribution (m) of one density.
-struct GrainSettings {
-  double diameter_m = 0;
-  double diameter_spread_m = 0;
-  double density_kg_m3 = 0;
 };
 
 /// /materials (and /bed/materials): the three bodies' materials.
@@ -116,6 +116,9 @@ struct StopSettings {
   double hold_time_sqrt_D_g = 0;
   std::optional<double> max_time_s;
   double max_time_sqrt_D_g = 0;
+
+  /// The engine's stop criterion of a drop at this gravity of a projectile of this diameter.
+  [[nodiscard]] DropStop drop_stop(double gravity_m_s2, double projectile_diameter_m) const;
 };
 
 /// /time_step: the drop's adaptive step (engine/scenario/time_step.h).
@@ -146,7 +149,7 @@ struct Scenario {
   std::optional<int> defaults_version;
   double gravity_m_s2 = 0;
   ContainerSettings container;
-  GrainSettings grains;
+  GrainSpec grains;  ///< /grains: the engine's own struct (diameter, spread +/-, density)
   MaterialSet materials;
   ContactSettings contact;
   std::string integrator;
@@ -162,6 +165,37 @@ struct Scenario {
 
   /// The materials the bed is prepared with: /bed/materials when given, else /materials.
   [[nodiscard]] const MaterialSet& bed_materials() const { return bed.materials ? *bed.materials : materials; }
+
+  // The engine's inputs, made from the record at the point of use (scenario_engine.cpp); a caller
+  // that runs with another thread count sets SystemConfig::threads on its copy.
+
+  /// The system a bed is prepared in: /contact, bed_materials(), /integrator, /threads, /bed/dt_s
+  /// and settle_gravity_m_s2().
+  [[nodiscard]] SystemConfig bed_config() const;
+  /// The system of the drop: /contact, /materials, /integrator, /threads, /dt_s, /gravity_m_s2 and
+  /// the drop's rolling threshold (drop_min_roll_vel_m_s()).
+  [[nodiscard]] SystemConfig drop_config() const;
+  /// /container, /grains and /bed as the engine's bed preparation (relaxed at the drop's gravity
+  /// when it settles at another).
+  [[nodiscard]] BedSpec bed_spec() const;
+  /// /projectile, its random start drawn from site_seed() (the same start at every call).
+  [[nodiscard]] ProjectileSpec projectile_spec() const;
+  /// /stop in the drop's scales.
+  [[nodiscard]] DropStop drop_stop() const { return stop.drop_stop(gravity_m_s2, projectile.diameter_m); }
+  /// /time_step, the drop's adaptive step (off when absent; its speed bound twice the fastest
+  /// particle's speed when it names none).
+  [[nodiscard]] AdaptiveStep drop_time_step() const;
+  /// The gravity the bed is poured and settled at: /bed/settle_gravity_m_s2, or the drop's when 0.
+  [[nodiscard]] double settle_gravity_m_s2() const;
+  /// The drop's rolling-friction regularisation speed (/rolling_threshold): Chrono's value at
+  /// 9.81 m/s2 scaled by sqrt(g / 9.81), or the absolute value given.
+  [[nodiscard]] double drop_min_roll_vel_m_s() const;
+  /// The impact speed the bed must be at rest for (/at_rest): impact_speed_m_s, or for a release
+  /// from rest sqrt(2 g h) with h the drop height (at least one grain diameter).
+  [[nodiscard]] double reference_impact_speed_m_s() const;
+  /// The seed of the drop's random start: /projectile/seed mixed with the sweep point (gravity,
+  /// projectile incl. its speed or drop height, grains, container) unless site_draw is "seed".
+  [[nodiscard]] std::uint64_t site_seed() const;
 };
 
 /// The record of a scenario validate_scenario returned (every default filled). A key the record

@@ -1,5 +1,5 @@
-// What the scenario's validation (scenario_spec.cpp) and its translation into engine inputs
-// (scenario_params.cpp) share; not part of the pipeline's interface.
+// What the scenario's validation (scenario_spec.cpp) and the engine's inputs made from the typed
+// scenario (scenario_engine.cpp) share; not part of the pipeline's interface.
 #pragma once
 #include <string>
 

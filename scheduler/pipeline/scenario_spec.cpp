@@ -175,7 +175,7 @@ void check_size_and_steps(Checks& ck) {
   });
   ck.run([&] {
     const double g = ck.num("/gravity_m_s2"), D = ck.num("/projectile/diameter_m");
-    const double max_time_s = drop_stop(stop_settings_of(ck.at("/stop")), g, D).max_time_s;
+    const double max_time_s = stop_settings_of(ck.at("/stop")).drop_stop(g, D).max_time_s;
     const double steps = max_time_s / ck.num("/dt_s");
     if (steps > kMaxSteps)
       ck.bad("/dt_s", fmt::format("{:g}", ck.num("/dt_s")),

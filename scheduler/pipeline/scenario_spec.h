@@ -1,14 +1,12 @@
 // The impact scenario spec (schemas/scenario.schema.json, compiled in): validation with defaults,
-// cross-field checks, and its translation into engine parameters.
+// cross-field checks, and what a job stores of it. The engine's inputs are made from the typed
+// record (scenario.h) by its member functions.
 #pragma once
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 
-#include "engine/scenario/bed.h"
-#include "engine/scenario/impact.h"
-#include "engine/system/system.h"
 #include "scheduler/pipeline/scenario.h"
 #include "spec/json_schema.h"
 
@@ -83,48 +81,5 @@ std::size_t engine_check_runs();
 /// Reads a scenario file (JSON) and validates it; parse errors name the file, line and column. A
 /// file that names no /defaults_version takes the current defaults (scenario_defaults.h).
 nlohmann::json load_scenario(const std::filesystem::path& path);
-
-/// The drop's stop criterion from /stop: each quantity absolute when given, else in the drop's
-/// scales (speed in sqrt(g D), time in sqrt(D/g); scenario.schema.json, /stop).
-DropStop drop_stop(const StopSettings& stop, double gravity_m_s2, double projectile_diameter_m);
-
-/// The drop's rolling-friction regularisation speed (/rolling_threshold): Chrono's value at
-/// 9.81 m/s2 scaled by sqrt(g / 9.81), or the absolute value given.
-double drop_min_roll_vel_m_s(const Scenario& s);
-
-/// The impact speed the bed must be at rest for (/at_rest): impact_speed_m_s, or for a release
-/// from rest sqrt(2 g h) with h the drop height (at least one grain diameter).
-double reference_impact_speed_m_s(const Scenario& s);
-
-/// The seed of the drop's random start: /projectile/seed mixed with the sweep point (gravity,
-/// projectile incl. its speed or drop height, grains, container) unless site_draw is "seed".
-std::uint64_t site_seed(const Scenario& s);
-
-/// The bed's residual grain speeds a drop accepts, relative to its impact speed (/at_rest).
-struct AtRestCriterion {
-  double surface_speed_fraction = 0.01;
-  double rms_speed_fraction = 0.001;
-  double impact_speed_m_s = 0;  ///< reference_impact_speed_m_s
-  /// Surface grains counted: within this many projectile diameters of the impact axis; 0: all.
-  double surface_radius_D = 0;
-};
-
-/// Everything the engine needs, from a validated scenario.
-struct ScenarioParams {
-  SystemConfig bed_config;   ///< preparation: bed.dt_s, settle gravity
-  SystemConfig drop_config;  ///< drop: dt_s, gravity_m_s2
-  BedSpec bed;
-  ProjectileSpec projectile;  ///< with its random offsets drawn from projectile.seed
-  DropStop stop;
-  AdaptiveStep time_step;  ///< /time_step (off when absent)
-  AtRestCriterion at_rest;
-  double gravity_m_s2 = 9.81;
-  double sample_rate_hz = 1e4;
-  double snapshot_interval_s = 0;  ///< /output/snapshot_interval_s: grain snapshots, 0 = none
-};
-
-/// The engine's inputs from the typed scenario, or from a validated one (read by scenario_of).
-ScenarioParams scenario_params(const Scenario& s);
-ScenarioParams scenario_params(const nlohmann::json& validated);
 
 }  // namespace gravsweep::pipeline

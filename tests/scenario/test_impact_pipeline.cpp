@@ -181,10 +181,10 @@ TEST_F(ImpactPipeline, ABedPreparedWithItsOwnMaterialsServesDropsWithOtherMateri
   for (const char* body : {"grain", "wall", "projectile"}) stiff["materials"][body]["young_modulus_Pa"] = kStiffE_Pa;
   stiff["bed"]["materials"] = json::object();  // the defaults: the bed of tiny_scenario()
   EXPECT_EQ(pipeline::bed_key(stiff), pipeline::bed_key(test::tiny_scenario()));
-  const auto p = pipeline::scenario_params(pipeline::validate_scenario(stiff));
-  EXPECT_DOUBLE_EQ(p.bed_config.materials.at(kGrainMaterial).young_modulus_Pa, 7e8);
-  EXPECT_DOUBLE_EQ(p.drop_config.materials.at(kGrainMaterial).young_modulus_Pa, kStiffE_Pa);
-  EXPECT_DOUBLE_EQ(p.drop_config.materials.at(kProjectileMaterial).young_modulus_Pa, kStiffE_Pa);
+  const pipeline::Scenario p = pipeline::scenario_of(pipeline::validate_scenario(stiff));
+  EXPECT_DOUBLE_EQ(p.bed_config().materials.at(kGrainMaterial).young_modulus_Pa, 7e8);
+  EXPECT_DOUBLE_EQ(p.drop_config().materials.at(kGrainMaterial).young_modulus_Pa, kStiffE_Pa);
+  EXPECT_DOUBLE_EQ(p.drop_config().materials.at(kProjectileMaterial).young_modulus_Pa, kStiffE_Pa);
 
   // Without /bed/materials the stiff scenario names another bed, and the prepared one is refused.
   json stiff_own_bed = stiff;

@@ -43,7 +43,7 @@ void expect_round_trip(const json& validated, const std::string& what) {
   const json back = pipeline::to_json(r);
   EXPECT_EQ(back, validated) << what;
   EXPECT_EQ(queue::canonical_json(back), queue::canonical_json(validated)) << what;
-  EXPECT_EQ(pipeline::site_seed(r), site_seed_from_json(validated)) << what;
+  EXPECT_EQ(r.site_seed(), site_seed_from_json(validated)) << what;
 }
 
 TEST(ScenarioRecord, EveryCommittedDropsScenarioReadsIntoTheRecordAndBack) {
@@ -101,8 +101,8 @@ TEST(ScenarioRecord, EveryOptionalFieldHasItsPlace) {
   EXPECT_DOUBLE_EQ(r.bed_materials().grain.mu_rolling, 0.2);
   EXPECT_DOUBLE_EQ(*r.contact.pairs.at("grain-projectile").mu_static, 0.3);
   EXPECT_EQ(r.time_step->speed_bound, "normal_approach");
-  EXPECT_DOUBLE_EQ(pipeline::scenario_params(r).stop.speed_m_s, 2e-3);
-  EXPECT_DOUBLE_EQ(pipeline::scenario_params(r).drop_config.options.min_roll_vel_m_s, 1e-5);
+  EXPECT_DOUBLE_EQ(r.drop_stop().speed_m_s, 2e-3);
+  EXPECT_DOUBLE_EQ(r.drop_config().options.min_roll_vel_m_s, 1e-5);
 }
 
 TEST(ScenarioRecord, AKeyTheRecordDoesNotHaveIsRefusedNamingItsPointer) {

@@ -51,48 +51,51 @@ TEST(ScenarioSpec, DefaultsAreThePapersChronoSetup) {
   EXPECT_DOUBLE_EQ(s["/stop/speed_sqrt_gD"_json_pointer].get<double>(), 1e-3);
   EXPECT_DOUBLE_EQ(s["/bed/settle/rms_speed_m_s"_json_pointer].get<double>(), 1e-5);
   // The engine parameters equal Table 1's Chrono set of engine/scenario/paper_params.h.
-  const auto p = pipeline::scenario_params(s);
+  const SystemConfig drop = pipeline::scenario_of(s).drop_config();
   const SystemConfig ref = chrono_table1_config();
-  ASSERT_EQ(p.drop_config.materials.size(), ref.materials.size());
+  ASSERT_EQ(drop.materials.size(), ref.materials.size());
   for (std::size_t i = 0; i < ref.materials.size(); ++i) {
-    EXPECT_EQ(p.drop_config.materials[i].cor_normal, ref.materials[i].cor_normal) << i;
-    EXPECT_EQ(p.drop_config.materials[i].mu_static, ref.materials[i].mu_static) << i;
-    EXPECT_EQ(p.drop_config.materials[i].mu_rolling, ref.materials[i].mu_rolling) << i;
-    EXPECT_EQ(p.drop_config.materials[i].young_modulus_Pa, ref.materials[i].young_modulus_Pa) << i;
+    EXPECT_EQ(drop.materials[i].cor_normal, ref.materials[i].cor_normal) << i;
+    EXPECT_EQ(drop.materials[i].mu_static, ref.materials[i].mu_static) << i;
+    EXPECT_EQ(drop.materials[i].mu_rolling, ref.materials[i].mu_rolling) << i;
+    EXPECT_EQ(drop.materials[i].young_modulus_Pa, ref.materials[i].young_modulus_Pa) << i;
   }
-  EXPECT_EQ(p.drop_config.pair_overrides.size(), ref.pair_overrides.size());
-  EXPECT_EQ(p.drop_config.contact_law, "hertz");
-  EXPECT_EQ(p.drop_config.rolling_model, "sunday");
+  EXPECT_EQ(drop.pair_overrides.size(), ref.pair_overrides.size());
+  EXPECT_EQ(drop.contact_law, "hertz");
+  EXPECT_EQ(drop.rolling_model, "sunday");
 }
 
-// An enum name the schema did not check (a scenario handed straight to scenario_params) is refused
+// An enum name the schema did not check (a scenario read unvalidated into the record) is refused
 // with its pointer, never mapped silently to another value (it became explicit_pair before).
 TEST(ScenarioSpec, UnknownCompositionNameIsRefusedNotDefaulted) {
   json s = validate_scenario(minimal());
   s["/contact/composition"_json_pointer] = "chrono-min";
   try {
-    (void)pipeline::scenario_params(s);
+    (void)pipeline::scenario_of(s).drop_config();
     ADD_FAILURE() << "expected a ConfigError";
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("/contact/composition: found \"chrono-min\""), std::string::npos) << e.what();
   }
   s["/contact/composition"_json_pointer] = "chrono_min";
-  EXPECT_EQ(pipeline::scenario_params(s).drop_config.composition, Composition::chrono_min);
+  EXPECT_EQ(pipeline::scenario_of(s).drop_config().composition, Composition::chrono_min);
 }
 
 TEST(ScenarioSpec, OffsetsAreDrawnWithinTheirBoundsFromTheSeed) {
   json s = minimal();
   s["projectile"]["lateral_offset_max_grain_diameters"] = 2;
   s["projectile"]["vertical_offset_max_grain_diameters"] = 2;
-  const auto a = pipeline::scenario_params(validate_scenario(s));
-  const auto b = pipeline::scenario_params(validate_scenario(s));
-  EXPECT_EQ(a.projectile.lateral_offset_x_m, b.projectile.lateral_offset_x_m);
-  EXPECT_LE(std::hypot(a.projectile.lateral_offset_x_m, a.projectile.lateral_offset_y_m), 0.02);
-  EXPECT_GE(a.projectile.vertical_offset_m, 0.0);
-  EXPECT_LE(a.projectile.vertical_offset_m, 0.02);
+  const auto projectile = [](const json& spec) {
+    return pipeline::scenario_of(validate_scenario(spec)).projectile_spec();
+  };
+  const ProjectileSpec a = projectile(s);
+  const ProjectileSpec b = projectile(s);
+  EXPECT_EQ(a.lateral_offset_x_m, b.lateral_offset_x_m);
+  EXPECT_LE(std::hypot(a.lateral_offset_x_m, a.lateral_offset_y_m), 0.02);
+  EXPECT_GE(a.vertical_offset_m, 0.0);
+  EXPECT_LE(a.vertical_offset_m, 0.02);
   s["projectile"]["seed"] = 2;
-  const auto c = pipeline::scenario_params(validate_scenario(s));
-  EXPECT_NE(a.projectile.lateral_offset_x_m, c.projectile.lateral_offset_x_m);
+  const ProjectileSpec c = projectile(s);
+  EXPECT_NE(a.lateral_offset_x_m, c.lateral_offset_x_m);
 }
 
 // Repeats are independent: the site is drawn from the seed and the sweep point, so the same seed
@@ -102,7 +105,7 @@ TEST(ScenarioSpec, TheSameSeedAtAnotherSpeedOrGravityHitsAnotherSite) {
   json s = minimal();
   s["projectile"]["vertical_offset_max_grain_diameters"] = 0.5;
   auto site = [](const json& spec) {
-    const auto p = pipeline::scenario_params(validate_scenario(spec)).projectile;
+    const ProjectileSpec p = pipeline::scenario_of(validate_scenario(spec)).projectile_spec();
     return std::array<double, 3>{p.lateral_offset_x_m, p.lateral_offset_y_m, p.vertical_offset_m};
   };
   const auto a = site(s);
@@ -131,26 +134,26 @@ TEST(ScenarioSpec, TheStopScalesWithGravityUnlessGivenAbsolute) {
     s["projectile"]["impact_speed_m_s"] = 0.05;
     s["projectile"]["start_gap_m"] = 1e-4;
     s["stop"] = stop;
-    return pipeline::scenario_params(validate_scenario(s));
+    return pipeline::scenario_of(validate_scenario(s));
   };
-  const auto earth = at(9.81, json::object());
-  EXPECT_NEAR(earth.stop.speed_m_s, 1e-3, 1e-5);
-  EXPECT_NEAR(earth.stop.hold_time_s, 5e-3, 1e-4);
-  EXPECT_NEAR(earth.stop.max_time_s, 1.0, 0.01);
-  EXPECT_DOUBLE_EQ(earth.drop_config.options.min_roll_vel_m_s, 1e-4);  // Chrono's value at 1 g
-  const auto low = at(0.000981, json::object());
-  EXPECT_NEAR(low.stop.speed_m_s, 1e-3 / 100, 1e-7);
-  EXPECT_NEAR(low.stop.max_time_s, 100 * earth.stop.max_time_s, 1e-9);
-  EXPECT_NEAR(low.drop_config.options.min_roll_vel_m_s, 1e-6, 1e-12);
-  const auto fixed = at(0.001, json{{"speed_m_s", 2e-3}, {"max_time_s", 3.0}});
-  EXPECT_DOUBLE_EQ(fixed.stop.speed_m_s, 2e-3);
-  EXPECT_DOUBLE_EQ(fixed.stop.max_time_s, 3.0);
+  const pipeline::Scenario earth = at(9.81, json::object());
+  EXPECT_NEAR(earth.drop_stop().speed_m_s, 1e-3, 1e-5);
+  EXPECT_NEAR(earth.drop_stop().hold_time_s, 5e-3, 1e-4);
+  EXPECT_NEAR(earth.drop_stop().max_time_s, 1.0, 0.01);
+  EXPECT_DOUBLE_EQ(earth.drop_config().options.min_roll_vel_m_s, 1e-4);  // Chrono's value at 1 g
+  const pipeline::Scenario low = at(0.000981, json::object());
+  EXPECT_NEAR(low.drop_stop().speed_m_s, 1e-3 / 100, 1e-7);
+  EXPECT_NEAR(low.drop_stop().max_time_s, 100 * earth.drop_stop().max_time_s, 1e-9);
+  EXPECT_NEAR(low.drop_config().options.min_roll_vel_m_s, 1e-6, 1e-12);
+  const pipeline::Scenario fixed = at(0.001, json{{"speed_m_s", 2e-3}, {"max_time_s", 3.0}});
+  EXPECT_DOUBLE_EQ(fixed.drop_stop().speed_m_s, 2e-3);
+  EXPECT_DOUBLE_EQ(fixed.drop_stop().max_time_s, 3.0);
   // A validated scenario (both forms present) validates again to the same drop: absolute wins.
   json twice = minimal();
   twice["stop"] = json{{"speed_m_s", 2e-3}};
   const json once = validate_scenario(twice);
   EXPECT_EQ(validate_scenario(once), once);
-  EXPECT_DOUBLE_EQ(pipeline::scenario_params(validate_scenario(once)).stop.speed_m_s, 2e-3);
+  EXPECT_DOUBLE_EQ(pipeline::scenario_of(validate_scenario(once)).drop_stop().speed_m_s, 2e-3);
 }
 
 TEST(ScenarioSpec, UnknownFieldsAreRefusedWithTheirPointer) {
@@ -342,9 +345,9 @@ TEST(ScenarioSpec, TheAdaptiveStepsSpeedBoundIsOptionalAndNamed) {
   s["time_step"] = {{"steps_per_contact", 20}, {"dt_max_s", 5e-5}};
   const json plain = validate_scenario(s);
   EXPECT_FALSE(plain["time_step"].contains("speed_bound")) << plain["time_step"];
-  EXPECT_EQ(pipeline::scenario_params(plain).time_step.speed_bound, AdaptiveStep::SpeedBound::fastest_particle);
+  EXPECT_EQ(pipeline::scenario_of(plain).drop_time_step().speed_bound, AdaptiveStep::SpeedBound::fastest_particle);
   s["time_step"]["speed_bound"] = "normal_approach";
-  EXPECT_EQ(pipeline::scenario_params(validate_scenario(s)).time_step.speed_bound,
+  EXPECT_EQ(pipeline::scenario_of(validate_scenario(s)).drop_time_step().speed_bound,
             AdaptiveStep::SpeedBound::normal_approach);
   s["time_step"]["speed_bound"] = "fastest";
   const std::string msg = refused_at(s, "/time_step/speed_bound");

@@ -1,18 +1,22 @@
-// The translation of a typed scenario (scenario.h) into the engine's inputs (ScenarioParams): the
-// system configurations of the bed and the drop, the bed and projectile specs, the drop's stop and
-// at-rest criteria; validation and the rules across fields are in scenario_spec.cpp.
-#include "scheduler/pipeline/scenario_spec.h"
+// The engine's inputs made from the typed scenario (scenario.h) where they are used: the system
+// configurations of the bed and the drop, the bed and projectile specs, the drop's stop and
+// adaptive step, and the figures they are made from (site seed, rolling threshold, the impact
+// speed the bed must be at rest for). Validation and the rules across fields are in
+// scenario_spec.cpp.
+#include "scheduler/pipeline/scenario.h"
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
-#include <tuple>
 #include <string>
+#include <tuple>
 
+#include "engine/core/error.h"
 #include "engine/scenario/paper_params.h"
-#include "scheduler/queue/canonical.h"
 #include "scheduler/pipeline/scenario_config.h"
+#include "scheduler/queue/canonical.h"
 
 namespace gravsweep::pipeline {
 
@@ -68,33 +72,37 @@ SystemConfig base_config(const ContactSettings& ct, const MaterialSet& m, const 
 
 using detail::base_config;
 
-DropStop drop_stop(const StopSettings& stop, double gravity_m_s2, double projectile_diameter_m) {
+DropStop StopSettings::drop_stop(double gravity_m_s2, double projectile_diameter_m) const {
   const double speed_scale_m_s = std::sqrt(gravity_m_s2 * projectile_diameter_m);
   const double time_scale_s = std::sqrt(projectile_diameter_m / gravity_m_s2);
   DropStop out;
-  out.speed_m_s = stop.speed_m_s.value_or(stop.speed_sqrt_gD * speed_scale_m_s);
-  out.hold_time_s = stop.hold_time_s.value_or(stop.hold_time_sqrt_D_g * time_scale_s);
-  out.max_time_s = stop.max_time_s.value_or(stop.max_time_sqrt_D_g * time_scale_s);
+  out.speed_m_s = speed_m_s.value_or(speed_sqrt_gD * speed_scale_m_s);
+  out.hold_time_s = hold_time_s.value_or(hold_time_sqrt_D_g * time_scale_s);
+  out.max_time_s = max_time_s.value_or(max_time_sqrt_D_g * time_scale_s);
   return out;
 }
 
-double drop_min_roll_vel_m_s(const Scenario& s) {
-  const RollingThresholdSettings& r = s.rolling_threshold;
-  return r.min_roll_vel_m_s.value_or(r.min_roll_vel_at_9_81_m_s * std::sqrt(s.gravity_m_s2 / kEarthGravity_m_s2));
+double Scenario::settle_gravity_m_s2() const {
+  return bed.settle_gravity_m_s2 > 0 ? bed.settle_gravity_m_s2 : gravity_m_s2;
 }
 
-double reference_impact_speed_m_s(const Scenario& s) {
-  if (s.projectile.impact_speed_m_s) return *s.projectile.impact_speed_m_s;
-  const double h = std::max(s.projectile.drop_height_m.value_or(0.0), s.grains.diameter_m);
-  return std::sqrt(2 * s.gravity_m_s2 * h);
+double Scenario::drop_min_roll_vel_m_s() const {
+  const RollingThresholdSettings& r = rolling_threshold;
+  return r.min_roll_vel_m_s.value_or(r.min_roll_vel_at_9_81_m_s * std::sqrt(gravity_m_s2 / kEarthGravity_m_s2));
 }
 
-std::uint64_t site_seed(const Scenario& s) {
-  if (s.projectile.site_draw == "seed") return s.projectile.seed;
+double Scenario::reference_impact_speed_m_s() const {
+  if (projectile.impact_speed_m_s) return *projectile.impact_speed_m_s;
+  const double h = std::max(projectile.drop_height_m.value_or(0.0), grains.diameter_m);
+  return std::sqrt(2 * gravity_m_s2 * h);
+}
+
+std::uint64_t Scenario::site_seed() const {
+  if (projectile.site_draw == "seed") return projectile.seed;
   // The sweep point: everything that makes one drop differ from another except the engine's
   // settings (threads, dt, output, stop), so thread counts and outputs never move the site. Its
   // canonical text is that of the scenario as validated (canonical JSON spells 2.0 as 2).
-  const json all = to_json(s);
+  const json all = to_json(*this);
   const json point{{"gravity_m_s2", all.at("gravity_m_s2")},
                    {"projectile", all.at("projectile")},
                    {"grains", all.at("grains")},
@@ -103,18 +111,27 @@ std::uint64_t site_seed(const Scenario& s) {
   return std::stoull(hex.substr(0, 16), nullptr, 16);
 }
 
-namespace {
+SystemConfig Scenario::bed_config() const {
+  SystemConfig c = base_config(contact, bed_materials(), integrator, threads);
+  c.dt_s = bed.dt_s;
+  c.gravity_m_s2 = Vec3(0, 0, -settle_gravity_m_s2());
+  return c;
+}
 
-/// /container, /grains and /bed as the engine's BedSpec (`settle_g`: the gravity the bed settles
-/// at; relaxed at the drop's gravity when they differ).
-BedSpec bed_spec_of(const Scenario& s, double settle_g) {
+SystemConfig Scenario::drop_config() const {
+  SystemConfig c = base_config(contact, materials, integrator, threads);
+  c.dt_s = dt_s;
+  c.gravity_m_s2 = Vec3(0, 0, -gravity_m_s2);
+  c.options.min_roll_vel_m_s = drop_min_roll_vel_m_s();
+  return c;
+}
+
+BedSpec Scenario::bed_spec() const {
   BedSpec b;
-  const BedSettings& bs = s.bed;
-  b.container.diameter_m = s.container.diameter_m;
-  b.grains.diameter_m = s.grains.diameter_m;
-  b.grains.diameter_spread_m = s.grains.diameter_spread_m;
-  b.grains.density_kg_m3 = s.grains.density_kg_m3;
-  b.fill_height_m = s.container.fill_height_m;
+  const BedSettings& bs = bed;
+  b.container.diameter_m = container.diameter_m;
+  b.grains = grains;
+  b.fill_height_m = container.fill_height_m;
   b.overfill_factor = bs.overfill_factor;
   b.packing_fraction = bs.packing_fraction;
   // Optional fields without a default keep the bed keys of the beds made before them.
@@ -129,7 +146,7 @@ BedSpec bed_spec_of(const Scenario& s, double settle_g) {
   b.relax_time_s = bs.relax_time_s;
   b.grain_material = kGrainMaterial;
   b.wall_material = kWallMaterial;
-  if (settle_g != s.gravity_m_s2) b.relax_gravity_m_s2 = Vec3(0, 0, -s.gravity_m_s2);
+  if (settle_gravity_m_s2() != gravity_m_s2) b.relax_gravity_m_s2 = Vec3(0, 0, -gravity_m_s2);
   b.gravity_ramp_s = bs.gravity_ramp_s;
   if (bs.quench) {
     b.quench_interval_s = bs.quench->interval_s;
@@ -145,10 +162,9 @@ BedSpec bed_spec_of(const Scenario& s, double settle_g) {
   return b;
 }
 
-/// /projectile as the engine's ProjectileSpec, its random start drawn from the point's site seed.
-ProjectileSpec projectile_spec_of(const Scenario& s) {
-  const ProjectileSettings& pj = s.projectile;
-  const double grain_diameter_m = s.grains.diameter_m;
+ProjectileSpec Scenario::projectile_spec() const {
+  const ProjectileSettings& pj = projectile;
+  const double grain_diameter_m = grains.diameter_m;
   ProjectileSpec ps;
   ps.diameter_m = pj.diameter_m;
   ps.mass_kg = pj.mass_kg;
@@ -157,7 +173,7 @@ ProjectileSpec projectile_spec_of(const Scenario& s) {
   ps.drop_height_m = pj.drop_height_m;
   ps.start_gap_m = pj.start_gap_m;
   // Random start (paper, Chrono repeats: radial and vertical start within two grain diameters).
-  std::mt19937_64 rng(site_seed(s));
+  std::mt19937_64 rng(site_seed());
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const double lat = pj.lateral_offset_max_grain_diameters * grain_diameter_m;
   const double r = lat * std::sqrt(u(rng));
@@ -168,38 +184,14 @@ ProjectileSpec projectile_spec_of(const Scenario& s) {
   return ps;
 }
 
-}  // namespace
-
-ScenarioParams scenario_params(const Scenario& s) {
-  ScenarioParams out;
-  out.gravity_m_s2 = s.gravity_m_s2;
-  const double settle_g = s.bed.settle_gravity_m_s2 > 0 ? s.bed.settle_gravity_m_s2 : s.gravity_m_s2;
-  out.bed_config = base_config(s.contact, s.bed_materials(), s.integrator, s.threads);
-  out.bed_config.dt_s = s.bed.dt_s;
-  out.bed_config.gravity_m_s2 = Vec3(0, 0, -settle_g);
-  out.drop_config = base_config(s.contact, s.materials, s.integrator, s.threads);
-  out.drop_config.dt_s = s.dt_s;
-  out.drop_config.gravity_m_s2 = Vec3(0, 0, -s.gravity_m_s2);
-  out.drop_config.options.min_roll_vel_m_s = drop_min_roll_vel_m_s(s);
-
-  out.bed = bed_spec_of(s, settle_g);
-  out.projectile = projectile_spec_of(s);
-  out.stop = drop_stop(s.stop, s.gravity_m_s2, s.projectile.diameter_m);
-  if (s.time_step) {  // dt_max_s >= dt_s: check_size_and_steps
-    out.time_step.steps_per_contact = s.time_step->steps_per_contact;
-    out.time_step.dt_max_s = s.time_step->dt_max_s;
-    // Optional and without a default, so that the job ids of existing sweeps stay.
-    out.time_step.speed_bound = speed_bound_named(s.time_step->speed_bound.value_or("fastest_particle"));
-  }
-  out.at_rest.surface_speed_fraction = s.at_rest.surface_speed_fraction;
-  out.at_rest.rms_speed_fraction = s.at_rest.rms_speed_fraction;
-  out.at_rest.impact_speed_m_s = reference_impact_speed_m_s(s);
-  out.at_rest.surface_radius_D = s.at_rest.surface_radius_D.value_or(0.0);  // 0: the whole surface
-  out.sample_rate_hz = s.output.sample_rate_hz;
-  out.snapshot_interval_s = s.output.snapshot_interval_s;
-  return out;
+AdaptiveStep Scenario::drop_time_step() const {
+  AdaptiveStep a;
+  if (!time_step) return a;  // off
+  a.steps_per_contact = time_step->steps_per_contact;
+  a.dt_max_s = time_step->dt_max_s;  // >= dt_s: check_size_and_steps
+  // Optional and without a default, so that the job ids of existing sweeps stay.
+  a.speed_bound = speed_bound_named(time_step->speed_bound.value_or("fastest_particle"));
+  return a;
 }
-
-ScenarioParams scenario_params(const json& validated) { return scenario_params(scenario_of(validated)); }
 
 }  // namespace gravsweep::pipeline
