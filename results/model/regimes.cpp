@@ -141,21 +141,35 @@ double whole_collision_crossover(const std::vector<RegimeTrial>& map, CrossoverS
   return crossing_of(mean);
 }
 
-CrossoverEstimate whole_collision_crossover(const FittedModel& law, const Campaign& c, CrossoverShare share) {
+namespace {
+
+/// f(law) with its standard deviation from the law's covariance: central differences of 1 % of
+/// each constant, delta method.
+template <class F>
+CrossoverEstimate with_sd(const FittedModel& law, F f) {
   CrossoverEstimate e;
-  e.froude = whole_collision_crossover(regime_map(law, c), share);
+  e.froude = f(law);
   const Eigen::Index n = law.coef.size();
   Eigen::VectorXd d(n);
   for (Eigen::Index j = 0; j < n; ++j) {
     FittedModel up = law, down = law;
     const double h = 0.01 * std::max(std::abs(law.coef(j)), 1e-12);
     up.coef(j) += h, down.coef(j) -= h;
-    d(j) =
-        (whole_collision_crossover(regime_map(up, c), share) - whole_collision_crossover(regime_map(down, c), share)) /
-        (2 * h);
+    d(j) = (f(up) - f(down)) / (2 * h);
   }
   if (d.allFinite()) e.sd = std::sqrt(std::max(0.0, d.dot(law.cov * d)));
   return e;
+}
+
+}  // namespace
+
+CrossoverEstimate whole_collision_crossover(const FittedModel& law, const Campaign& c, CrossoverShare share) {
+  return with_sd(law, [&](const FittedModel& m) { return whole_collision_crossover(regime_map(m, c), share); });
+}
+
+CrossoverEstimate surface_crossover(const FittedModel& law, const Trial& at) {
+  const TermContext ctx = detail::context(at);
+  return with_sd(law, [&](const FittedModel& m) { return surface_crossover_froude(m, ctx); });
 }
 
 }  // namespace gravsweep::results

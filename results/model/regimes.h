@@ -61,5 +61,8 @@ struct CrossoverEstimate {
   double froude = NAN, sd = NAN;
 };
 CrossoverEstimate whole_collision_crossover(const FittedModel& law, const Campaign& c, CrossoverShare share);
+/// surface_crossover_froude for a projectile like trial `at`'s, with its standard deviation
+/// propagated the same way.
+CrossoverEstimate surface_crossover(const FittedModel& law, const Trial& at);
 
 }  // namespace gravsweep::results

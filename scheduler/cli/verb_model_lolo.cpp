@@ -108,7 +108,12 @@ std::string crossover_summary(const results::FittedModel& law, const results::Ca
     along.push_back(r.crossover_froude);
   }
   const auto [lo, hi] = std::minmax_element(surface.begin(), surface.end());
-  const std::string law_fr = num(*lo, 3) == num(*hi, 3) ? num(*lo, 3) : num(*lo, 3) + "-" + num(*hi, 3);
+  // One crossover at every level (a law whose terms all follow g at equal Fr): with its SD.
+  std::string law_fr = num(*lo, 3) + "-" + num(*hi, 3);
+  if (num(*lo, 3) == num(*hi, 3)) {
+    const auto e = results::surface_crossover(law, c.trials[map.front().trial].info);
+    law_fr = fmt::format("{} +- {}", num(*lo, 3), num(e.sd, 2));
+  }
   const std::size_t crossing =
       static_cast<std::size_t>(std::count_if(along.begin(), along.end(), [](double x) { return std::isfinite(x); }));
   const auto range = [&](results::CrossoverShare s) {

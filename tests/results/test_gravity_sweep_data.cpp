@@ -122,6 +122,7 @@ TEST(GravitySweep, TheCrossoverOfTheFiveLevelsByThreeDefinitions) {
   }
   const auto table = gravsweep::testing::run_gravsweep(
       "model regimes" + sweep_levels() + " --law scaled_base+gravity_depth_friction", false);
+  EXPECT_NE(table.out.find("Fr 0.693 +- 0.023 by the law at the surface"), std::string::npos) << table.out;
   EXPECT_NE(table.out.find("the drag does half the work at Fr 1.44 +- 0.038 and carries half the impulse at Fr 2.63"),
             std::string::npos)
       << table.out;
