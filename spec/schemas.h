@@ -34,4 +34,8 @@ const char* file_kind(Schema which);
 /// found: what is wrong; expected: "valid JSON"); a sweep spec's as SpecError::sweep_spec.
 nlohmann::json read_spec_file(const std::filesystem::path& path, Schema which);
 
+/// Spec text not read from a file (a test's, a benchmark's), parsed as read_spec_file parses a
+/// file's; `source` names it in errors ("SOURCE:LINE:COLUMN").
+nlohmann::json parse_spec_text(const std::string& text, const std::string& source, Schema which);
+
 }  // namespace gravsweep::spec

@@ -77,7 +77,7 @@ double make_campaign(const std::string& db_path, long n) {
       {"job", "noop"},
       {"base", {{"i", 0}}},
       {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"range", {{"start", 0}, {"stop", n - 1}, {"step", 1}}}}}}};
-  const auto spec = sweep::parse_spec(doc, "<bench-queue>", ".");
+  const auto spec = sweep::load_spec_text(doc.dump(), "<bench-queue>", ".");
   const auto jobs = sweep::expand(spec);
   const auto t0 = Clock::now();
   db::Database db(db_path);

@@ -6,8 +6,11 @@
 // sub-record's fields are the engine's own (/grains: GrainSpec) the record holds the engine struct.
 // The defaults live in one place, the schema (filled by validate_scenario, with the versioned ones
 // of scenario_defaults.h); a field the schema gives no default is a std::optional here, absent
-// when the scenario omits it. Identities (job ids, bed keys, the site seed) stay computed from the
-// JSON text a user wrote, never from this record: a number's spelling (2 or 2.0) is part of them.
+// when the scenario omits it. Identities are computed from canonical JSON, never from the
+// record's fields one by one: job ids from the point as written and bed keys from the validated
+// JSON; the site seed (site_seed()) from to_json(record), which gives the validated JSON back
+// exactly (tested on every committed scenario and sweep point), so its canonical text, and the
+// seed, are the validated scenario's.
 #pragma once
 #include <cstdint>
 #include <map>

@@ -67,12 +67,14 @@ struct SubmitReport {
   bool sweep_new = false;
 };
 
-/// A sweep as the queue stores it (sweeps table, results columns). A parsed spec is one
-/// (sweep::SweepSpec derives from it: parse_spec writes these fields once, and submit stores them).
+/// A sweep as the queue stores it (sweeps table, results columns). A read spec is one
+/// (sweep::SweepSpec derives from it: load_spec writes these fields once, and submit stores them).
 struct SweepRecord {
   std::string name;                 ///< unique within a campaign
   std::string job_kind = "impact";  ///< the sweep kind's name (sweep/sweep_kind.h: "impact", "noop", ...)
-  nlohmann::json source;            ///< the spec as read, stored canonical and hashed
+  /// The spec as written (no defaults filled), its base inlined and canonical, as canonical JSON
+  /// text (canonical.h): the sweeps row stores it as it is, with its SHA-256.
+  std::string spec_json;
   int max_attempts = 3;
   /// Each swept parameter's results column and every value it takes (the column's SQL type fits them all).
   std::vector<std::pair<std::string, std::vector<nlohmann::json>>> columns;

@@ -16,12 +16,13 @@ namespace fs = std::filesystem;
 namespace {
 
 /// The sweep's row (its spec as submitted last; `submits` counts the submissions).
-void upsert_sweep(Database& db, const SweepRecord& spec, const std::string& spec_text, double now) {
+void upsert_sweep(Database& db, const SweepRecord& spec, double now) {
   Statement st(db,
                "INSERT INTO sweeps(sweep_id, job_kind, spec_json, spec_sha256, submitted_at, updated_at) "
                "VALUES(?1, ?2, ?3, ?4, ?5, ?5) ON CONFLICT(sweep_id) DO UPDATE SET spec_json=excluded.spec_json, "
                "spec_sha256=excluded.spec_sha256, updated_at=excluded.updated_at, submits=sweeps.submits+1");
-  st.bind(1, spec.name).bind(2, spec.job_kind).bind(3, spec_text).bind(4, queue::sha256_hex(spec_text)).bind(5, now);
+  st.bind(1, spec.name).bind(2, spec.job_kind).bind(3, spec.spec_json).bind(4, queue::sha256_hex(spec.spec_json));
+  st.bind(5, now);
   st.run();
 }
 
@@ -105,14 +106,13 @@ SubmitReport submit(Database& db, const SweepRecord& spec, const std::vector<Pla
   rep.sweep = spec.name;
   rep.planned = jobs.size();
   const double now = clock_s(db);
-  const std::string spec_text = queue::canonical_json(spec.source);
   Transaction tx(db);
   {
     Statement exists(db, "SELECT 1 FROM sweeps WHERE sweep_id=?");
     exists.bind(1, spec.name);
     rep.sweep_new = !exists.step();
   }
-  upsert_sweep(db, spec, spec_text, now);
+  upsert_sweep(db, spec, now);
   add_param_columns(db, spec);
   add_output_columns(db, jobs);
   insert_jobs(db, spec, jobs, now, rep);

@@ -305,9 +305,13 @@ std::string column_from_pointer(const std::string& pointer) {
   return out;
 }
 
-SweepSpec parse_spec(const json& doc_in, const std::string& file, const std::filesystem::path& base_dir) {
-  json doc = doc_in;  // the schema inserts its defaults (job, max_attempts, priority, repeat start/step)
-  Problems problems;  // the schema's; then the rules across fields add theirs to `ck`
+namespace {
+
+/// The one reader of a spec's parsed text: schema-checked (its defaults filled in `doc`), the
+/// rules across fields, then the record. `doc` is the parse of the text and goes no further.
+SweepSpec spec_of(json doc, const std::string& file, const std::filesystem::path& base_dir) {
+  json written = doc;  // the spec as written, before the schema fills its defaults: the stored text
+  Problems problems;   // the schema's; then the rules across fields add theirs to `ck`
   spec::validator(spec::Schema::sweep).collect(doc, problems.list());
   if (!doc.is_object()) throw SpecError::sweep_spec(file, problems.list());
   SweepSpec spec;
@@ -332,16 +336,22 @@ SweepSpec parse_spec(const json& doc_in, const std::string& file, const std::fil
   problems.append(ck);
   if (!problems.empty()) throw SpecError::sweep_spec(file, problems.list());
   refuse_costly(spec, file);
-  spec.source = doc_in;
-  spec.source["base"] = spec.base;
+  written["base"] = spec.base;
+  spec.spec_json = queue::canonical_json(written);
   for (const auto& g : spec.groups)
     for (const auto& a : g.axes) spec.columns.emplace_back(a.name, a.values);
   spec.file = file;
   return spec;
 }
 
+}  // namespace
+
 SweepSpec load_spec(const std::filesystem::path& path) {
-  return parse_spec(spec::read_spec_file(path, spec::Schema::sweep), path.string(), path.parent_path());
+  return spec_of(spec::read_spec_file(path, spec::Schema::sweep), path.string(), path.parent_path());
+}
+
+SweepSpec load_spec_text(const std::string& text, const std::string& file, const std::filesystem::path& base_dir) {
+  return spec_of(spec::parse_spec_text(text, file, spec::Schema::sweep), file, base_dir);
 }
 
 namespace {

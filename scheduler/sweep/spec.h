@@ -45,9 +45,10 @@ struct AxisGroup {
   [[nodiscard]] std::size_t size() const { return axes.empty() ? 0 : axes.front().values.size(); }
 };
 
-/// A parsed spec is the sweep the queue stores (queue::SweepRecord: name, job kind, the spec as read
-/// with its base inlined, retry budget and a results column per axis, all set by parse_spec), plus
-/// what expansion needs.
+/// A sweep spec as read: the sweep the queue stores (queue::SweepRecord: name, job kind, the spec's
+/// canonical text, retry budget and a results column per axis, all set by load_spec), plus what
+/// expansion needs. The spec's JSON tree lives only while load_spec reads it (the schema check and
+/// the error pointers are made on it); what is kept of it is this record and the stored text.
 struct SweepSpec : queue::SweepRecord {
   nlohmann::json base;            ///< canonical base scenario
   std::vector<AxisGroup> groups;  ///< product over groups, first group slowest; repeats last
@@ -56,11 +57,13 @@ struct SweepSpec : queue::SweepRecord {
   [[nodiscard]] std::size_t points() const;
 };
 
-/// Parses and validates a spec document. `file` names it in errors; `base_dir` resolves a base
-/// given as a file name. Throws SpecError.
-SweepSpec parse_spec(const nlohmann::json& doc, const std::string& file, const std::filesystem::path& base_dir);
-/// Reads the file (JSON parse errors are SpecError with line/column) and parses it.
+/// Reads a spec file into its record: parsed (JSON errors are SpecError with line and column),
+/// schema-checked, defaults filled, the rules across fields checked; a base given as a file name is
+/// read relative to the spec. Throws SpecError listing every problem.
 SweepSpec load_spec(const std::filesystem::path& path);
+/// The same for spec text not read from a file (a test's, a benchmark's): `file` names it in
+/// errors, `base_dir` resolves a base given as a file name.
+SweepSpec load_spec_text(const std::string& text, const std::string& file, const std::filesystem::path& base_dir);
 
 /// A point's scenario as checked by the pipeline that runs it: the scenario its jobs store
 /// (validated, defaults filled, marked so that the worker need not validate it again) and its bed
@@ -100,7 +103,7 @@ ExpansionCost expansion_cost(const SweepSpec& spec);
 /// Physical memory of this machine in bytes (0 when unknown).
 double machine_memory_bytes();
 /// A sweep whose expansion would need more than this share of the machine's memory, or longer
-/// than kMaxExpansionSeconds, is refused at parse_spec with both estimates and the limits.
+/// than kMaxExpansionSeconds, is refused by load_spec with both estimates and the limits.
 inline constexpr double kMaxExpansionMemoryFraction = 0.5;
 inline constexpr double kMaxExpansionSeconds = 1800;
 

@@ -108,9 +108,9 @@ TEST(DefaultsVersion, ALowGravitySweepWithoutAStepGetsNewIdsAndPinningVersionOne
       {"sweep", "slow"},
       {"base", point(0.01)},
       {"axes", {{{"name", "impact_speed_m_s"}, {"pointer", "/projectile/impact_speed_m_s"}, {"values", {0.05, 0.1}}}}}};
-  const auto current = sweep::parse_spec(doc, "slow.json", ".");
+  const auto current = sweep::load_spec_text(doc.dump(), "slow.json", ".");
   doc["base"]["defaults_version"] = 1;
-  const auto pinned = sweep::parse_spec(doc, "slow.json", ".");
+  const auto pinned = sweep::load_spec_text(doc.dump(), "slow.json", ".");
   doc["base"].erase("defaults_version");
   const auto ids_now = drop_ids(current), ids_pinned = drop_ids(pinned);
   ASSERT_EQ(ids_now.size(), 2u);

@@ -20,7 +20,7 @@ TEST(ResultsQuery, FiltersAreBoundAndColumnsChecked) {
                         {"axes",
                          {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {0.5, 1.62, 9.81}}},
                           {{"name", "tag"}, {"pointer", "/tag"}, {"values", {"a", "b'); DROP TABLE jobs; --"}}}}}};
-  const auto spec = sweep::parse_spec(doc, "t", ".");
+  const auto spec = sweep::load_spec_text(doc.dump(), "t", ".");
   submit(db, spec, sweep::expand(spec));
   const auto me = make_identity("t", 1);
   const CampaignPaths paths(dir.path / "c.db");

@@ -75,7 +75,7 @@ queue::WorkerReport submit_and_work(const std::filesystem::path& db_path, const 
   {
     db::Database db(db_path.string());
     queue::ensure_schema(db);
-    const auto spec = sweep::parse_spec(doc, doc["sweep"].get<std::string>() + ".json", ".");
+    const auto spec = sweep::load_spec_text(doc.dump(), doc["sweep"].get<std::string>() + ".json", ".");
     EXPECT_GT(queue::submit(db, spec, sweep::expand(spec)).added, 0u);
     if (after_submit) after_submit(db);
   }
@@ -173,7 +173,7 @@ TEST(JobKind, AnUnknownKindAndABadPointAreClearErrors) {
   try {
     json cubes = square_sweep({1.0});
     cubes["job"] = "cube";
-    (void)sweep::expand(sweep::parse_spec(cubes, "cubes.json", "."));
+    (void)sweep::expand(sweep::load_spec_text(cubes.dump(), "cubes.json", "."));
     FAIL() << "an unknown kind was expanded";
   } catch (const sweep::SpecError& e) {
     const std::string m = e.what();
@@ -184,7 +184,7 @@ TEST(JobKind, AnUnknownKindAndABadPointAreClearErrors) {
   register_square();
   EXPECT_THROW(sweep::register_sweep_kind(square_kind()), std::exception) << "a name registered twice";
   try {
-    (void)sweep::expand(sweep::parse_spec(square_sweep({1.0, -2.0}), "squares.json", "."));
+    (void)sweep::expand(sweep::load_spec_text(square_sweep({1.0, -2.0}).dump(), "squares.json", "."));
     FAIL() << "a negative side was planned";
   } catch (const sweep::SpecError& e) {
     EXPECT_NE(std::string(e.what()).find("/base/side_m"), std::string::npos) << e.what();

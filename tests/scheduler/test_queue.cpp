@@ -32,7 +32,7 @@ sweep::SweepSpec noop_spec(const std::string& name, std::vector<double> gs, int 
               {"base", base},
               {"max_attempts", max_attempts},
               {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", gs}}}}};
-  return sweep::parse_spec(doc, "test", ".");
+  return sweep::load_spec_text(doc.dump(), "test", ".");
 }
 
 sweep::CheckedPoint bed_key(const json& s) { return {s.dump(), {{"g", s["g"]}}, {}}; }
@@ -44,7 +44,7 @@ sweep::SweepSpec impact_spec() {
               {"axes",
                {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {9.81, 1.62}}},
                 {{"name", "speed_m_s"}, {"pointer", "/v"}, {"values", {1.0, 2.0, 3.0}}}}}};
-  return sweep::parse_spec(doc, "test", ".");
+  return sweep::load_spec_text(doc.dump(), "test", ".");
 }
 
 struct QueueTest : ::testing::TestWithParam<test::Store> {
@@ -164,9 +164,9 @@ TEST_P(QueueTest, DropsWaitForTheirBedAndBedsAreClaimedFirst) {
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results WHERE apeak_m_s2=42.0 AND rebound=0"), 1);
   // Extending the sweep after the bed finished: the new drops of that bed are queued at once.
   auto spec = impact_spec();
-  json doc = spec.source;
+  json doc = json::parse(spec.spec_json);  // the spec as written, its base inlined
   doc["axes"][1]["values"].push_back(4.0);
-  auto r2 = submit_spec(sweep::parse_spec(doc, "test", "."), bed_key);
+  auto r2 = submit_spec(sweep::load_spec_text(doc.dump(), "test", "."), bed_key);
   EXPECT_EQ(r2.added, 2u);
   EXPECT_EQ(r2.present, 8u);
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM jobs WHERE kind='drop' AND state='queued'"), 3);
@@ -422,7 +422,7 @@ TEST_P(QueueTest, StatusCountsAHundredThousandJobs) {
               {"job", "noop"},
               {"base", {{"i", 0}}},
               {"axes", {{{"name", "i"}, {"pointer", "/i"}, {"range", {{"start", 0}, {"stop", 99999}, {"step", 1}}}}}}};
-  const auto spec = sweep::parse_spec(doc, "test", ".");
+  const auto spec = sweep::load_spec_text(doc.dump(), "test", ".");
   const auto r = submit_spec(spec);
   ASSERT_EQ(r.added, 100000u);
   for (int i = 0; i < 3; ++i) {

@@ -98,7 +98,7 @@ TEST_P(ResultColumns, TheDeclaredColumnsExistRightAfterSubmit) {
                     {"axes",
                      {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {9.81, 1.62}}},
                       {{"name", "impact_speed_m_s"}, {"pointer", "/v"}, {"values", {1.0, 2.0}}}}}};
-  const auto spec = sweep::parse_spec(doc, "imp.json", ".");
+  const auto spec = sweep::load_spec_text(doc.dump(), "imp.json", ".");
   const sweep::SweepKind impact{
       "impact", "test", {}, sweep::shared_input_planner(by_gravity, sweep::drop_kind(), sweep::bed_kind()), {}};
   submit(db, spec, sweep::expand(spec, impact));
@@ -137,7 +137,7 @@ TEST_P(ResultColumns, AnUndeclaredMetricOrAWrongTypeIsRefusedAndMakesNoColumn) {
                     {"job", "noop"},
                     {"base", {{"g", 1.5}}},
                     {"axes", {{{"name", "gravity_m_s2"}, {"pointer", "/g"}, {"values", {1.0}}}}}};
-  const auto spec = sweep::parse_spec(doc, "n.json", ".");
+  const auto spec = sweep::load_spec_text(doc.dump(), "n.json", ".");
   submit(db, spec, sweep::expand(spec));
   const CampaignPaths paths(store.location, store.files);
   auto c = claim(db, me, paths, 60);

@@ -42,7 +42,7 @@ json tiny_sweep(long speeds, long repeats) {
 }  // namespace
 
 TEST(SweepScale, EngineChecksRunOncePerDistinctSetupNotPerPoint) {
-  const SweepSpec spec = parse_spec(tiny_sweep(50, 40), "big.json", GRAVSWEEP_SOURCE_DIR "/examples");
+  const SweepSpec spec = load_spec_text(tiny_sweep(50, 40).dump(), "big.json", GRAVSWEEP_SOURCE_DIR "/examples");
   const std::size_t before = pipeline::engine_check_runs();
   const auto jobs = expand(spec, impact());
   EXPECT_EQ(jobs.size(), 2001u);  // one bed, 2,000 drops
@@ -63,7 +63,7 @@ TEST(SweepScale, AnEngineProblemIsStillFoundAtEveryPointThatHasIt) {
   json s = tiny_sweep(3, 2);
   // The time step swept to one the contact law refuses: each point with it is reported, counted.
   s["axes"].push_back({{"name", "dt_s"}, {"pointer", "/dt_s"}, {"values", {1e-5, 1e-2}}});
-  const SweepSpec spec = parse_spec(s, "big.json", GRAVSWEEP_SOURCE_DIR "/examples");
+  const SweepSpec spec = load_spec_text(s.dump(), "big.json", GRAVSWEEP_SOURCE_DIR "/examples");
   try {
     expand(spec, impact());
     FAIL() << "a time step the contact law refuses was accepted";
@@ -78,7 +78,7 @@ TEST(SweepScale, TheCapIsAboutCostAndTheMessageSaysWhatItWouldTake) {
   // A million speeds times a million seeds: the old cap counted points; this one says what the
   // expansion would need, in memory and time, and what this machine allows.
   try {
-    parse_spec(tiny_sweep(1000000, 1000000), "huge.json", GRAVSWEEP_SOURCE_DIR "/examples");
+    load_spec_text(tiny_sweep(1000000, 1000000).dump(), "huge.json", GRAVSWEEP_SOURCE_DIR "/examples");
     FAIL() << "a sweep of 1e12 points was accepted";
   } catch (const SpecError& e) {
     const std::string what = e.what();
@@ -89,14 +89,17 @@ TEST(SweepScale, TheCapIsAboutCostAndTheMessageSaysWhatItWouldTake) {
     EXPECT_NE(what.find("split it into several specs"), std::string::npos) << what;
   }
   // What a sweep is estimated to cost grows with its points and its scenario.
-  const auto small = expansion_cost(parse_spec(tiny_sweep(10, 10), "s.json", GRAVSWEEP_SOURCE_DIR "/examples"));
-  const auto large = expansion_cost(parse_spec(tiny_sweep(100, 10), "s.json", GRAVSWEEP_SOURCE_DIR "/examples"));
+  const auto small =
+      expansion_cost(load_spec_text(tiny_sweep(10, 10).dump(), "s.json", GRAVSWEEP_SOURCE_DIR "/examples"));
+  const auto large =
+      expansion_cost(load_spec_text(tiny_sweep(100, 10).dump(), "s.json", GRAVSWEEP_SOURCE_DIR "/examples"));
   EXPECT_EQ(small.points, 100);
   EXPECT_GT(small.memory_bytes, 100 * 500.0);  // a scenario tree is kilobytes
   EXPECT_GT(small.seconds, 0);
   EXPECT_NEAR(large.memory_bytes, 10 * small.memory_bytes, 1e-9 * large.memory_bytes);
   // 4.9 million points passed the old cap of 5 million; a machine needs the stated memory for them.
-  const auto c = expansion_cost(parse_spec(tiny_sweep(4900, 10), "s.json", GRAVSWEEP_SOURCE_DIR "/examples"));
+  const auto c =
+      expansion_cost(load_spec_text(tiny_sweep(4900, 10).dump(), "s.json", GRAVSWEEP_SOURCE_DIR "/examples"));
   EXPECT_GT(c.memory_bytes * 100, 4900 * 1000 * 1000.0);
 }
 

@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
 #include <set>
 
 #include "scheduler/queue/canonical.h"
@@ -19,7 +22,7 @@ namespace {
 const json kBase = json::parse(R"({"g": 9.81, "speed_m_s": 1.0, "fill_m": 0.1, "dt_s": 1e-5, "seed": 1,
                                     "name": "x", "nested": {"k": 2.5}})");
 
-SweepSpec parse(const json& doc) { return parse_spec(doc, "spec.json", "."); }
+SweepSpec parse(const json& doc) { return load_spec_text(doc.dump(), "spec.json", "."); }
 
 /// Bed key of the test: beds differ by gravity, fill and seed (not by speed).
 CheckedPoint test_bed_key(const json& s) {
@@ -75,7 +78,7 @@ TEST(SweepSpec, ProductOfListsRangesZipsAndRepeats) {
   EXPECT_EQ(names, (std::vector<std::string>{"gravity_m_s2", "speed_m_s", "fill_m", "dt_s", "seed"}));
   EXPECT_EQ(spec.columns[1].second, spec.groups[1].axes[0].values);
   EXPECT_EQ(spec.name, "s");
-  EXPECT_EQ(spec.source["base"], spec.base);
+  EXPECT_EQ(json::parse(spec.spec_json)["base"], spec.base);
   const auto jobs = expand(spec, test_impact());
   std::size_t beds = 0, drops = 0;
   std::set<std::string> ids;
@@ -184,6 +187,36 @@ TEST(SweepSpec, BaseFromFileRelativeToSpec) {
   const auto spec = load_spec(dir.path / "s.json");
   EXPECT_EQ(spec.groups[0].axes[0].name, "nested_k");
   EXPECT_EQ(spec.points(), 2u);
+}
+
+TEST(SweepSpec, StoredTextIsTheSpecAsWrittenWithItsBaseInlined) {
+  // The sweeps row stores the spec as written (no defaults filled, a range as a range), its base
+  // inlined and canonical, as canonical text with its SHA-256: the same text earlier builds stored,
+  // worked out here from the file for every committed spec.
+  namespace fs = std::filesystem;
+  std::size_t n = 0;
+  for (const auto& e : fs::recursive_directory_iterator(fs::path(GRAVSWEEP_SOURCE_DIR) / "examples")) {
+    if (e.path().extension() != ".json") continue;
+    std::ifstream in(e.path());
+    json written = json::parse(in, nullptr, false);
+    if (!written.is_object() || !written.contains("sweep")) continue;
+    if (written["base"].is_string()) {
+      std::ifstream base_in(e.path().parent_path() / written["base"].get<std::string>());
+      written["base"] = json::parse(base_in);
+    }
+    written["base"] = gravsweep::queue::canonicalize(written["base"]);
+    EXPECT_EQ(load_spec(e.path()).spec_json, gravsweep::queue::canonical_json(written)) << e.path();
+    ++n;
+  }
+  EXPECT_GE(n, 20u) << "the sweep specs under examples/";
+  // The hash the sweeps row of examples/sweep_tiny.json has held since it was written.
+  EXPECT_EQ(
+      gravsweep::queue::sha256_hex(load_spec(fs::path(GRAVSWEEP_SOURCE_DIR) / "examples/sweep_tiny.json").spec_json),
+      "7f863e1f6511f56ab353a46f7e997707e333588b4bdca5b9e0450080886665c1");
+  // Defaults the schema fills are the record's, not the stored text's.
+  const SweepSpec bare = parse({{"sweep", "s"}, {"base", kBase}, {"axes", {{{"pointer", "/g"}, {"values", {1}}}}}});
+  EXPECT_EQ(bare.max_attempts, 3);
+  EXPECT_FALSE(json::parse(bare.spec_json).contains("max_attempts"));
 }
 
 TEST(SweepSpec, ErrorIsTheOneSpecErrorAConfigErrorWithTheSweepMessage) {

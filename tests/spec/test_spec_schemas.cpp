@@ -35,7 +35,7 @@ bool has(const std::vector<spec::SpecProblem>& ps, const std::string& pointer, c
 
 std::vector<spec::SpecProblem> sweep_problems(const json& doc) {
   try {
-    sweep::parse_spec(doc, "spec.json", ".");
+    sweep::load_spec_text(doc.dump(), "spec.json", ".");
   } catch (const spec::SpecError& e) {
     return e.problems();
   }
