@@ -181,24 +181,33 @@ results::Table projectile_table(const results::Campaign& c, const std::vector<re
   return t;
 }
 
-/// Each model's held-out predictions by gravity level and Froude number: the signed mean errors
-/// (predicted - measured, % of measured) a median over every trial hides, each cell flagged when
-/// beyond a target (zstop 10 %, tstop 15 %, as leave-one-level-out's).
-results::Table froude_table(const results::Campaign& c, const std::vector<results::ComparedModel>& cm) {
+/// Each model's held-out predictions by gravity level and Froude number (results::froude_cells):
+/// the signed mean errors (predicted - measured, % of measured) a median over every trial hides,
+/// each cell flagged when beyond a target (zstop 10 %, tstop 15 %, as leave-one-level-out's).
+struct ModelCells {
+  std::string model;
+  std::vector<results::FroudeCell> cells;
+};
+std::vector<ModelCells> model_cells(const results::Campaign& c, const std::vector<results::ComparedModel>& cm) {
+  std::vector<ModelCells> out;
+  for (const auto& m : cm) out.push_back({m.name, results::froude_cells(c, m.held_out.pred)});
+  return out;
+}
+
+results::Table froude_table(const std::vector<ModelCells>& by_model) {
   results::Table t({"model", "gravity_m_s2", "impact_fr", "drops", "zstop_mean_err_pct", "zstop_min_err_pct",
                     "zstop_max_err_pct", "tstop_mean_err_pct", "beyond_target"});
-  for (const auto& m : cm)
-    for (const auto& [g, f] : results::froude_cells(c, m.held_out.pred))
-      t.add({m.name, num(g), num(f.froude, 3), std::to_string(f.drops), num(f.zstop_mean_err_pct, 3),
+  for (const auto& [model, cells] : by_model)
+    for (const auto& [g, f] : cells)
+      t.add({model, num(g), num(f.froude, 3), std::to_string(f.drops), num(f.zstop_mean_err_pct, 3),
              num(f.zstop_min_err_pct, 3), num(f.zstop_max_err_pct, 3), num(f.tstop_mean_err_pct, 3),
              f.misses ? "yes" : "no"});
   return t;
 }
 
 /// "model: 7 of 25 cells beyond a target (worst zstop +23.1 % at 0.1 m/s2, Fr 2)" per model.
-void print_froude_verdicts(const results::Campaign& c, const std::vector<results::ComparedModel>& cm) {
-  for (const auto& m : cm) {
-    const auto cells = results::froude_cells(c, m.held_out.pred);
+void print_froude_verdicts(const std::vector<ModelCells>& by_model) {
+  for (const auto& [model, cells] : by_model) {
     int beyond = 0;
     const results::FroudeCell* worst = nullptr;
     for (const auto& cell : cells) {
@@ -211,7 +220,7 @@ void print_froude_verdicts(const results::Campaign& c, const std::vector<results
     fmt::print(
         "{}: {} of {} cells beyond a target (zstop {:g} %, tstop {:g} %); worst zstop {:+.1f} % at {:g} m/s2, "
         "Fr {:.2g}\n",
-        m.name, beyond, cells.size(), results::kLevelOutZstopTargetPct, results::kLevelOutTstopTargetPct,
+        model, beyond, cells.size(), results::kLevelOutZstopTargetPct, results::kLevelOutTstopTargetPct,
         worst->errors.zstop_mean_err_pct, worst->g_m_s2, worst->errors.froude);
   }
 }
@@ -243,8 +252,9 @@ void print_errors(const FitOptions& o, const results::Campaign& c, const std::ve
       fmt::print(
           "\nBy gravity level and Froude number (held out; signed mean error, predicted - measured, % of "
           "measured):\n");
-    froude_table(c, cm).print(o.in.format);
-    if (table) print_froude_verdicts(c, cm);
+    const auto by_model = model_cells(c, cm);
+    froude_table(by_model).print(o.in.format);
+    if (table) print_froude_verdicts(by_model);
   }
   if (table) explain_rises(cm);
 }
@@ -259,7 +269,7 @@ void print_fit_json(const results::ModelSpec& spec, const results::FittedModel& 
                         {"parameters", params_table(fm).json_value()},
                         {"held_out_errors", error_table(cm).json_value()}};
   if (by_projectile) out["projectiles_held_out"] = projectile_table(c, cm).json_value();
-  out["by_froude"] = froude_table(c, cm).json_value();
+  out["by_froude"] = froude_table(model_cells(c, cm)).json_value();
   std::fputs((out.dump(2) + "\n").c_str(), stdout);
 }
 

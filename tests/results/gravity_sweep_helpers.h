@@ -17,23 +17,28 @@
 
 namespace gravsweep::testing::sweep {
 
-/// The rows of `gravsweep <args> --format csv`, each by column name.
-inline std::vector<std::map<std::string, std::string>> csv_rows(const std::string& args, std::string& out) {
-  const auto r = gravsweep::testing::run_gravsweep(args + " --format csv", false);
-  out = r.out;
-  std::vector<std::map<std::string, std::string>> rows;
-  if (r.code != 0) return rows;
-  std::istringstream in(r.out);
+/// The rows of a CSV table with a header line, each by column name.
+inline std::vector<std::map<std::string, std::string>> csv_table_rows(std::istream& in) {
   gravsweep::results::CsvReader csv(in);
   std::vector<std::string> header, cells;
+  std::vector<std::map<std::string, std::string>> rows;
   int line = 0;
-  csv.next(header, line);
+  if (!csv.next(header, line)) return rows;
   while (csv.next(cells, line)) {
     std::map<std::string, std::string> row;
     for (std::size_t i = 0; i < header.size() && i < cells.size(); ++i) row[header[i]] = cells[i];
     rows.push_back(row);
   }
   return rows;
+}
+
+/// The rows of `gravsweep <args> --format csv`, each by column name.
+inline std::vector<std::map<std::string, std::string>> csv_rows(const std::string& args, std::string& out) {
+  const auto r = gravsweep::testing::run_gravsweep(args + " --format csv", false);
+  out = r.out;
+  if (r.code != 0) return {};
+  std::istringstream in(r.out);
+  return csv_table_rows(in);
 }
 
 /// One committed folder of the gravity sweep as a quoted command-line argument, with a space before.

@@ -240,16 +240,8 @@ TEST(GravitySweep, TheResultsTableIsTheProcessingOfEveryCommittedDrop) {
   const auto dir = std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "data" / "gravity_sweep";
   std::ifstream in(dir / "results.csv");
   ASSERT_TRUE(in) << "no " << (dir / "results.csv");
-  CsvReader csv(in);
-  std::vector<std::string> header, cells;
-  int line = 0;
-  ASSERT_TRUE(csv.next(header, line));
   std::map<std::string, std::map<std::string, std::string>> table;  // by job id
-  while (csv.next(cells, line)) {
-    std::map<std::string, std::string> row;
-    for (std::size_t i = 0; i < header.size() && i < cells.size(); ++i) row[header[i]] = cells[i];
-    table[row.at("job_id")] = row;
-  }
+  for (auto& row : csv_table_rows(in)) table[row.at("job_id")] = std::move(row);
   std::size_t trials = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (!std::filesystem::exists(entry.path() / "trials.csv")) continue;

@@ -11,21 +11,15 @@
 #include <string>
 #include <vector>
 
-#include "results/io/csv.h"
+#include "gravity_sweep_helpers.h"
 
 TEST(Reproduction, TheCommittedAnglesOfReposeFollowTableTwo) {
   const auto path = std::filesystem::path(GRAVSWEEP_SOURCE_DIR) / "data" / "reproduction" / "results_table2_repose.csv";
   std::ifstream in(path);
   ASSERT_TRUE(in) << path;
-  gravsweep::results::CsvReader csv(in);
-  std::vector<std::string> header, cells;
-  int line = 0;
-  ASSERT_TRUE(csv.next(header, line));
   std::map<double, double> by_beta;  // mu_r 1.05: beta -> angle (deg)
   int rows = 0;
-  while (csv.next(cells, line)) {
-    std::map<std::string, std::string> r;
-    for (std::size_t i = 0; i < header.size() && i < cells.size(); ++i) r[header[i]] = cells[i];
+  for (const auto& r : gravsweep::testing::sweep::csv_table_rows(in)) {
     ++rows;
     const double ours = std::stod(r.at("repose_angle_deg")), paper = std::stod(r.at("paper_table2_deg"));
     EXPECT_LT(std::abs(ours - paper), 2.0) << "mu_r " << r.at("mu_rolling") << ", beta " << r.at("shape_beta");
