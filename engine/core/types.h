@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <vector>
 
 /// Contact kernels are inlined into the one pair loop (engine/system/force_loop.h).
 /// GRAVSWEEP_INLINE_LAMBDA goes after a lambda's parameter list: `[&]() GRAVSWEEP_INLINE_LAMBDA {`.
@@ -34,6 +35,11 @@ inline constexpr double kTinyLength_m = 1e-12;
 /// Mass of a solid sphere, rho pi d^3 / 6.
 inline double sphere_mass_kg(double density_kg_m3, double diameter_m) {
   return density_kg_m3 * kPi / 6 * diameter_m * diameter_m * diameter_m;
+}
+
+/// Appends a Vec3 as the three values of one row of a row-major (N, 3) column held flat.
+inline void push_xyz(std::vector<double>& column, const Vec3& v) {
+  for (int k = 0; k < 3; ++k) column.push_back(v[k]);
 }
 
 /// Index of a particle inside Particles (structure of arrays).

@@ -10,6 +10,27 @@
 
 namespace gravsweep {
 
+bool DropSamples::consistent() const {
+  const std::size_t n = size();
+  return depth_m.size() == n && velocity_down_m_s.size() == n && accel_up_m_s2.size() == n &&
+         omega_rad_s.size() == 3 * n && position_m.size() == 3 * n && contacts.size() == n &&
+         grain_kinetic_energy_J.size() == n;
+}
+
+void DropSamples::reserve(std::size_t n) {
+  for (auto* c : {&t_s, &depth_m, &velocity_down_m_s, &accel_up_m_s2, &grain_kinetic_energy_J}) c->reserve(n);
+  omega_rad_s.reserve(3 * n);
+  position_m.reserve(3 * n);
+  contacts.reserve(n);
+}
+
+void DropSamples::resize(std::size_t n) {
+  for (auto* c : {&t_s, &depth_m, &velocity_down_m_s, &accel_up_m_s2, &grain_kinetic_energy_J}) c->resize(n);
+  omega_rad_s.resize(3 * n);
+  position_m.resize(3 * n);
+  contacts.resize(n);
+}
+
 double grain_kinetic_energy_J(const System& sys) {
   const auto& p = sys.particles;
   double e = 0;
@@ -169,10 +190,11 @@ class DropRun {
     const Particles& p = saved.system.particles;
     const ParticleIndex ip = saved.loop.result.projectile;
     if (ip >= p.size() || ip >= p.size_class.size() || p.size_class[ip] != SizeClass::projectile ||
-        saved.loop.result.samples.empty() || saved.loop.samples_done + 1 != std::ssize(saved.loop.result.samples))
+        saved.loop.result.samples.empty() || !saved.loop.result.samples.consistent() ||
+        saved.loop.samples_done + 1 != static_cast<long long>(saved.loop.result.samples.size()))
       throw std::invalid_argument(fmt::format(
           "drop state cannot be continued: particle {} of {} is not the projectile, or its {} samples are not "
-          "the {} taken",
+          "the {} taken in every column",
           ip, p.size(), saved.loop.result.samples.size(), saved.loop.samples_done + 1));
     sys_.restore_state(saved.system);
     st_ = saved.loop;
@@ -193,20 +215,19 @@ class DropRun {
   double sample_dt_ = 0;
   DropLoopState st_;
 
-  DropSample sample(double accel_up) {
+  /// Appends the projectile's state now as one sample to every column of the record.
+  void sample(double accel_up) {
     const auto& p = sys_.particles;
     const ParticleIndex ip = st_.result.projectile;
-    DropSample s;
-    s.t_s = sys_.time_s() - st_.release_time_s;
-    s.position_m = p.position_m[ip];
-    s.depth_m = st_.result.surface_height_m - (p.position_m[ip].z() - 0.5 * ps_.diameter_m);
-    s.velocity_down_m_s = -p.velocity_m_s[ip].z();
-    s.accel_up_m_s2 = accel_up;
-    s.omega_rad_s = p.omega_rad_s[ip];
-    s.contacts = sys_.contact_count(ip);
-    s.grain_kinetic_energy_J = grain_kinetic_energy_J(sys_);
-    st_.result.samples.push_back(s);
-    return s;
+    DropSamples& c = st_.result.samples;
+    c.t_s.push_back(sys_.time_s() - st_.release_time_s);
+    c.depth_m.push_back(st_.result.surface_height_m - (p.position_m[ip].z() - 0.5 * ps_.diameter_m));
+    c.velocity_down_m_s.push_back(-p.velocity_m_s[ip].z());
+    c.accel_up_m_s2.push_back(accel_up);
+    push_xyz(c.omega_rad_s, p.omega_rad_s[ip]);
+    push_xyz(c.position_m, p.position_m[ip]);
+    c.contacts.push_back(sys_.contact_count(ip));
+    c.grain_kinetic_energy_J.push_back(grain_kinetic_energy_J(sys_));
   }
 
   void snapshot(long long k) {
@@ -233,16 +254,17 @@ bool DropRun::next_sample(long long k) {
   sys_.advance(steps_per_sample_);
   res.grains_spilled += remove_spilled_grains(sys_, res.projectile);
   const double vz_after = sys_.particles.velocity_m_s[res.projectile].z();
-  const DropSample s = sample((vz_after - vz_before) / sample_dt_);
+  sample((vz_after - vz_before) / sample_dt_);
+  const double t_s = res.samples.t_s.back();
   st_.samples_done = k;
   if (snapshot_every_ > 0 && k % snapshot_every_ == 0) snapshot(k);
-  if (s.contacts > 0 && !res.first_contact_s) res.first_contact_s = s.t_s;
+  if (res.samples.contacts.back() > 0 && !res.first_contact_s) res.first_contact_s = t_s;
   if (res.first_contact_s) {
     const double speed = sys_.particles.velocity_m_s[res.projectile].norm();
     st_.below_stop = speed < stop_.speed_m_s ? st_.below_stop + 1 : 0;
     if (st_.below_stop >= hold_samples_) {
       res.stopped = true;
-      res.rest_s = s.t_s - static_cast<double>(hold_samples_ - 1) * sample_dt_;
+      res.rest_s = t_s - static_cast<double>(hold_samples_ - 1) * sample_dt_;
       return true;
     }
   }
@@ -250,9 +272,10 @@ bool DropRun::next_sample(long long k) {
   if (checkpoints_.save && checkpoints_.due && checkpoints_.due()) checkpoints_.save(sys_, st_);
   if (progress_ && k % 50 == 0)
     progress_(static_cast<double>(k) / static_cast<double>(max_samples_),
-              fmt::format("t={:.4f}s of {:.4g}s cap step={} dt={:.3g}s depth={:.2f}cm v={:.3f}m/s contacts={}", s.t_s,
+              fmt::format("t={:.4f}s of {:.4g}s cap step={} dt={:.3g}s depth={:.2f}cm v={:.3f}m/s contacts={}", t_s,
                           static_cast<double>(max_samples_) * sample_dt_, sys_.step_count(), sys_.config().dt_s,
-                          100 * s.depth_m, s.velocity_down_m_s, s.contacts));
+                          100 * res.samples.depth_m.back(), res.samples.velocity_down_m_s.back(),
+                          res.samples.contacts.back()));
   return false;
 }
 

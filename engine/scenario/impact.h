@@ -4,6 +4,7 @@
 // after contact (paper: 0.1 cm/s). The projectile is recorded at a fixed sample rate (paper,
 // Chrono: 10 kHz). Engine frame: z up, bottom disk at z = 0; the trace uses the paper's frame.
 #pragma once
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -39,22 +40,34 @@ struct DropStop {
   double max_time_s = 1.0;     ///< cap on simulated time after release
 };
 
-/// One sample of the projectile (paper frame: z positive down from the bed surface, velocity
-/// positive down, acceleration positive up so that free fall reads -g).
-struct DropSample {
-  double t_s = 0;      ///< time since release
-  double depth_m = 0;  ///< depth of the projectile's lowest point below the mean surface
-  double velocity_down_m_s = 0;
-  double accel_up_m_s2 = 0;           ///< mean over the preceding sample interval (dv/dt), so the
-                                      ///< 10 kHz record is not aliased by the us-scale contact force
-  Vec3 omega_rad_s = Vec3::Zero();    ///< projectile's angular velocity (engine frame)
-  Vec3 position_m = Vec3::Zero();     ///< projectile centre (engine frame)
-  int contacts = 0;                   ///< particles and walls touching the projectile
-  double grain_kinetic_energy_J = 0;  ///< translational + rotational kinetic energy of the grains
+/// The projectile's record during a drop, a column per quantity and a value per output sample
+/// (paper frame: z positive down from the bed surface, velocity positive down, acceleration
+/// positive up so that free fall reads -g). DropRun::sample appends each sample here once, and
+/// the trace record (results::TraceData) takes the columns over by move: the values the engine
+/// writes are the trace's own, never copied into another form.
+struct DropSamples {
+  std::vector<double> t_s;      ///< time since release
+  std::vector<double> depth_m;  ///< depth of the projectile's lowest point below the mean surface
+  std::vector<double> velocity_down_m_s;
+  std::vector<double> accel_up_m_s2;           ///< mean over the preceding sample interval (dv/dt), so the
+                                               ///< 10 kHz record is not aliased by the us-scale contact force
+  std::vector<double> omega_rad_s;             ///< T x 3: projectile's angular velocity (engine frame)
+  std::vector<double> position_m;              ///< T x 3: projectile centre (engine frame)
+  std::vector<std::int32_t> contacts;          ///< particles and walls touching the projectile
+  std::vector<double> grain_kinetic_energy_J;  ///< translational + rotational kinetic energy of the grains
+
+  [[nodiscard]] std::size_t size() const { return t_s.size(); }
+  [[nodiscard]] bool empty() const { return t_s.empty(); }
+  /// Every column holds size() samples (the (T, 3) ones 3 size() values).
+  [[nodiscard]] bool consistent() const;
+  /// Room for n samples in every column.
+  void reserve(std::size_t n);
+  /// Every column cut or extended (with zeros) to n samples.
+  void resize(std::size_t n);
 };
 
 struct DropResult {
-  std::vector<DropSample> samples;
+  DropSamples samples;
   double surface_height_m = 0;      ///< engine z of the mean bed surface (depth 0)
   double release_height_m = 0;      ///< engine z of the projectile's bottom at release
   double release_speed_m_s = 0;     ///< downward speed at release

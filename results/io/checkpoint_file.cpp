@@ -55,30 +55,6 @@ struct Rec<FrameHistory> {
   static void hash(ContentHash& h, const std::vector<FrameHistory>& v) { h.bytes(v.data(), v.size() * sizeof(v[0])); }
 };
 
-template <>
-struct Rec<DropSample> {
-  static h5::Handle type() {
-    const DropSample r;
-    h5::Handle t(H5Tcreate(H5T_COMPOUND, sizeof r), &H5Tclose);
-    H5Tinsert(t, "t_s", offset_in(r, r.t_s), H5T_NATIVE_DOUBLE);
-    H5Tinsert(t, "depth_m", offset_in(r, r.depth_m), H5T_NATIVE_DOUBLE);
-    H5Tinsert(t, "velocity_down_m_s", offset_in(r, r.velocity_down_m_s), H5T_NATIVE_DOUBLE);
-    H5Tinsert(t, "accel_up_m_s2", offset_in(r, r.accel_up_m_s2), H5T_NATIVE_DOUBLE);
-    H5Tinsert(t, "omega_rad_s", offset_in(r, r.omega_rad_s), vec3_type());
-    H5Tinsert(t, "position_m", offset_in(r, r.position_m), vec3_type());
-    H5Tinsert(t, "contacts", offset_in(r, r.contacts), H5T_NATIVE_INT);
-    H5Tinsert(t, "grain_kinetic_energy_J", offset_in(r, r.grain_kinetic_energy_J), H5T_NATIVE_DOUBLE);
-    return t;
-  }
-  static constexpr hsize_t width = 1;
-  static void hash(ContentHash& h, const std::vector<DropSample>& v) {
-    for (const DropSample& s : v) {
-      h.value(s.t_s), h.value(s.depth_m), h.value(s.velocity_down_m_s), h.value(s.accel_up_m_s2);
-      h.value(s.omega_rad_s), h.value(s.position_m), h.value(s.contacts), h.value(s.grain_kinetic_energy_J);
-    }
-  }
-};
-
 }  // namespace h5visit
 
 namespace {
@@ -148,6 +124,24 @@ void visit_system(Io& io, hid_t root, SystemState& s) {
   visit_lists(io, root, s);
 }
 
+/// The trace so far under /drop/samples: DropSamples' columns as they are in memory.
+template <class Io>
+void visit_samples(Io& io, hid_t drop, DropSamples& s) {
+  h5::Handle g = io.group(drop, "samples");
+  io.array(g, "t_s", s.t_s, "s", "time since release");
+  io.array(g, "depth_m", s.depth_m, "m", "depth of the projectile's lowest point below the surface, paper frame");
+  io.array(g, "velocity_down_m_s", s.velocity_down_m_s, "m/s", "positive down");
+  io.array(g, "accel_up_m_s2", s.accel_up_m_s2, "m/s2", "positive up, mean over the preceding sample interval");
+  io.rows(g, "omega_rad_s", s.omega_rad_s, 3, "rad/s", "projectile angular velocity, engine frame");
+  io.rows(g, "position_m", s.position_m, 3, "m", "projectile centre, engine frame");
+  io.array(g, "contacts", s.contacts, "1", "grains and walls touching the projectile");
+  io.array(g, "grain_kinetic_energy_J", s.grain_kinetic_energy_J, "J", "kinetic energy of the grains");
+  if constexpr (Io::kReading) {
+    if (!s.consistent())
+      throw CheckpointError(fmt::format("{}: the sample columns differ in length ({} times)", h5::where(g), s.size()));
+  }
+}
+
 template <class Io>
 void visit_loop(Io& io, hid_t root, DropLoopState& st) {
   h5::Handle g = io.group(root, "drop");
@@ -167,7 +161,7 @@ void visit_loop(Io& io, hid_t root, DropLoopState& st) {
   io.attr(g, "steps", r.steps);
   number(io, g, "projectile", r.projectile);
   number(io, g, "grains_spilled", r.grains_spilled);
-  io.array(g, "samples", r.samples, "", "the trace so far, one record per sample (DropSample, paper frame)");
+  visit_samples(io, g, r.samples);
 }
 
 template <class Io>

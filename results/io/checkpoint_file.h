@@ -13,8 +13,8 @@
 //   /neighbor_list/...     offset, neighbor, work_offset (uint32), history, frame_history
 //                          (compound records), position_at_build_m (N, 3)
 //   /walls/...             candidates (uint32 codes particle * walls + wall), history, frame_history
-//   /drop                  (kind drop) attrs: the loop's counters and release facts; dataset
-//                          samples (compound, one record per trace sample so far)
+//   /drop                  (kind drop) attrs: the loop's counters and release facts
+//   /drop/samples/<column> (kind drop) the trace so far, DropSamples' columns, (T) or (T, 3)
 //   /bed                   (kind bed) attrs: the stage, its cursor, the wall height and the
 //                          report of the finished stages
 //
@@ -35,7 +35,7 @@
 namespace gravsweep::results {
 
 inline constexpr const char* kCheckpointFormat = "gravsweep-drop-checkpoint";
-inline constexpr long long kCheckpointFormatVersion = 2;
+inline constexpr long long kCheckpointFormatVersion = 3;
 
 struct CheckpointData {
   /// The System's state and the loop's: a drop's, or a bed preparation's.

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include "engine/scenario/bed.h"
 #include "engine/scenario/paper_params.h"
@@ -14,18 +15,13 @@ namespace gravsweep::results {
 
 namespace {
 
-/// Appends a Vec3 as three values of a row-major (N, 3) column.
-void push3(std::vector<double>& out, const Vec3& v) {
-  for (int k = 0; k < 3; ++k) out.push_back(v[k]);
-}
-
 /// The state of particles [begin, end) as a snapshot's point set.
 void gather_points(const Particles& p, const std::vector<int>& contacts, std::size_t begin, std::size_t end,
                    SnapshotPoints& out) {
   for (std::size_t i = begin; i < end; ++i) {
-    push3(out.position_m, p.position_m[i]);
-    push3(out.velocity_m_s, p.velocity_m_s[i]);
-    push3(out.omega_rad_s, p.omega_rad_s[i]);
+    push_xyz(out.position_m, p.position_m[i]);
+    push_xyz(out.velocity_m_s, p.velocity_m_s[i]);
+    push_xyz(out.omega_rad_s, p.omega_rad_s[i]);
     out.contacts.push_back(contacts[i]);
   }
 }
@@ -51,19 +47,19 @@ BedFacts load_bed(System& sys, const std::filesystem::path& bed) {
   return f;
 }
 
-TraceData trace_columns_of(const DropResult& dr, double nominal_rate_hz) {
+TraceData take_trace_columns(DropResult& dr, double nominal_rate_hz) {
+  DropSamples& s = dr.samples;
+  const double sample_dt = s.size() > 1 ? s.t_s[1] - s.t_s[0] : 1.0 / nominal_rate_hz;
   TraceData td;
-  for (const auto& smp : dr.samples) {
-    td.t_s.push_back(smp.t_s);
-    td.depth_m.push_back(smp.depth_m);
-    td.velocity_down_m_s.push_back(smp.velocity_down_m_s);
-    td.accel_up_m_s2.push_back(smp.accel_up_m_s2);
-    push3(td.omega_rad_s, smp.omega_rad_s);
-    push3(td.position_m, smp.position_m);
-    td.contacts.push_back(smp.contacts);
-    td.grain_kinetic_energy_J.push_back(smp.grain_kinetic_energy_J);
-  }
-  const double sample_dt = dr.samples.size() > 1 ? dr.samples[1].t_s - dr.samples[0].t_s : 1.0 / nominal_rate_hz;
+  td.t_s = std::move(s.t_s);
+  td.depth_m = std::move(s.depth_m);
+  td.velocity_down_m_s = std::move(s.velocity_down_m_s);
+  td.accel_up_m_s2 = std::move(s.accel_up_m_s2);
+  td.omega_rad_s = std::move(s.omega_rad_s);
+  td.position_m = std::move(s.position_m);
+  td.contacts = std::move(s.contacts);
+  td.grain_kinetic_energy_J = std::move(s.grain_kinetic_energy_J);
+  s = DropSamples{};  // taken: empty, not a moved-from state
   td.sample_rate_hz = 1.0 / sample_dt;
   td.release_height_m = dr.release_height_m;
   td.release_speed_m_s = dr.release_speed_m_s;

@@ -26,9 +26,11 @@ BedFacts bed_facts_of(const System& sys);
 /// history; read_bed's checks and errors) and its container walls. Returns the bed's facts.
 BedFacts load_bed(System& sys, const std::filesystem::path& bed);
 
-/// The drop's samples as trace columns, with its release facts and stop flag; the sample rate is
-/// the samples' own (`nominal_rate_hz` for a trace of one sample).
-TraceData trace_columns_of(const DropResult& dr, double nominal_rate_hz);
+/// The drop's record as a trace: the columns of its samples taken over as they are (moved, so the
+/// values the engine wrote are the trace's own and none is copied; `dr.samples` is left empty),
+/// with its release facts and stop flag; the sample rate is the samples' own (`nominal_rate_hz`
+/// for a trace of one sample).
+TraceData take_trace_columns(DropResult& dr, double nominal_rate_hz);
 
 /// One grain snapshot: every particle before `projectile` as a grain (the bed's order), the
 /// projectile as its own point set.

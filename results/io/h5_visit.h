@@ -71,10 +71,12 @@ inline h5::Handle vec3_type() {
 template <class T>
 struct Rec {
   static_assert(std::is_same_v<T, double> || std::is_same_v<T, Vec3> || std::is_same_v<T, std::uint32_t> ||
-                std::is_same_v<T, std::uint8_t> || std::is_same_v<T, SizeClass>);
+                std::is_same_v<T, std::int32_t> || std::is_same_v<T, std::uint8_t> || std::is_same_v<T, SizeClass>);
   static h5::Handle type() {
     if constexpr (std::is_same_v<T, std::uint32_t>)
       return copy_type(H5T_NATIVE_UINT32);
+    else if constexpr (std::is_same_v<T, std::int32_t>)
+      return copy_type(H5T_NATIVE_INT32);
     else if constexpr (std::is_same_v<T, std::uint8_t> || std::is_same_v<T, SizeClass>)
       return copy_type(H5T_NATIVE_UINT8);
     else

@@ -49,7 +49,7 @@ struct TraceData : Trace {
   [[nodiscard]] std::size_t size() const { return t_s.size(); }
   /// Sets contact_start_s from `contacts`: the engine's first contact is the last sample before the
   /// first one that counts a contact (none when no sample does). Not stored: read_trace and
-  /// trace_columns_of call it.
+  /// take_trace_columns call it.
   void mark_contact_start();
 };
 

@@ -266,11 +266,11 @@ DropSnapshots snapshot_hooks(const Scenario& s, const std::vector<double>& grain
   return ds;
 }
 
-/// The drop's samples as trace columns, with the facts a reader of the trace needs (scenario, bed
-/// key and file, code version).
-results::TraceData trace_of(const DropResult& dr, const Scenario& s, const json& validated,
-                            const results::BedFacts& bed, const std::filesystem::path& bed_in) {
-  results::TraceData td = results::trace_columns_of(dr, s.output.sample_rate_hz);
+/// The drop's record as a trace (its samples' columns taken over, `dr.samples` left empty), with
+/// the facts a reader of the trace needs (scenario, bed key and file, code version).
+results::TraceData trace_of(DropResult& dr, const Scenario& s, const json& validated, const results::BedFacts& bed,
+                            const std::filesystem::path& bed_in) {
+  results::TraceData td = results::take_trace_columns(dr, s.output.sample_rate_hz);
   td.dt_s = s.dt_s;
   td.gravity_m_s2 = s.gravity_m_s2;
   td.surface_height_m = bed.surface_height_m;
@@ -332,7 +332,7 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
         },
         ds, ckpt.drop_hooks(), s.drop_time_step());
   };
-  const DropResult dr = resume_or_start(ckpt, ckpt.resume_drop() != nullptr, drop);
+  DropResult dr = resume_or_start(ckpt, ckpt.resume_drop() != nullptr, drop);
   const double wall_s = seconds_since(t0) + ckpt.prior_wall_time_s();
 
   results::TraceData td = trace_of(dr, s, validated, bed, bed_in);

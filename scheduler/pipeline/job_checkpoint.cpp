@@ -134,7 +134,7 @@ Hooks JobCheckpointer::hooks(const State* resume, PositionOf position_s) {
 DropCheckpoints JobCheckpointer::drop_hooks() {
   // A drop's checkpoint is at its last sample (0 before the first).
   return hooks<DropCheckpoints>(resume_drop(), [](const System&, const DropLoopState& loop) {
-    return loop.result.samples.empty() ? 0.0 : loop.result.samples.back().t_s;
+    return loop.result.samples.empty() ? 0.0 : loop.result.samples.t_s.back();
   });
 }
 

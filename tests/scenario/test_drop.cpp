@@ -8,6 +8,7 @@
 #include "engine/scenario/bed.h"
 #include "engine/scenario/impact.h"
 #include "engine/scenario/paper_params.h"
+#include "results/io/engine_records.h"
 
 namespace gravsweep {
 namespace {
@@ -29,12 +30,12 @@ struct EmptyContainer {
 
 /// Velocity (down) when the trace's depth crosses zero, by linear interpolation.
 double speed_at_surface(const DropResult& r) {
+  const auto& z = r.samples.depth_m;
+  const auto& v = r.samples.velocity_down_m_s;
   for (std::size_t i = 1; i < r.samples.size(); ++i) {
-    const auto& a = r.samples[i - 1];
-    const auto& b = r.samples[i];
-    if (a.depth_m < 0 && b.depth_m >= 0) {
-      const double f = -a.depth_m / (b.depth_m - a.depth_m);
-      return a.velocity_down_m_s + f * (b.velocity_down_m_s - a.velocity_down_m_s);
+    if (z[i - 1] < 0 && z[i] >= 0) {
+      const double f = -z[i - 1] / (z[i] - z[i - 1]);
+      return v[i - 1] + f * (v[i] - v[i - 1]);
     }
   }
   return NAN;
@@ -51,23 +52,54 @@ TEST(Drop, ImpactSpeedModeReachesTheSurfaceAtThatSpeed) {
   stop.max_time_s = 1.0;
   const DropResult r = drop_projectile(c.sys, 0.05, p, stop, 1e4);
   ASSERT_GT(r.samples.size(), 10u);
-  EXPECT_NEAR(r.samples.front().depth_m, -0.01, 1e-12);
+  EXPECT_NEAR(r.samples.depth_m.front(), -0.01, 1e-12);
   EXPECT_NEAR(r.release_speed_m_s, std::sqrt(0.49 - 2 * 9.81 * 0.01), 1e-12);
   EXPECT_NEAR(speed_at_surface(r), 0.7, 2e-3);  // semi-implicit Euler, 10 kHz sampling
   // Paper frame: free fall reads -g, velocity positive down, depth grows.
-  EXPECT_NEAR(r.samples[5].accel_up_m_s2, -9.81, 1e-9);
-  EXPECT_GT(r.samples[5].velocity_down_m_s, 0.0);
-  EXPECT_EQ(r.samples[5].contacts, 0);
+  EXPECT_NEAR(r.samples.accel_up_m_s2[5], -9.81, 1e-9);
+  EXPECT_GT(r.samples.velocity_down_m_s[5], 0.0);
+  EXPECT_EQ(r.samples.contacts[5], 0);
   // The floor is 5 cm below the "surface": the projectile lands there and comes to rest.
   ASSERT_TRUE(r.first_contact_s.has_value());
   EXPECT_NEAR(*r.first_contact_s, 0.07, 0.01);  // 6 cm at about 0.7-1.0 m/s
   EXPECT_TRUE(r.stopped);
   ASSERT_TRUE(r.rest_s.has_value());
-  EXPECT_NEAR(*r.rest_s, r.samples.back().t_s - stop.hold_time_s, 2e-4);
-  EXPECT_NEAR(r.samples.back().depth_m, 0.05, 1e-3);
-  EXPECT_EQ(r.samples.back().contacts, 1);
-  EXPECT_LT(std::abs(r.samples.back().velocity_down_m_s), 1e-3);
-  EXPECT_LT(r.samples.back().t_s, 1.0);
+  EXPECT_NEAR(*r.rest_s, r.samples.t_s.back() - stop.hold_time_s, 2e-4);
+  EXPECT_NEAR(r.samples.depth_m.back(), 0.05, 1e-3);
+  EXPECT_EQ(r.samples.contacts.back(), 1);
+  EXPECT_LT(std::abs(r.samples.velocity_down_m_s.back()), 1e-3);
+  EXPECT_LT(r.samples.t_s.back(), 1.0);
+}
+
+// The samples are written once: the trace record takes the drop's columns over as they are (the
+// same buffers, so no value is copied), with the release facts, and leaves the result's empty.
+TEST(Drop, TheTraceRecordTakesTheSampleColumnsOverWithoutACopy) {
+  EmptyContainer c(9.81);
+  ProjectileSpec p;
+  p.impact_speed_m_s = 0.7;
+  p.start_gap_m = 0.01;
+  DropResult r = drop_projectile(c.sys, 0.05, p, DropStop{}, 1e4);
+  ASSERT_TRUE(r.samples.consistent());
+  const DropSamples before = r.samples;  // the values, to compare
+  const DropSamples& s = r.samples;
+  const std::vector<const void*> buffers{
+      s.t_s.data(),         s.depth_m.data(),    s.velocity_down_m_s.data(), s.accel_up_m_s2.data(),
+      s.omega_rad_s.data(), s.position_m.data(), s.contacts.data(),          s.grain_kinetic_energy_J.data()};
+  const results::TraceData td = results::take_trace_columns(r, 1e4);
+  const std::vector<const void*> taken{
+      td.t_s.data(),         td.depth_m.data(),    td.velocity_down_m_s.data(), td.accel_up_m_s2.data(),
+      td.omega_rad_s.data(), td.position_m.data(), td.contacts.data(),          td.grain_kinetic_energy_J.data()};
+  EXPECT_EQ(taken, buffers);
+  EXPECT_TRUE(r.samples.empty());
+  EXPECT_EQ(td.t_s, before.t_s);
+  EXPECT_EQ(td.depth_m, before.depth_m);
+  EXPECT_EQ(td.position_m, before.position_m);
+  EXPECT_EQ(td.contacts, before.contacts);
+  EXPECT_EQ(td.release_speed_m_s, r.release_speed_m_s);
+  EXPECT_EQ(td.stopped, r.stopped);
+  EXPECT_NEAR(td.sample_rate_hz, 1e4, 1e-6);  // the samples' own spacing
+  ASSERT_TRUE(td.contact_start_s.has_value());
+  EXPECT_LT(*td.contact_start_s, *r.first_contact_s);  // the last sample before the first contact
 }
 
 TEST(Drop, DropHeightModeFallsFromRestWithTheOffsets) {
@@ -80,13 +112,13 @@ TEST(Drop, DropHeightModeFallsFromRestWithTheOffsets) {
   stop.max_time_s = 0.5;
   const DropResult r = drop_projectile(c.sys, 0.05, p, stop, 1e4);
   EXPECT_EQ(r.release_speed_m_s, 0.0);
-  EXPECT_NEAR(r.samples.front().depth_m, -0.04, 1e-12);
-  EXPECT_NEAR(r.samples.front().position_m.x(), 0.02, 1e-12);
+  EXPECT_NEAR(r.samples.depth_m.front(), -0.04, 1e-12);
+  EXPECT_NEAR(r.samples.position_m[0], 0.02, 1e-12);  // x of the first (T, 3) row
   EXPECT_NEAR(speed_at_surface(r), std::sqrt(2 * 1.62 * 0.04), 2e-3);
-  EXPECT_NEAR(r.samples[3].accel_up_m_s2, -1.62, 1e-9);
+  EXPECT_NEAR(r.samples.accel_up_m_s2[3], -1.62, 1e-9);
   // Time cap: at 1.62 m/s2 the bounces on the floor outlast 0.5 s, and the run ends at the cap.
   EXPECT_FALSE(r.stopped);
-  EXPECT_NEAR(r.samples.back().t_s, 0.5, 1e-3);
+  EXPECT_NEAR(r.samples.t_s.back(), 0.5, 1e-3);
 }
 
 TEST(Drop, RefusesAmbiguousOrUnreachableStarts) {
@@ -123,13 +155,13 @@ TEST(Drop, StartGapIsMeasuredFromTheGrainUnderTheFootprint) {
   const DropResult res = drop_projectile(c.sys, surface, p, stop, 1e4);
   EXPECT_NEAR(res.release_height_m, touch + 0.001, 1e-12);
   EXPECT_NEAR(res.first_touch_height_m, touch, 1e-12);
-  EXPECT_EQ(res.samples.front().contacts, 0);  // nothing touches at release
+  EXPECT_EQ(res.samples.contacts.front(), 0);  // nothing touches at release
   ASSERT_TRUE(res.first_contact_s.has_value());
   // The touch comes after about 1 mm of free fall, at about the requested speed.
   EXPECT_LT(*res.first_contact_s, 0.005);
   std::size_t k = 0;
-  while (res.samples[k].contacts == 0) ++k;
-  EXPECT_NEAR(res.samples[k - 1].velocity_down_m_s, 0.3, 2e-3);
+  while (res.samples.contacts[k] == 0) ++k;
+  EXPECT_NEAR(res.samples.velocity_down_m_s[k - 1], 0.3, 2e-3);
 }
 
 // The reproduction's part 2 (0.1 m/s2), at 1.2 m/s: an ejected grain flew over the 0.3 m wall and
@@ -164,7 +196,7 @@ TEST(Drop, AGrainThatGoesOverTheRimIsRemovedNotAFailure) {
   EXPECT_EQ(c.sys.particles.size_class[res.projectile], SizeClass::projectile);
   EXPECT_NEAR(c.sys.particles.radius_m[res.projectile], 0.05, 1e-15);
   // The samples after the removal still follow the projectile (free fall at -g until contact).
-  EXPECT_NEAR(res.samples[50].accel_up_m_s2, -0.1, 1e-9);
+  EXPECT_NEAR(res.samples.accel_up_m_s2[50], -0.1, 1e-9);
 }
 
 // A grain whose centre is above the wall's top by less than its radius feels no wall (the

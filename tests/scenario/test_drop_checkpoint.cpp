@@ -118,11 +118,11 @@ DropCheckpoint::AdaptiveRuns DropCheckpoint::run_adaptive_interrupted(const json
 // uninterrupted one.
 TEST_F(DropCheckpoint, ResumedThreeTimesTheTraceIsTheUninterruptedOne) {
   ASSERT_NO_FATAL_FAILURE(interrupted_once(0.03));
-  const double t1 = results::read_checkpoint(ckpt_).drop()->loop.result.samples.back().t_s;
+  const double t1 = results::read_checkpoint(ckpt_).drop()->loop.result.samples.t_s.back();
   EXPECT_FALSE(attempt(dir_->path / "never.h5", 0.08));
-  const double t2 = results::read_checkpoint(ckpt_).drop()->loop.result.samples.back().t_s;
+  const double t2 = results::read_checkpoint(ckpt_).drop()->loop.result.samples.t_s.back();
   EXPECT_FALSE(attempt(dir_->path / "never.h5", 0.13));
-  const double t3 = results::read_checkpoint(ckpt_).drop()->loop.result.samples.back().t_s;
+  const double t3 = results::read_checkpoint(ckpt_).drop()->loop.result.samples.t_s.back();
   EXPECT_LT(t1, t2);
   EXPECT_LT(t2, t3);
   json m;
@@ -189,7 +189,9 @@ TEST_F(DropCheckpoint, FileRoundTripIsExact) {
   EXPECT_TRUE(a.domain.has_value() == b.domain.has_value());
   EXPECT_EQ(c.drop()->loop.samples_done, d.drop()->loop.samples_done);
   EXPECT_EQ(c.drop()->loop.result.samples.size(), d.drop()->loop.result.samples.size());
-  EXPECT_EQ(c.drop()->loop.result.samples.back().position_m, d.drop()->loop.result.samples.back().position_m);
+  EXPECT_TRUE(c.drop()->loop.result.samples.consistent());
+  EXPECT_EQ(c.drop()->loop.result.samples.position_m, d.drop()->loop.result.samples.position_m);
+  EXPECT_EQ(c.drop()->loop.result.samples.contacts, d.drop()->loop.result.samples.contacts);
   EXPECT_EQ(c.identity_json, d.identity_json);
   EXPECT_GT(c.wall_time_s, 0);
 }
