@@ -31,22 +31,21 @@ struct RecordField {
   [[nodiscard]] const char* sql_type() const { return number || maybe ? "REAL" : count || flag ? "INTEGER" : "TEXT"; }
 };
 
+/// Field f of r as a JSON value (an absent number as null).
+template <class R>
+nlohmann::json field_json(const R& r, const RecordField<R>& f) {
+  if (f.number) return r.*f.number;
+  if (f.maybe) return (r.*f.maybe) ? nlohmann::json(*(r.*f.maybe)) : nlohmann::json(nullptr);
+  if (f.count) return r.*f.count;
+  if (f.flag) return r.*f.flag;
+  return r.*f.text;
+}
+
 /// Every field of r, in the table's order (an absent number as null).
 template <class R>
 nlohmann::json record_json(const R& r, const std::vector<RecordField<R>>& fields) {
   nlohmann::json j = nlohmann::json::object();
-  for (const auto& f : fields) {
-    if (f.number)
-      j[f.key] = r.*f.number;
-    else if (f.maybe)
-      j[f.key] = (r.*f.maybe) ? nlohmann::json(*(r.*f.maybe)) : nlohmann::json(nullptr);
-    else if (f.count)
-      j[f.key] = r.*f.count;
-    else if (f.flag)
-      j[f.key] = r.*f.flag;
-    else
-      j[f.key] = r.*f.text;
-  }
+  for (const auto& f : fields) j[f.key] = field_json(r, f);
   return j;
 }
 
@@ -82,15 +81,6 @@ R record_of_json(const nlohmann::json& j, const std::vector<RecordField<R>>& fie
     }
   }
   return r;
-}
-
-/// Adds every key of `add` to `into`; a key both hold is a logic error (two tables that name one
-/// field: one would silently replace the other).
-inline void merge_disjoint(nlohmann::json& into, const nlohmann::json& add) {
-  for (const auto& [k, v] : add.items()) {
-    if (into.contains(k)) throw std::logic_error(fmt::format("the key {} is in two records of one job", k));
-    into[k] = v;
-  }
 }
 
 }  // namespace gravsweep::results

@@ -24,23 +24,15 @@ const std::vector<MetricField>& metric_fields() {
   return fields;
 }
 
-void to_json(nlohmann::json& j, const Metrics& m) {
-  j = nlohmann::json::object();
-  for (const auto& f : metric_fields()) {
-    if (f.number)
-      j[f.key] = m.*f.number;
-    else if (f.flag)
-      j[f.key] = m.*f.flag;
-    else
-      j[f.key] = m.*f.text;
-  }
+nlohmann::json metric_json(const Metrics& m, const MetricField& f) {
+  if (f.number) return m.*f.number;
+  if (f.flag) return m.*f.flag;
+  return m.*f.text;
 }
 
-nlohmann::json null_metrics_json() {
-  nlohmann::json j = nlohmann::json::object();
-  for (const auto& f : metric_fields())
-    if (!f.text) j[f.key] = nullptr;
-  return j;
+void to_json(nlohmann::json& j, const Metrics& m) {
+  j = nlohmann::json::object();
+  for (const auto& f : metric_fields()) j[f.key] = metric_json(m, f);
 }
 
 std::vector<std::string> headline_metric_keys() {

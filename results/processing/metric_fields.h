@@ -1,7 +1,7 @@
 // The one table of the paper's metrics (Metrics, trace.h): every representation of a processed
-// collision (a drop job's metrics JSON and its results columns, the `trial_metrics` table of an
-// imported campaign, a --where row, the report's figure records) is made from metric_fields();
-// nothing else lists them.
+// collision (a drop job's results columns and the values bound to them, its trace's metrics text,
+// the `trial_metrics` table of an imported campaign, a --where row, the report's figure records)
+// is made from metric_fields(); nothing else lists them.
 #pragma once
 #include <nlohmann/json.hpp>
 
@@ -28,10 +28,10 @@ struct MetricField {
 /// The table, headline figures first.
 const std::vector<MetricField>& metric_fields();
 
-/// Every field (the flag as a JSON boolean, the note as a string).
+/// Field f of m as a JSON value (the flag as a JSON boolean, the note as a string).
+nlohmann::json metric_json(const Metrics& m, const MetricField& f);
+/// Every field, by metric_json.
 void to_json(nlohmann::json& j, const Metrics& m);
-/// Every numeric and flag field as null: a trace whose metrics could not be found.
-nlohmann::json null_metrics_json();
 /// The keys of the headline figures, in the table's order.
 std::vector<std::string> headline_metric_keys();
 

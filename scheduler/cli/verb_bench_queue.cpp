@@ -114,7 +114,7 @@ void bench_operations(const BenchQueueOptions& o, BenchStore& store) {
     queue::Completion done;
     done.output_rel = c->output_rel;
     done.sha256 = std::string(64, '0');
-    done.metrics = {{"noop_value", k}};
+    done.values = {{"noop_value", k}};
     t0 = Clock::now();
     queue::complete(db, *c, done);
     t_done += since(t0);

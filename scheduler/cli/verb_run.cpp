@@ -171,7 +171,7 @@ void run_impact(const RunOptions& o) {
     const auto d =
         pipeline::run_drop_job(scenario, bed_path, out / "trace.h5", o.threads, progress, &queue::stop_requested());
     bar.finish();
-    nlohmann::json metrics = d.metrics;
+    nlohmann::json metrics = d.outputs_json();
     metrics["scenario"] = std::filesystem::absolute(o.scenario).string();
     metrics["bed_file"] = std::filesystem::absolute(bed_path).string();
     metrics["trace_file"] = std::filesystem::absolute(d.trace_path).string();

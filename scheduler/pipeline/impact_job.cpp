@@ -17,11 +17,11 @@
 #include "results/io/snapshot_file.h"
 #include "results/io/trace_file.h"
 #include "results/measurements/campaign.h"
-#include "results/processing/metric_fields.h"
 #include "results/processing/trace.h"
 #include "scheduler/pipeline/build_version.h"
 #include "scheduler/pipeline/scenario_spec.h"
 #include "scheduler/queue/canonical.h"
+#include "scheduler/sweep/impact_kinds.h"
 
 namespace gravsweep::pipeline {
 
@@ -336,23 +336,21 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   const double wall_s = seconds_since(t0) + ckpt.prior_wall_time_s();
 
   results::TraceData td = trace_of(dr, s, validated, bed, bed_in);
-  std::string metrics_error;
-  const std::optional<results::Metrics> metrics = paper_metrics(td, trace_out, metrics_error);
-  // Nulls and metrics_error when the trace cannot be measured.
-  json m = metrics ? json(*metrics) : results::null_metrics_json();
-  if (!metrics) m["metrics_error"] = metrics_error;
+  // The run's outputs, the records themselves (no copy into JSON): the trace's text is written from them.
+  auto outputs = std::make_shared<sweep::DropOutputs>();
+  outputs->metrics = paper_metrics(td, trace_out, outputs->metrics_error);
+  const auto& metrics = outputs->metrics;
   const std::optional<double> t_start = metrics ? std::optional<double>(metrics->t_start_s) : std::nullopt;
-  results::DemFigures dem = results::dem_figures_of(
+  results::DemFigures& dem = outputs->dem = results::dem_figures_of(
       td, dr, bed, bed_grains, t_start, std::hypot(projectile.lateral_offset_x_m, projectile.lateral_offset_y_m));
   dem.threads = sys.threads();
   dem.wall_time_s = wall_s;
   results::set_checkpoint_counts(dem, ckpt.counts());
-  results::merge_disjoint(m, results::to_json(dem));
-  td.metrics_json = m.dump();
   check_stop(stop, "drop");
   DropJobResult out;
   out.trace_path = trace_out;
-  out.metrics = std::move(m);
+  out.record = std::move(outputs);
+  td.metrics_json = out.outputs_json().dump();
   if (snaps) {
     out.snapshots = snaps->count();
     out.snapshot_bytes = snaps->bytes_per_snapshot();

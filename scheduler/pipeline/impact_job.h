@@ -33,8 +33,9 @@ struct BedJobResult {
   results::BedSummary report;  ///< the preparation's report, as bed.h5's `report` holds it
 };
 
-/// The drop's outputs as its runner reports them (metrics: vc_m_s, apeak_m_s2, zstop_m, tstop_s,
-/// rebound, the DEM's figures, wall_time_s, ...) with the files it wrote.
+/// The drop's outputs as its runner reports them (record: a sweep::DropOutputs, the paper's
+/// metrics vc_m_s, apeak_m_s2, zstop_m, tstop_s, rebound, ... and the DEM's figures, wall_time_s,
+/// ...) with the files it wrote.
 struct DropJobResult : queue::RunOutput {
   std::filesystem::path trace_path;
   /// Grain snapshots (/output/snapshot_interval_s > 0): the .h5 and its .xdmf index, else empty.
@@ -53,9 +54,10 @@ BedJobResult run_bed_job(const nlohmann::json& scenario, const std::filesystem::
 
 /// Validates `scenario` unless this build validated it at submit (job_scenario), loads the bed (its
 /// key must equal the validated scenario's, bed_key_of_validated), drops the projectile, writes the trace
-/// (HDF5, temporary name then rename) and returns the metrics: the paper's vc, apeak, zstop, tstop,
-/// rebound, plus wall time. A collision the metrics cannot resolve (e.g. no contact before the time
-/// cap) is not an error: the metrics carry "metrics_error" with the reason, and null values.
+/// (HDF5, temporary name then rename) and returns the outputs: the paper's vc, apeak, zstop, tstop,
+/// rebound, plus the DEM's figures and wall time. A collision the metrics cannot resolve (e.g. no
+/// contact before the time cap) is not an error: the outputs carry "metrics_error" with the
+/// reason, and null values.
 /// With /output/snapshot_interval_s > 0 it also writes results::snapshot_path_for(trace_out) and its XDMF.
 /// With checkpointing.path set, it continues the drop saved there if that checkpoint is usable,
 /// saves the drop there as job_checkpoint.h says, and removes it once the trace is written.

@@ -15,7 +15,7 @@
 
 namespace gravsweep::queue {
 
-/// One field a job kind's runner reports in its metrics (RunOutput::metrics) and the column of the
+/// One field a job kind's runner reports (RunOutput::each_output) and the column of the
 /// results table that holds it. The columns of the kinds a sweep plans are added at submit, so a
 /// campaign's results table is known before any job finishes; a runner that reports a key its
 /// kind does not declare fails its attempt (see check_outputs in queue.h).

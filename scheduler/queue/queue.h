@@ -281,11 +281,12 @@ class OutputError : public std::logic_error {
  public:
   using std::logic_error::logic_error;
 };
-/// Checks a runner's metrics ({key: value}, flat) against the outputs `kind` declares: every key
-/// declared, every value null or of the declared type (REAL: a number; INTEGER: an integer or a
-/// flag; TEXT: a string). Throws OutputError naming the kind and the key. A declared key a runner
-/// leaves out is NULL in its row.
-void check_outputs(JobKind kind, const nlohmann::json& metrics);
+/// Checks a runner's outputs (RunOutput::each_output: its values, {key: value} flat, and its
+/// record's) against the outputs `kind` declares: every key declared and reported once, every
+/// value null or of the declared type (REAL: a number; INTEGER: an integer or a flag; TEXT: a
+/// string). Throws OutputError naming the kind and the key. A declared key a runner leaves out is
+/// NULL in its row.
+void check_outputs(JobKind kind, const RunOutput& out);
 
 /// Column names of the results table, in display order (fixed, parameters, metrics).
 std::vector<std::string> result_columns(db::Database& db);

@@ -41,7 +41,7 @@ std::string dependency_of(Database& db, const std::string& job_id) {
 
 void insert_results_row(Database& db, const Claim& c, const Completion& done, double now,
                         const std::string& code_version) {
-  check_outputs(c.kind, done.metrics);
+  check_outputs(c.kind, done);
   const auto cols = result_extra_columns(db);
   const std::string bed_id = dependency_of(db, c.job_id);
   const FinishedJob job{c, done, now, code_version, bed_id};
@@ -53,8 +53,7 @@ void insert_results_row(Database& db, const Claim& c, const Completion& done, do
   }
   for (auto it = c.params.begin(); it != c.params.end(); ++it)  // typed to fit every value at submit
     if (cols.count(it.key()) && used.insert(it.key()).second) values.emplace_back(it.key(), it.value());
-  const json no_metrics = json::object();  // check_outputs: null or an object
-  for (const auto& [key, v] : (done.metrics.is_object() ? done.metrics : no_metrics).items()) {
+  done.each_output([&](const std::string& key, const json& v) {  // each from where the runner holds it
     const std::string name = output_column(key, cols);
     if (!cols.count(name))
       throw std::runtime_error(fmt::format(
@@ -64,7 +63,7 @@ void insert_results_row(Database& db, const Claim& c, const Completion& done, do
           c.job_id, name, kind_name(c.kind)));
     // A swept parameter of the same name, in a column an earlier sweep made for the output, holds it.
     if (used.insert(name).second) values.emplace_back(name, v);
-  }
+  });
   std::string names, marks;
   for (const auto& [name, v] : values) {
     names += fmt::format("{}\"{}\"", names.empty() ? "" : ", ", name);

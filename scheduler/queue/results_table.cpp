@@ -164,13 +164,13 @@ bool fits_type(const std::string& type, const json& v) {
 
 }  // namespace
 
-void check_outputs(JobKind kind, const json& metrics) {
-  if (metrics.is_null()) return;
+void check_outputs(JobKind kind, const RunOutput& out) {
   const JobKindInfo& info = kind_info(kind);
-  if (!metrics.is_object())
-    throw OutputError(fmt::format("job kind '{}': its runner's metrics are {}, expected an object of its outputs",
-                                  info.name, metrics.type_name()));
-  for (const auto& [key, v] : metrics.items()) {
+  if (!out.values.is_null() && !out.values.is_object())
+    throw OutputError(fmt::format("job kind '{}': its runner's values are {}, expected an object of its outputs",
+                                  info.name, out.values.type_name()));
+  std::set<std::string> reported;
+  out.each_output([&](const std::string& key, const json& v) {
     const auto o = std::find_if(info.outputs.begin(), info.outputs.end(),
                                 [&key = key](const OutputField& f) { return f.key == key; });
     if (o == info.outputs.end()) {
@@ -181,6 +181,8 @@ void check_outputs(JobKind kind, const json& metrics) {
           "declare it in the kind's registration (JobKindInfo::outputs), which gives it a results column at submit",
           info.name, key, declared.empty() ? "none" : declared));
     }
+    if (!reported.insert(key).second)
+      throw OutputError(fmt::format("job kind '{}': its runner reported the metric '{}' twice", info.name, key));
     if (!fits_type(o->type, v))
       throw OutputError(
           fmt::format("job kind '{}': its runner reported the metric '{}' as {} ({}), expected {} or null", info.name,
@@ -188,7 +190,7 @@ void check_outputs(JobKind kind, const json& metrics) {
                       o->type == "REAL"      ? "a number"
                       : o->type == "INTEGER" ? "an integer or a flag"
                                              : "a string"));
-  }
+  });
 }
 
 std::vector<std::string> result_columns(Database& db) {

@@ -321,7 +321,7 @@ class Worker {
                      &sig.progress_saved,
                      o_.max_memory_bytes};
       a.out = runner->second(ctx);
-      check_outputs(c.kind, a.out.metrics);  // before the output is stored as the job's
+      check_outputs(c.kind, a.out);  // before the output is stored as the job's
     } catch (const OutputError& e) {
       a.error = fmt::format("logic error: {}", e.what());
       a.exit_code = kExitFailure;

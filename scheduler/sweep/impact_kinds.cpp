@@ -1,6 +1,5 @@
 #include "scheduler/sweep/impact_kinds.h"
 
-#include "results/io/job_reports.h"
 #include "results/processing/metric_fields.h"
 
 namespace gravsweep::sweep {
@@ -12,12 +11,15 @@ queue::JobKind bed_kind() {
 
 namespace {
 
-/// What a drop's runner reports: its metrics JSON is written from the same tables.
+/// Why a drop's trace could not be measured: the one output beside the two tables.
+constexpr const char* kMetricsErrorKey = "metrics_error";
+
+/// What a drop's runner reports (DropOutputs::each_output walks the same tables).
 std::vector<queue::OutputField> drop_outputs() {
   std::vector<queue::OutputField> outputs;
   queue::append_outputs(outputs, results::metric_fields());
   queue::append_outputs(outputs, results::dem_figure_fields());
-  outputs.push_back({"metrics_error", "", "TEXT"});
+  outputs.push_back({kMetricsErrorKey, "", "TEXT"});
   return outputs;
 }
 
@@ -26,6 +28,17 @@ std::vector<queue::OutputField> drop_outputs() {
 queue::JobKind drop_kind() {
   static const queue::JobKind kind = queue::register_kind({"drop", "traces", ".h5", true, false, drop_outputs()});
   return kind;
+}
+
+void DropOutputs::each_output(const Visit& visit) const {
+  for (const auto& f : results::metric_fields()) {
+    if (metrics)
+      visit(f.key, results::metric_json(*metrics, f));
+    else if (!f.text)
+      visit(f.key, nullptr);  // unmeasured; the note is left out (NULL)
+  }
+  if (!metrics) visit(kMetricsErrorKey, metrics_error);
+  for (const auto& f : results::dem_figure_fields()) visit(f.key, results::field_json(dem, f));
 }
 
 namespace {

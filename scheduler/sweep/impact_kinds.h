@@ -1,7 +1,14 @@
 // The job kinds of an impact campaign, registered with the queue (queue/job_types.h): a bed
-// preparation and a drop. The sweep plans them (spec.h); pipeline/ runs them.
+// preparation and a drop. The sweep plans them (spec.h); pipeline/ runs them. A drop's outputs
+// are declared and reported from the same field tables (DropOutputs).
 #pragma once
+#include <optional>
+#include <string>
+
+#include "results/io/job_reports.h"
+#include "results/processing/trace.h"
 #include "scheduler/queue/job_types.h"
+#include "scheduler/queue/run_output.h"
 
 namespace gravsweep::sweep {
 
@@ -12,5 +19,17 @@ queue::JobKind bed_kind();
 /// paper's metrics (results::metric_fields()), the DEM's figures (results::dem_figure_fields())
 /// and metrics_error, why a trace could not be measured (pipeline/impact_job.cpp:run_drop_job).
 queue::JobKind drop_kind();
+
+/// A drop's outputs as its runner reports them (queue::RunOutput::record): the paper's metrics as
+/// processing made them and the DEM's figures, the typed records themselves, read by their field
+/// tables (the tables that declare drop_kind()'s outputs) where a value is needed.
+struct DropOutputs final : queue::OutputRecord {
+  /// The paper's metrics; none when the trace could not be measured: then every number and flag
+  /// of metric_fields() is null and metrics_error says why.
+  std::optional<results::Metrics> metrics;
+  std::string metrics_error;
+  results::DemFigures dem;
+  void each_output(const Visit& visit) const override;
+};
 
 }  // namespace gravsweep::sweep

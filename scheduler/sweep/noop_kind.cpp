@@ -64,8 +64,8 @@ queue::RunOutput run_noop(const queue::RunContext& ctx) {
   // A write error (a full disk, no file descriptor left) fails the attempt with its errno.
   queue::write_file_synced(ctx.output_tmp, json{{"job_id", ctx.claim.job_id}, {"attempt", ctx.claim.attempt}}.dump());
   queue::RunOutput out;
-  out.metrics["noop_value"] = s.contains("value") ? s["value"] : json(0);
-  out.metrics["sleep_s"] = sleep_s;
+  out.values["noop_value"] = s.contains("value") ? s["value"] : json(0);
+  out.values["sleep_s"] = sleep_s;
   return out;
 }
 

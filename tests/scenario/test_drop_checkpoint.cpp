@@ -62,7 +62,7 @@ class DropCheckpoint : public ::testing::Test {
     };
     try {
       const auto r = pipeline::run_drop_job(scenario_, bed(), trace, 1, progress, &stop, checkpointing());
-      if (metrics) *metrics = r.metrics;
+      if (metrics) *metrics = r.outputs_json();
       return true;
     } catch (const pipeline::Interrupted& e) {
       EXPECT_NE(std::string(e.what()).find(ckpt_.string()), std::string::npos) << e.what();

@@ -79,7 +79,7 @@ TEST_F(ImpactPipeline, BedIsPreparedFlattenedAndSaved) {
 }
 
 TEST_F(ImpactPipeline, DropIsRecordedAndMeasured) {
-  const json& m = drop_->metrics;
+  const json m = drop_->outputs_json();
   ASSERT_FALSE(m.contains("metrics_error")) << m.dump(2);
   const auto tr = results::read_trace(drop_->trace_path);
   ASSERT_GT(tr.size(), 100u);
@@ -141,8 +141,8 @@ TEST_F(ImpactPipeline, BedReuseEqualsPreparingTheBedAgain) {
   const auto t1 = results::read_trace(drop_->trace_path), t2 = results::read_trace(d2.trace_path);
   EXPECT_EQ(t1.depth_m, t2.depth_m);
   EXPECT_EQ(t1.accel_up_m_s2, t2.accel_up_m_s2);
-  EXPECT_EQ(drop_->metrics["zstop_m"], d2.metrics["zstop_m"]);
-  EXPECT_EQ(drop_->metrics["apeak_m_s2"], d2.metrics["apeak_m_s2"]);
+  EXPECT_EQ(drop_->outputs_json()["zstop_m"], d2.outputs_json()["zstop_m"]);
+  EXPECT_EQ(drop_->outputs_json()["apeak_m_s2"], d2.outputs_json()["apeak_m_s2"]);
   // Another seed gives another bed.
   json other = test::tiny_scenario();
   other["bed"]["seed"] = 8;
@@ -205,7 +205,7 @@ TEST_F(ImpactPipeline, ABedPreparedWithItsOwnMaterialsServesDropsWithOtherMateri
   // beside the projectile's kinetic energy, and the depth stays close.
   const auto d = run_drop_job(stiff, bed_->bed_path, dir_->path / "stiff.h5", 1, {}, nullptr);
   const auto tr = results::read_trace(d.trace_path);
-  const double first_contact_s = d.metrics.at("first_contact_s");
+  const double first_contact_s = d.outputs_json().at("first_contact_s");
   double released_J = 0;
   std::size_t before = 0;
   for (std::size_t k = 0; k < tr.t_s.size() && tr.t_s[k] < first_contact_s; ++k, ++before)
@@ -216,7 +216,7 @@ TEST_F(ImpactPipeline, ABedPreparedWithItsOwnMaterialsServesDropsWithOtherMateri
   EXPECT_LT(released_J, 0.01 * impact_ke_J);
   EXPECT_DOUBLE_EQ(tr.dt_s, 5e-6);
   EXPECT_TRUE(json::parse(tr.scenario_json)["bed"].contains("materials"));
-  const double z_soft = drop_->metrics.at("zstop_m"), z_stiff = d.metrics.at("zstop_m");
+  const double z_soft = drop_->outputs_json().at("zstop_m"), z_stiff = d.outputs_json().at("zstop_m");
   EXPECT_NEAR(z_stiff, z_soft, 0.3 * z_soft) << "soft " << z_soft << " m, stiff " << z_stiff << " m";
 }
 

@@ -28,7 +28,7 @@ TEST(ResultsQuery, FiltersAreBoundAndColumnsChecked) {
     Completion d;
     d.output_rel = c->output_rel;
     d.sha256 = "x";
-    d.metrics = {{"noop_value", c->scenario["g"].get<double>() * 10}};
+    d.values = {{"noop_value", c->scenario["g"].get<double>() * 10}};
     ASSERT_TRUE(complete(db, *c, d));
   }
   auto t = query_results(db, {{"gravity_m_s2<1"}, {"gravity_m_s2", "noop_value"}, "", "", -1});

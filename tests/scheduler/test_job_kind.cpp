@@ -47,7 +47,7 @@ sweep::SweepKind square_kind() {
                   const double side_m = ctx.claim.scenario.at("side_m");
                   queue::write_file_synced(ctx.output_tmp, json{{"side_m", side_m}}.dump());
                   queue::RunOutput out;
-                  out.metrics["area_m2"] = side_m * side_m;
+                  out.values["area_m2"] = side_m * side_m;
                   return out;
                 }}};
   return k;
@@ -123,8 +123,8 @@ void register_sloppy() {
     k.runners = {{sloppy_job(), [](const queue::RunContext& ctx) {
                     queue::write_file_synced(ctx.output_tmp, "{}");
                     queue::RunOutput out;
-                    out.metrics["area_m2"] = 1.0;
-                    out.metrics["perimeter_m"] = 4.0;  // not declared
+                    out.values["area_m2"] = 1.0;
+                    out.values["perimeter_m"] = 4.0;  // not declared
                     return out;
                   }}};
     sweep::register_sweep_kind(std::move(k));

@@ -80,9 +80,9 @@ struct QueueTest : ::testing::TestWithParam<test::Store> {
     d.bytes = 1;
     // What each kind declares (a bed's job is no results row: no metrics).
     if (c.kind == sweep::drop_kind())
-      d.metrics = {{"apeak_m_s2", value}, {"rebound", false}, {"note", nullptr}};
+      d.values = {{"apeak_m_s2", value}, {"rebound", false}, {"note", nullptr}};
     else if (c.kind == noop_kind())
-      d.metrics = {{"noop_value", value}, {"sleep_s", 0.25}};
+      d.values = {{"noop_value", value}, {"sleep_s", 0.25}};
     return d;
   }
 };
@@ -121,7 +121,7 @@ TEST_P(QueueTest, ANonIntegerValueWidensAnIntegerResultsColumnAndKeepsItsValues)
     auto c = claim(db, me, paths, 60);
     if (!c) return false;
     Completion d = done_for(*c);
-    d.metrics["noop_value"] = value;
+    d.values["noop_value"] = value;
     return complete(db, *c, d);
   };
   EXPECT_TRUE(finish(3));

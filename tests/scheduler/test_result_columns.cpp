@@ -1,16 +1,19 @@
 // The results table's columns on both backends (label postgres: scheduler_postgres_tests): a job
 // kind's declared outputs are columns from submit on, before any job finished; a metric a kind
 // did not declare is refused at completion, naming the kind and the key, and makes no column; a
-// campaign an earlier build wrote (its metric columns made at completion, typed by their first
-// value) takes completions of this build and reads as before.
+// drop's typed record is bound to its columns as it holds its values; a campaign an earlier build
+// wrote (its metric columns made at completion, typed by their first value) takes completions of
+// this build and reads as before.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <fstream>
 #include <sstream>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "results/processing/metric_fields.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/copy.h"
 #include "scheduler/queue/filter.h"
@@ -83,7 +86,7 @@ struct ResultColumns : ::testing::TestWithParam<test::Store> {
     d.output_rel = c.output_rel;
     d.sha256 = std::string(64, 'a');
     d.bytes = 1;
-    d.metrics = std::move(metrics);
+    d.values = std::move(metrics);
     return d;
   }
 };
@@ -156,10 +159,74 @@ TEST_P(ResultColumns, AnUndeclaredMetricOrAWrongTypeIsRefusedAndMakesNoColumn) {
   };
   refused({{"noop_value", 1.0}, {"typo_value", 2.0}}, {"'noop'", "'typo_value'", "noop_value, sleep_s"});
   refused({{"noop_value", "many"}}, {"'noop_value'", "a number"});
-  EXPECT_THROW(check_outputs(noop_kind(), json::array()), OutputError);
+  RunOutput listed;
+  listed.values = json::array();
+  EXPECT_THROW(check_outputs(noop_kind(), listed), OutputError);
   ASSERT_TRUE(complete(db, *c, done_for(*c, {{"noop_value", 7}})));
   EXPECT_EQ(sql_int(db, "SELECT count(*) FROM results WHERE noop_value=7 AND sleep_s IS NULL"), 1)
       << "a declared output left out is NULL";
+}
+
+TEST_P(ResultColumns, ADropsRecordIsBoundToItsColumnsAsItHoldsItsValues) {
+  db::Database db(store.location);
+  ensure_schema(db);
+  const json doc = {{"sweep", "imp"},
+                    {"base", {{"g", 9.81}, {"v", 1.0}}},
+                    {"axes", {{{"name", "impact_speed_m_s"}, {"pointer", "/v"}, {"values", {1.0, 2.0}}}}}};
+  const auto spec = sweep::load_spec_text(doc.dump(), "imp.json", ".");
+  const sweep::SweepKind impact{
+      "impact", "test", {}, sweep::shared_input_planner(by_gravity, sweep::drop_kind(), sweep::bed_kind()), {}};
+  submit(db, spec, sweep::expand(spec, impact));
+  const CampaignPaths paths(store.location, store.files);
+  auto bed = claim(db, me, paths, 60);
+  ASSERT_TRUE(bed && bed->kind == sweep::bed_kind());
+  ASSERT_TRUE(complete(db, *bed, done_for(*bed, json::object())));
+  // One drop measured, one not (its metrics' numbers and flag null, metrics_error why).
+  results::Metrics m;
+  m.vc_m_s = 0.975;
+  m.rebound = true;
+  m.note = "measured";
+  for (const bool measured : {true, false}) {
+    auto c = claim(db, me, paths, 60);
+    ASSERT_TRUE(c && c->kind == sweep::drop_kind());
+    auto outputs = std::make_shared<sweep::DropOutputs>();
+    if (measured)
+      outputs->metrics = m;
+    else
+      outputs->metrics_error = "no contact";
+    outputs->dem.steps = 12345;
+    outputs->dem.first_contact_s = 0.125;
+    Completion d = done_for(*c, json::object());
+    d.record = outputs;
+    check_outputs(c->kind, d);
+    // Its text (a trace's `metrics` attribute): every metric, or their numbers and flag null and
+    // metrics_error, with the DEM's figures.
+    json text = json::object();
+    for (const auto& f : results::metric_fields())
+      if (measured || !f.text) text[f.key] = measured ? json(m)[f.key] : json(nullptr);
+    if (!measured) text["metrics_error"] = "no contact";
+    text.update(results::to_json(outputs->dem));
+    EXPECT_EQ(d.outputs_json(), text);
+    ASSERT_TRUE(complete(db, *c, d));
+    const char* metrics_where =
+        measured ? "vc_m_s=0.975 AND rebound=1 AND note='measured' AND metrics_error IS NULL"
+                 : "vc_m_s IS NULL AND rebound IS NULL AND note IS NULL AND metrics_error='no contact'";
+    EXPECT_EQ(sql_int(db, fmt::format("SELECT count(*) FROM results WHERE job_id='{}' AND {} AND steps=12345 AND "
+                                      "first_contact_s=0.125 AND resumed_at_s IS NULL AND stopped=0",
+                                      c->job_id, metrics_where)),
+              1);
+  }
+  // A key both as a value and in the record: refused, naming the kind and the key.
+  Completion twice;
+  twice.values = {{"steps", 1}};
+  twice.record = std::make_shared<sweep::DropOutputs>();
+  try {
+    check_outputs(sweep::drop_kind(), twice);
+    ADD_FAILURE() << "a key reported twice was taken";
+  } catch (const OutputError& e) {
+    for (const char* part : {"'drop'", "'steps'", "twice"})
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+  }
 }
 
 TEST_P(ResultColumns, ACampaignOfTheEarlierLayoutTakesCompletionsAndReadsAsBefore) {
