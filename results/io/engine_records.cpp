@@ -3,7 +3,6 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -100,32 +99,6 @@ BedSummary bed_summary_of(const System& sys, const BedReport& rep, const BedRest
   r.dt_s = sys.config().dt_s;
   r.threads = sys.threads();
   return r;
-}
-
-DemFigures dem_figures_of(const TraceData& td, const DropResult& dr, const BedFacts& bed, std::size_t bed_grains,
-                          std::optional<double> t_start_s, double lateral_offset_m) {
-  DemFigures d;
-  d.max_depth_m = td.depth_m.empty() ? 0.0 : *std::max_element(td.depth_m.begin(), td.depth_m.end());
-  d.final_depth_below_surface_m = td.depth_m.empty() ? 0.0 : td.depth_m.back();
-  d.first_contact_s = dr.first_contact_s;
-  d.stopped = dr.stopped;
-  d.grains_spilled_over_rim = static_cast<long long>(dr.grains_spilled);
-  // Sect. 2.2's stop criterion (speed < stop.speed_m_s after contact): when the projectile came to
-  // rest, and how long after the collision start (a DEM-side duration next to the paper's tstop).
-  d.rest_time_s = dr.rest_s;
-  if (dr.rest_s && t_start_s) d.duration_to_rest_s = *dr.rest_s - *t_start_s;
-  d.simulated_time_s = td.t_s.empty() ? 0.0 : td.t_s.back();
-  d.steps = dr.steps;
-  d.dt_s = td.dt_s;
-  d.sample_rate_hz = td.sample_rate_hz;
-  d.gravity_m_s2 = td.gravity_m_s2;
-  d.grains = static_cast<long long>(bed_grains);
-  d.surface_height_m = bed.surface_height_m;
-  d.release_speed_m_s = dr.release_speed_m_s;
-  d.release_height_above_surface_m = dr.release_height_m - bed.surface_height_m;
-  d.first_touch_height_above_surface_m = dr.first_touch_height_m - bed.surface_height_m;
-  d.lateral_offset_m = lateral_offset_m;
-  return d;
 }
 
 }  // namespace gravsweep::results

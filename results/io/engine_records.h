@@ -5,7 +5,6 @@
 #pragma once
 #include <cstddef>
 #include <filesystem>
-#include <optional>
 
 #include "engine/scenario/bed.h"
 #include "engine/scenario/impact.h"
@@ -40,11 +39,5 @@ Snapshot snapshot_of(const System& sys, ParticleIndex projectile, double t_s);
 /// `at_rest_for_impacts_above_m_s` infinite: none. The wall time and checkpoint counts are the job's.
 BedSummary bed_summary_of(const System& sys, const BedReport& rep, const BedRestState& rest,
                           double at_rest_for_impacts_above_m_s);
-
-/// The DEM figures of a drop from its trace (depths below the bed's surface), its result and the
-/// bed it was dropped on (its facts and its number of grains); `t_start_s` is the paper's collision
-/// start (none: duration_to_rest_s is absent).
-DemFigures dem_figures_of(const TraceData& td, const DropResult& dr, const BedFacts& bed, std::size_t bed_grains,
-                          std::optional<double> t_start_s, double lateral_offset_m);
 
 }  // namespace gravsweep::results

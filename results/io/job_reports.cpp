@@ -1,36 +1,84 @@
 // The field tables of a job's reports (see job_reports.h).
 #include "results/io/job_reports.h"
 
+#include <algorithm>
+
 namespace gravsweep::results {
 
-const std::vector<RecordField<DemFigures>>& dem_figure_fields() {
-  using D = DemFigures;
-  static const std::vector<RecordField<D>> fields = {
-      {.key = "max_depth_m", .unit = "m", .number = &D::max_depth_m},
-      {.key = "final_depth_below_surface_m", .unit = "m", .number = &D::final_depth_below_surface_m},
-      {.key = "first_contact_s", .unit = "s", .maybe = &D::first_contact_s},
-      {.key = "stopped", .unit = "1", .flag = &D::stopped},
-      {.key = "grains_spilled_over_rim", .unit = "1", .count = &D::grains_spilled_over_rim},
-      {.key = "rest_time_s", .unit = "s", .maybe = &D::rest_time_s},
-      {.key = "duration_to_rest_s", .unit = "s", .maybe = &D::duration_to_rest_s},
-      {.key = "simulated_time_s", .unit = "s", .number = &D::simulated_time_s},
-      {.key = "steps", .unit = "1", .count = &D::steps},
-      {.key = "dt_s", .unit = "s", .number = &D::dt_s},
-      {.key = "sample_rate_hz", .unit = "Hz", .number = &D::sample_rate_hz},
-      {.key = "gravity_m_s2", .unit = "m/s2", .number = &D::gravity_m_s2},
-      {.key = "grains", .unit = "1", .count = &D::grains},
-      {.key = "surface_height_m", .unit = "m", .number = &D::surface_height_m},
-      {.key = "release_speed_m_s", .unit = "m/s", .number = &D::release_speed_m_s},
-      {.key = "release_height_above_surface_m", .unit = "m", .number = &D::release_height_above_surface_m},
-      {.key = "first_touch_height_above_surface_m", .unit = "m", .number = &D::first_touch_height_above_surface_m},
-      {.key = "lateral_offset_m", .unit = "m", .number = &D::lateral_offset_m},
-      {.key = "threads", .unit = "1", .count = &D::threads},
-      {.key = "wall_time_s", .unit = "s", .number = &D::wall_time_s},
-      {.key = "checkpoint_resumes", .unit = "1", .count = &D::checkpoint_resumes},
-      {.key = "resumed_at_s", .unit = "s", .maybe = &D::resumed_at_s},
-      {.key = "checkpoints_written", .unit = "1", .count = &D::checkpoints_written},
+namespace {
+
+/// The depth below the bed's mean surface at the deepest and at the last sample (0: no sample).
+double max_depth_m(const DropRecord& d) {
+  const auto& z = d.trace.depth_m;
+  return z.empty() ? 0.0 : *std::max_element(z.begin(), z.end());
+}
+double final_depth_m(const DropRecord& d) { return d.trace.depth_m.empty() ? 0.0 : d.trace.depth_m.back(); }
+
+/// Sect. 2.2's stop criterion (speed < stop.speed_m_s after contact) met: how long after the
+/// paper's collision start (a DEM-side duration next to tstop); none without both.
+std::optional<double> duration_to_rest_s(const DropRecord& d) {
+  if (!d.result.rest_s || !d.metrics) return std::nullopt;
+  return *d.result.rest_s - d.metrics->t_start_s;
+}
+
+}  // namespace
+
+// Each figure is read where the drop holds it: the trace record (its columns, dt, gravity, sample
+// rate, surface, release speed, stop flag), the engine's result (first contact, rest, steps,
+// spilled grains, release and first-touch heights), the metrics, or the run's own facts.
+const std::vector<DemFigureField>& dem_figure_fields() {
+  using D = DropRecord;
+  using Maybe = std::optional<double>;
+  static const std::vector<DemFigureField> fields = {
+      {.key = "max_depth_m", .unit = "m", .number = max_depth_m},
+      {.key = "final_depth_below_surface_m", .unit = "m", .number = final_depth_m},
+      {.key = "first_contact_s", .unit = "s", .maybe = [](const D& d) -> Maybe { return d.result.first_contact_s; }},
+      {.key = "stopped", .unit = "1", .flag = [](const D& d) { return d.trace.stopped; }},
+      {.key = "grains_spilled_over_rim",
+       .unit = "1",
+       .count = [](const D& d) { return static_cast<long long>(d.result.grains_spilled); }},
+      {.key = "rest_time_s", .unit = "s", .maybe = [](const D& d) -> Maybe { return d.result.rest_s; }},
+      {.key = "duration_to_rest_s", .unit = "s", .maybe = duration_to_rest_s},
+      {.key = "simulated_time_s",
+       .unit = "s",
+       .number = [](const D& d) { return d.trace.t_s.empty() ? 0.0 : d.trace.t_s.back(); }},
+      {.key = "steps", .unit = "1", .count = [](const D& d) { return d.result.steps; }},
+      {.key = "dt_s", .unit = "s", .number = [](const D& d) { return d.trace.dt_s; }},
+      {.key = "sample_rate_hz", .unit = "Hz", .number = [](const D& d) { return d.trace.sample_rate_hz; }},
+      {.key = "gravity_m_s2", .unit = "m/s2", .number = [](const D& d) { return d.trace.gravity_m_s2; }},
+      {.key = "grains", .unit = "1", .count = [](const D& d) { return d.bed_grains; }},
+      {.key = "surface_height_m", .unit = "m", .number = [](const D& d) { return d.trace.surface_height_m; }},
+      {.key = "release_speed_m_s", .unit = "m/s", .number = [](const D& d) { return d.trace.release_speed_m_s; }},
+      {.key = "release_height_above_surface_m",
+       .unit = "m",
+       .number = [](const D& d) { return d.trace.release_height_m - d.trace.surface_height_m; }},
+      {.key = "first_touch_height_above_surface_m",
+       .unit = "m",
+       .number = [](const D& d) { return d.result.first_touch_height_m - d.trace.surface_height_m; }},
+      {.key = "lateral_offset_m", .unit = "m", .number = [](const D& d) { return d.lateral_offset_m; }},
+      {.key = "threads", .unit = "1", .count = [](const D& d) { return d.threads; }},
+      {.key = "wall_time_s", .unit = "s", .number = [](const D& d) { return d.wall_time_s; }},
+      {.key = "checkpoint_resumes", .unit = "1", .count = [](const D& d) { return d.checkpoints.resumes; }},
+      {.key = "resumed_at_s", .unit = "s", .maybe = [](const D& d) -> Maybe { return d.checkpoints.resumed_at_s; }},
+      {.key = "checkpoints_written", .unit = "1", .count = [](const D& d) { return d.checkpoints.written; }},
   };
   return fields;
+}
+
+nlohmann::json dem_figure_json(const DropRecord& d, const DemFigureField& f) {
+  if (f.number) return f.number(d);
+  if (f.maybe) {
+    const std::optional<double> v = f.maybe(d);
+    return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+  }
+  if (f.count) return f.count(d);
+  return f.flag(d);
+}
+
+nlohmann::json dem_figures_json(const DropRecord& d) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& f : dem_figure_fields()) j[f.key] = dem_figure_json(d, f);
+  return j;
 }
 
 const std::vector<RecordField<BedSummary>>& bed_summary_fields() {
@@ -63,7 +111,6 @@ const std::vector<RecordField<BedSummary>>& bed_summary_fields() {
   return fields;
 }
 
-nlohmann::json to_json(const DemFigures& d) { return record_json(d, dem_figure_fields()); }
 nlohmann::json to_json(const BedSummary& b) { return record_json(b, bed_summary_fields()); }
 
 BedSummary bed_summary_of_json(const nlohmann::json& j, const std::string& where) {

@@ -1,8 +1,8 @@
-// What a bed job and a drop job report beside the paper's metrics, as typed records with one
-// field table each (record_fields.h): a drop's DEM figures (depths below the bed's mean surface,
-// rest, steps, the run's setup) and a bed's preparation report. The job's JSON, its results
-// columns and the bed file's `report` attribute are made from these tables; readers (export,
-// `run`'s summary) read the typed records back.
+// What a bed job and a drop job report beside the paper's metrics, each with one field table: a
+// drop's DEM figures (depths below the bed's mean surface, rest, steps, the run's setup), read by
+// their table from the drop's own record (DropRecord), and a bed's preparation report, a typed
+// record (record_fields.h). The job's JSON, its results columns and the bed file's `report`
+// attribute are made from these tables.
 #pragma once
 #include <nlohmann/json.hpp>
 
@@ -10,7 +10,10 @@
 #include <string>
 #include <vector>
 
+#include "engine/scenario/impact.h"
 #include "results/io/record_fields.h"
+#include "results/io/trace_file.h"
+#include "results/processing/trace.h"
 
 namespace gravsweep::results {
 
@@ -21,36 +24,46 @@ struct CheckpointCounts {
   long long written = 0;               ///< checkpoints this attempt wrote
 };
 
-/// The DEM side of a drop (engine frame facts in the paper's frame: depth z positive down from the
-/// bed's mean surface). Its keys are disjoint from the paper's metrics (metric_fields()): the
-/// processed record's `final_depth_m` is measured from the collision start, this record's
-/// `final_depth_below_surface_m` from the surface.
-struct DemFigures {
-  double max_depth_m = 0;                    ///< deepest point of the projectile's bottom below the surface
-  double final_depth_below_surface_m = 0;    ///< its depth at the last sample
-  std::optional<double> first_contact_s;     ///< first contact with a grain, since release
-  bool stopped = false;                      ///< Sect. 2.2's stop criterion met (false: time cap)
-  long long grains_spilled_over_rim = 0;     ///< low-gravity ejecta removed (engine/scenario/impact.h)
-  std::optional<double> rest_time_s;         ///< start of the hold that met the stop criterion
-  std::optional<double> duration_to_rest_s;  ///< rest_time_s less the paper's collision start
-  double simulated_time_s = 0;
-  long long steps = 0;
-  double dt_s = 0;
-  double sample_rate_hz = 0;
-  double gravity_m_s2 = 0;
-  long long grains = 0;
-  double surface_height_m = 0;  ///< engine z of the bed's mean surface (floor at 0)
-  double release_speed_m_s = 0;
-  double release_height_above_surface_m = 0;
-  double first_touch_height_above_surface_m = 0;
+/// A drop's outputs as its run holds them, in the records where they were made: the paper's
+/// metrics as processing made them, the trace record (its samples' columns, dt, gravity, sample
+/// rate, the bed's surface, the release speed, the stop flag), the engine's result (its samples
+/// taken over by the trace; first contact, rest, steps, grains spilled, first touch) and the few
+/// facts of the run kept from the System and the job as they end (the bed's grains, the impact
+/// point, threads, wall time, checkpoints). The DEM's figures are read from it by their table (dem_figure_fields()): no
+/// record of copies of them is made.
+struct DropRecord {
+  /// The paper's metrics; none when the trace could not be measured: metrics_error says why.
+  std::optional<Metrics> metrics;
+  std::string metrics_error;
+  TraceData trace;              ///< the drop's trace, as trace.h5 holds it
+  DropResult result;            ///< the engine's result, its samples taken by `trace` (left empty)
+  long long bed_grains = 0;     ///< grains of the bed it was dropped into
   double lateral_offset_m = 0;  ///< impact point's distance from the container's axis
   long long threads = 0;
   double wall_time_s = 0;
-  long long checkpoint_resumes = 0;
-  std::optional<double> resumed_at_s;
-  long long checkpoints_written = 0;
+  CheckpointCounts checkpoints;
 };
-const std::vector<RecordField<DemFigures>>& dem_figure_fields();
+
+/// One of the DEM's figures of a drop (engine frame facts in the paper's frame: depth z positive
+/// down from the bed's mean surface) and how it is read from the drop's record. Exactly one getter
+/// is set: a number, a number that may be absent (JSON null), a count or a flag. The keys are
+/// disjoint from the paper's metrics (metric_fields()): the processed `final_depth_m` is measured
+/// from the collision start, `final_depth_below_surface_m` from the surface.
+struct DemFigureField {
+  const char* key;   ///< JSON key and results column (units in the name)
+  const char* unit;  ///< SI unit; "1" for counts and flags
+  double (*number)(const DropRecord&) = nullptr;
+  std::optional<double> (*maybe)(const DropRecord&) = nullptr;
+  long long (*count)(const DropRecord&) = nullptr;
+  bool (*flag)(const DropRecord&) = nullptr;
+  /// Its column type where a drop's results row holds it: REAL or INTEGER (counts, flags).
+  [[nodiscard]] const char* sql_type() const { return number || maybe ? "REAL" : "INTEGER"; }
+};
+const std::vector<DemFigureField>& dem_figure_fields();
+/// Figure f of the drop d as a JSON value (an absent number as null).
+nlohmann::json dem_figure_json(const DropRecord& d, const DemFigureField& f);
+/// Every figure of d, {key: value}.
+nlohmann::json dem_figures_json(const DropRecord& d);
 
 /// A prepared bed's report (Sect. 2.2: pour, settle, flatten, relax), kept in bed.h5's `report`
 /// attribute and in the bed job's results. A number a bed of an older build did not record reads
@@ -83,7 +96,7 @@ struct BedSummary {
 };
 const std::vector<RecordField<BedSummary>>& bed_summary_fields();
 
-/// The checkpoint's counts into a record of either kind.
+/// The checkpoint's counts into a bed's report.
 template <class R>
 void set_checkpoint_counts(R& r, const CheckpointCounts& c) {
   r.checkpoint_resumes = c.resumes;
@@ -91,7 +104,6 @@ void set_checkpoint_counts(R& r, const CheckpointCounts& c) {
   r.checkpoints_written = c.written;
 }
 
-nlohmann::json to_json(const DemFigures& d);
 nlohmann::json to_json(const BedSummary& b);
 /// A bed's report from its JSON (bed.h5's `report`, a bed job's results); `where` names the
 /// source in an error (a key of the wrong type).

@@ -1,6 +1,7 @@
 // A record's field table: one row per field (its key, unit and the member it lives in), from which
-// the record's JSON is written and read. A record that a job reports (the DEM figures of a drop,
-// the report of a bed) is a struct with such a table; nothing else lists its keys.
+// the record's JSON is written and read. A record that a job reports (the report of a bed) is a
+// struct with such a table; nothing else lists its keys. (A drop's DEM figures have a table of
+// getters instead, job_reports.h: they are read from the drop's own record, not kept in a struct.)
 #pragma once
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>

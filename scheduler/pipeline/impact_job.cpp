@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 #include <memory>
+#include <utility>
 
 #include "engine/core/error.h"
 #include "engine/scenario/bed.h"
@@ -293,7 +294,7 @@ std::optional<results::Metrics> paper_metrics(const results::TraceData& td, cons
   try {
     results::MeasuredTrial trial = results::dem_trial_of(td, {"", "", trace_out});
     results::process_trial(trial);
-    return trial.processed.metrics;
+    return std::move(trial.processed.metrics);  // the metrics as processing made them
   } catch (const std::exception& e) {
     error = e.what();
     return std::nullopt;
@@ -335,29 +336,30 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   DropResult dr = resume_or_start(ckpt, ckpt.resume_drop() != nullptr, drop);
   const double wall_s = seconds_since(t0) + ckpt.prior_wall_time_s();
 
-  results::TraceData td = trace_of(dr, s, validated, bed, bed_in);
-  // The run's outputs, the records themselves (no copy into JSON): the trace's text is written from them.
+  // The run's outputs are its records themselves, moved into what the runner returns (no copy
+  // into JSON or into a record of figures): the trace, the engine's result, the metrics.
   auto outputs = std::make_shared<sweep::DropOutputs>();
-  outputs->metrics = paper_metrics(td, trace_out, outputs->metrics_error);
-  const auto& metrics = outputs->metrics;
-  const std::optional<double> t_start = metrics ? std::optional<double>(metrics->t_start_s) : std::nullopt;
-  results::DemFigures& dem = outputs->dem = results::dem_figures_of(
-      td, dr, bed, bed_grains, t_start, std::hypot(projectile.lateral_offset_x_m, projectile.lateral_offset_y_m));
-  dem.threads = sys.threads();
-  dem.wall_time_s = wall_s;
-  results::set_checkpoint_counts(dem, ckpt.counts());
+  results::DropRecord& rec = *outputs;
+  rec.trace = trace_of(dr, s, validated, bed, bed_in);
+  rec.result = std::move(dr);
+  rec.metrics = paper_metrics(rec.trace, trace_out, rec.metrics_error);
+  rec.bed_grains = static_cast<long long>(bed_grains);
+  rec.lateral_offset_m = std::hypot(projectile.lateral_offset_x_m, projectile.lateral_offset_y_m);
+  rec.threads = sys.threads();
+  rec.wall_time_s = wall_s;
+  rec.checkpoints = ckpt.counts();
   check_stop(stop, "drop");
   DropJobResult out;
   out.trace_path = trace_out;
-  out.record = std::move(outputs);
-  td.metrics_json = out.outputs_json().dump();
+  out.record = outputs;
+  rec.trace.metrics_json = out.outputs_json().dump();  // the trace's text, written from the record
   if (snaps) {
     out.snapshots = snaps->count();
     out.snapshot_bytes = snaps->bytes_per_snapshot();
     out.snapshot_path = results::snapshot_path_for(trace_out);
     out.snapshot_xdmf = snaps->finish();
   }
-  results::write_trace(trace_out, td);
+  results::write_trace(trace_out, rec.trace);
   ckpt.finished();
   return out;
 }

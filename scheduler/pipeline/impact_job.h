@@ -33,9 +33,10 @@ struct BedJobResult {
   results::BedSummary report;  ///< the preparation's report, as bed.h5's `report` holds it
 };
 
-/// The drop's outputs as its runner reports them (record: a sweep::DropOutputs, the paper's
-/// metrics vc_m_s, apeak_m_s2, zstop_m, tstop_s, rebound, ... and the DEM's figures, wall_time_s,
-/// ...) with the files it wrote.
+/// The drop's outputs as its runner reports them (record: a sweep::DropOutputs, the drop's own
+/// record: the paper's metrics vc_m_s, apeak_m_s2, zstop_m, tstop_s, rebound, ..., the trace and
+/// the engine's result, from which the DEM's figures, wall_time_s, ... are read) with the files it
+/// wrote.
 struct DropJobResult : queue::RunOutput {
   std::filesystem::path trace_path;
   /// Grain snapshots (/output/snapshot_interval_s > 0): the .h5 and its .xdmf index, else empty.

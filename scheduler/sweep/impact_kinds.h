@@ -2,9 +2,6 @@
 // preparation and a drop. The sweep plans them (spec.h); pipeline/ runs them. A drop's outputs
 // are declared and reported from the same field tables (DropOutputs).
 #pragma once
-#include <optional>
-#include <string>
-
 #include "results/io/job_reports.h"
 #include "results/processing/trace.h"
 #include "scheduler/queue/job_types.h"
@@ -20,15 +17,11 @@ queue::JobKind bed_kind();
 /// and metrics_error, why a trace could not be measured (pipeline/impact_job.cpp:run_drop_job).
 queue::JobKind drop_kind();
 
-/// A drop's outputs as its runner reports them (queue::RunOutput::record): the paper's metrics as
-/// processing made them and the DEM's figures, the typed records themselves, read by their field
-/// tables (the tables that declare drop_kind()'s outputs) where a value is needed.
-struct DropOutputs final : queue::OutputRecord {
-  /// The paper's metrics; none when the trace could not be measured: then every number and flag
-  /// of metric_fields() is null and metrics_error says why.
-  std::optional<results::Metrics> metrics;
-  std::string metrics_error;
-  results::DemFigures dem;
+/// A drop's outputs as its runner reports them (queue::RunOutput::record): the drop's own record
+/// (results::DropRecord: the paper's metrics as processing made them, the trace record and the
+/// engine's result, owned by move, and the run's facts), read by the tables that declare
+/// drop_kind()'s outputs (metric_fields(), dem_figure_fields()) where a value is needed.
+struct DropOutputs final : queue::OutputRecord, results::DropRecord {
   void each_output(const Visit& visit) const override;
 };
 

@@ -1,10 +1,13 @@
 // The records a bed job and a drop job report (results/io/job_reports.h): one field table each,
-// no key shared with the paper's metrics, and a round trip through JSON (the bed file's `report`).
+// no key shared with the paper's metrics, a drop's figures read from its own record, and a round
+// trip through JSON (the bed file's `report`).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "results/io/job_reports.h"
 #include "results/processing/metric_fields.h"
@@ -25,14 +28,66 @@ TEST(JobReports, EveryFieldHasOneMemberAndAUnitAndAUniqueKey) {
   const auto check = [](const auto& fields) {
     std::set<std::string> keys;
     for (const auto& f : fields) {
-      const int members = !!f.number + !!f.maybe + !!f.count + !!f.flag + !!f.text;
+      int members = !!f.number + !!f.maybe + !!f.count + !!f.flag;
+      if constexpr (requires { f.text; }) members += !!f.text;
       EXPECT_EQ(members, 1) << f.key;
       EXPECT_TRUE(keys.insert(f.key).second) << f.key << " twice";
-      EXPECT_TRUE(f.text || std::string(f.unit) != "") << f.key << " has no unit";
+      EXPECT_TRUE(std::string(f.unit) != "" || std::string(f.sql_type()) == "TEXT") << f.key << " has no unit";
     }
   };
   check(dem_figure_fields());
   check(bed_summary_fields());
+}
+
+TEST(JobReports, TheDemFiguresAreReadFromTheDropsOwnRecord) {
+  // No record of copies: each figure is read where the drop holds it (the trace, the engine's
+  // result, the metrics, the run's facts), the depths and durations computed from them.
+  DropRecord d;
+  d.trace.t_s = {0.0, 0.1, 0.2};
+  d.trace.depth_m = {-0.01, 0.03, 0.02};
+  d.trace.dt_s = 1e-5;
+  d.trace.sample_rate_hz = 10.0;
+  d.trace.surface_height_m = 0.0625;  // binary fractions: exact differences
+  d.trace.release_height_m = 0.078125;
+  d.trace.release_speed_m_s = 0.5;
+  d.trace.stopped = true;
+  d.result.first_touch_height_m = 0.0703125;
+  d.result.first_contact_s = 0.05;
+  d.result.rest_s = 0.375;
+  d.result.steps = 20000;
+  d.result.grains_spilled = 3;
+  d.bed_grains = 2200;
+  d.threads = 2;
+  d.checkpoints.written = 1;
+  const auto json_of = [&] { return nlohmann::json::parse(dem_figures_json(d).dump()); };
+  nlohmann::json j = json_of();
+  EXPECT_EQ(j["max_depth_m"], 0.03);
+  EXPECT_EQ(j["final_depth_below_surface_m"], 0.02);
+  EXPECT_EQ(j["simulated_time_s"], 0.2);
+  EXPECT_EQ(j["stopped"], true);
+  EXPECT_EQ(j["grains_spilled_over_rim"], 3);
+  EXPECT_EQ(j["steps"], 20000);
+  EXPECT_EQ(j["grains"], 2200);
+  EXPECT_EQ(j["threads"], 2);
+  EXPECT_EQ(j["checkpoints_written"], 1);
+  EXPECT_EQ(j["first_contact_s"], 0.05);
+  EXPECT_EQ(j["rest_time_s"], 0.375);
+  EXPECT_TRUE(j["duration_to_rest_s"].is_null()) << "no metrics: no collision start";
+  EXPECT_TRUE(j["resumed_at_s"].is_null());
+  EXPECT_EQ(j["release_height_above_surface_m"], 0.015625);
+  EXPECT_EQ(j["first_touch_height_above_surface_m"], 0.0078125);
+  d.metrics = Metrics{};
+  d.metrics->t_start_s = 0.125;
+  j = json_of();
+  EXPECT_EQ(j["duration_to_rest_s"], 0.25);
+  // Every key of the table, once.
+  std::vector<std::string> keys;
+  const nlohmann::json all = dem_figures_json(d);
+  for (const auto& [key, value] : all.items()) keys.push_back(key);
+  std::vector<std::string> table;
+  for (const auto& f : dem_figure_fields()) table.emplace_back(f.key);
+  std::sort(table.begin(), table.end());  // nlohmann::json objects iterate by key
+  EXPECT_EQ(keys, table);
 }
 
 TEST(JobReports, ABedReportRoundTripsAndAnOlderOneReadsWhatItHas) {

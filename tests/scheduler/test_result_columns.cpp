@@ -194,8 +194,8 @@ TEST_P(ResultColumns, ADropsRecordIsBoundToItsColumnsAsItHoldsItsValues) {
       outputs->metrics = m;
     else
       outputs->metrics_error = "no contact";
-    outputs->dem.steps = 12345;
-    outputs->dem.first_contact_s = 0.125;
+    outputs->result.steps = 12345;
+    outputs->result.first_contact_s = 0.125;
     Completion d = done_for(*c, json::object());
     d.record = outputs;
     check_outputs(c->kind, d);
@@ -205,7 +205,7 @@ TEST_P(ResultColumns, ADropsRecordIsBoundToItsColumnsAsItHoldsItsValues) {
     for (const auto& f : results::metric_fields())
       if (measured || !f.text) text[f.key] = measured ? json(m)[f.key] : json(nullptr);
     if (!measured) text["metrics_error"] = "no contact";
-    text.update(results::to_json(outputs->dem));
+    text.update(results::dem_figures_json(*outputs));
     EXPECT_EQ(d.outputs_json(), text);
     ASSERT_TRUE(complete(db, *c, d));
     const char* metrics_where =
