@@ -85,10 +85,11 @@ struct ClusterFixture : ::testing::Test {
 TEST_F(ClusterFixture, ATinyImpactCampaignCompletesThroughSlurmWithATaskScancelledMidJob) {
   // 2 beds and 8 drops (4 speeds per bed, 6 s simulated: 3-18 s each), 2 pilot workers of 1 thread
   // (this machine's cores). Progress is written at each heartbeat (1.25 s with --lease 5), so the
-  // value read may be that old: a drop must outlast the heartbeat by far, and the window read (5-40 %)
+  // value read may be that old: a drop must outlast the heartbeat by far, and the window read (5-25 %)
   // must end well before the drop does. Seen on 2026-12-02: with 1 s simulated no task was ever seen
   // mid-job (each drop took about 1 s); with 4 s and a window up to 70 % the job was done before the
-  // scancel landed.
+  // scancel landed. Seen under load (the suite on 2 cores beside a campaign): with a window up to
+  // 40 % a 3 s drop read at one heartbeat (about 40 % of it) was done before the scancel landed.
   json base = json::parse(tiny_base());
   base["stop"]["max_time_s"] = 6.0;
   base["at_rest"] = {{"surface_speed_fraction", 1.0}, {"rms_speed_fraction", 1.0}};  // a quick test bed
@@ -111,7 +112,7 @@ TEST_F(ClusterFixture, ATinyImpactCampaignCompletesThroughSlurmWithATaskScancell
   // lease names its Slurm task, and status shows it.
   const std::string mid_job =
       "SELECT substr(a.worker, strpos(a.worker, ':slurm=') + 7) || ' ' || a.job_id FROM attempts a JOIN jobs j ON "
-      "j.job_id=a.job_id WHERE a.outcome='running' AND j.state='running' AND j.progress > 0.05 AND j.progress < 0.4 "
+      "j.job_id=a.job_id WHERE a.outcome='running' AND j.state='running' AND j.progress > 0.05 AND j.progress < 0.25 "
       "AND a.worker LIKE '%:slurm=" +
       array + "%' ORDER BY j.progress LIMIT 1";
   std::string found;
