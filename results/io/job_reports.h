@@ -97,8 +97,7 @@ struct BedSummary {
 const std::vector<RecordField<BedSummary>>& bed_summary_fields();
 
 /// The checkpoint's counts into a bed's report.
-template <class R>
-void set_checkpoint_counts(R& r, const CheckpointCounts& c) {
+inline void set_checkpoint_counts(BedSummary& r, const CheckpointCounts& c) {
   r.checkpoint_resumes = c.resumes;
   r.resumed_at_s = c.resumed_at_s;
   r.checkpoints_written = c.written;
