@@ -26,10 +26,10 @@ std::optional<double> duration_to_rest_s(const DropRecord& d) {
 // Each figure is read where the drop holds it: the trace record (its columns, dt, gravity, sample
 // rate, surface, release speed, stop flag), the engine's result (first contact, rest, steps,
 // spilled grains, release and first-touch heights), the metrics, or the run's own facts.
-const std::vector<DemFigureField>& dem_figure_fields() {
+const std::vector<RecordField<DropRecord>>& dem_figure_fields() {
   using D = DropRecord;
   using Maybe = std::optional<double>;
-  static const std::vector<DemFigureField> fields = {
+  static const std::vector<RecordField<D>> fields = {
       {.key = "max_depth_m", .unit = "m", .number = max_depth_m},
       {.key = "final_depth_below_surface_m", .unit = "m", .number = final_depth_m},
       {.key = "first_contact_s", .unit = "s", .maybe = [](const D& d) -> Maybe { return d.result.first_contact_s; }},
@@ -65,21 +65,7 @@ const std::vector<DemFigureField>& dem_figure_fields() {
   return fields;
 }
 
-nlohmann::json dem_figure_json(const DropRecord& d, const DemFigureField& f) {
-  if (f.number) return f.number(d);
-  if (f.maybe) {
-    const std::optional<double> v = f.maybe(d);
-    return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
-  }
-  if (f.count) return f.count(d);
-  return f.flag(d);
-}
-
-nlohmann::json dem_figures_json(const DropRecord& d) {
-  nlohmann::json j = nlohmann::json::object();
-  for (const auto& f : dem_figure_fields()) j[f.key] = dem_figure_json(d, f);
-  return j;
-}
+nlohmann::json dem_figures_json(const DropRecord& d) { return record_json(d, dem_figure_fields()); }
 
 const std::vector<RecordField<BedSummary>>& bed_summary_fields() {
   using B = BedSummary;

@@ -1,7 +1,7 @@
-// What a bed job and a drop job report beside the paper's metrics, each with one field table: a
-// drop's DEM figures (depths below the bed's mean surface, rest, steps, the run's setup), read by
-// their table from the drop's own record (DropRecord), and a bed's preparation report, a typed
-// record (record_fields.h). The job's JSON, its results columns and the bed file's `report`
+// What a bed job and a drop job report beside the paper's metrics, each with one field table
+// (record_fields.h): a drop's DEM figures (depths below the bed's mean surface, rest, steps, the
+// run's setup), read by their table's getters from the drop's own record (DropRecord), and a
+// bed's preparation report, a typed record of members. The job's JSON, its results columns and the bed file's `report`
 // attribute are made from these tables.
 #pragma once
 #include <nlohmann/json.hpp>
@@ -44,25 +44,13 @@ struct DropRecord {
   CheckpointCounts checkpoints;
 };
 
-/// One of the DEM's figures of a drop (engine frame facts in the paper's frame: depth z positive
-/// down from the bed's mean surface) and how it is read from the drop's record. Exactly one getter
-/// is set: a number, a number that may be absent (JSON null), a count or a flag. The keys are
-/// disjoint from the paper's metrics (metric_fields()): the processed `final_depth_m` is measured
-/// from the collision start, `final_depth_below_surface_m` from the surface.
-struct DemFigureField {
-  const char* key;   ///< JSON key and results column (units in the name)
-  const char* unit;  ///< SI unit; "1" for counts and flags
-  double (*number)(const DropRecord&) = nullptr;
-  std::optional<double> (*maybe)(const DropRecord&) = nullptr;
-  long long (*count)(const DropRecord&) = nullptr;
-  bool (*flag)(const DropRecord&) = nullptr;
-  /// Its column type where a drop's results row holds it: REAL or INTEGER (counts, flags).
-  [[nodiscard]] const char* sql_type() const { return number || maybe ? "REAL" : "INTEGER"; }
-};
-const std::vector<DemFigureField>& dem_figure_fields();
-/// Figure f of the drop d as a JSON value (an absent number as null).
-nlohmann::json dem_figure_json(const DropRecord& d, const DemFigureField& f);
-/// Every figure of d, {key: value}.
+/// The DEM's figures of a drop (engine frame facts in the paper's frame: depth z positive down
+/// from the bed's mean surface), each read by a getter from the drop's record: a number, a number
+/// that may be absent (JSON null), a count or a flag. The keys are disjoint from the paper's
+/// metrics (metric_fields()): the processed `final_depth_m` is measured from the collision start,
+/// `final_depth_below_surface_m` from the surface.
+const std::vector<RecordField<DropRecord>>& dem_figure_fields();
+/// Every figure of d, {key: value} (record_json over dem_figure_fields()).
 nlohmann::json dem_figures_json(const DropRecord& d);
 
 /// A prepared bed's report (Sect. 2.2: pour, settle, flatten, relax), kept in bed.h5's `report`

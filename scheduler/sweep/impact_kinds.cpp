@@ -38,7 +38,7 @@ void DropOutputs::each_output(const Visit& visit) const {
       visit(f.key, nullptr);  // unmeasured; the note is left out (NULL)
   }
   if (!metrics) visit(kMetricsErrorKey, metrics_error);
-  for (const auto& f : results::dem_figure_fields()) visit(f.key, results::dem_figure_json(*this, f));
+  for (const auto& f : results::dem_figure_fields()) visit(f.key, results::field_json<results::DropRecord>(*this, f));
 }
 
 namespace {

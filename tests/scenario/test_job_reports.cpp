@@ -90,6 +90,28 @@ TEST(JobReports, TheDemFiguresAreReadFromTheDropsOwnRecord) {
   EXPECT_EQ(keys, table);
 }
 
+TEST(JobReports, OneFieldTableTypeReadsAMemberOrAGetterAndReadsBackOnlyMembers) {
+  // The bed's report (members) and the drop's figures (getters) are rows of one RecordField type,
+  // written to JSON by one field_json; only a member can be read back from JSON.
+  BedSummary b;
+  b.steps = 7;
+  const auto& bed = bed_summary_fields();
+  const auto steps = std::find_if(bed.begin(), bed.end(), [](const auto& f) { return std::string(f.key) == "steps"; });
+  ASSERT_NE(steps, bed.end());
+  EXPECT_TRUE(steps->count.member && !steps->count.getter);
+  EXPECT_EQ(field_json(b, *steps), 7);
+  DropRecord d;
+  d.result.steps = 9;
+  const auto& dem = dem_figure_fields();
+  const auto figure = std::find_if(dem.begin(), dem.end(), [](const auto& f) { return std::string(f.key) == "steps"; });
+  ASSERT_NE(figure, dem.end());
+  EXPECT_TRUE(figure->count.getter && !figure->count.member);
+  EXPECT_EQ(field_json(d, *figure), 9);
+  EXPECT_EQ(std::string(figure->sql_type()), "INTEGER");
+  EXPECT_THROW(record_of_json(nlohmann::json{{"steps", 9}}, dem, "figures"), std::logic_error);
+  EXPECT_EQ(record_of_json(nlohmann::json{{"steps", 9}}, bed, "report").steps, 9);
+}
+
 TEST(JobReports, ABedReportRoundTripsAndAnOlderOneReadsWhatItHas) {
   BedSummary b;
   b.grains_kept = 18220;
