@@ -9,13 +9,9 @@
 #include "engine/core/error.h"
 #include "scheduler/queue/dialect.h"
 #include "scheduler/queue/queue.h"
+#include "scheduler/queue/queue_internal.h"
 
 namespace gravsweep::queue {
-
-using db::Database;
-using db::Statement;
-using db::Transaction;
-namespace fs = std::filesystem;
 
 namespace {
 

@@ -10,12 +10,6 @@
 
 namespace gravsweep::queue {
 
-using db::Database;
-using db::Statement;
-using db::Transaction;
-using nlohmann::json;
-namespace fs = std::filesystem;
-
 namespace detail {
 
 void cascade_dead(Database& db, const std::string& job_id, double now) {

@@ -10,11 +10,6 @@
 
 namespace gravsweep::queue {
 
-using db::Database;
-using db::Statement;
-using db::Transaction;
-namespace fs = std::filesystem;
-
 namespace {
 
 /// Copies every row of `table` (all columns, by name) from src to dst; returns the row count.

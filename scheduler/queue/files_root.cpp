@@ -13,14 +13,9 @@
 #include "engine/core/error.h"
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/queue.h"
+#include "scheduler/queue/queue_internal.h"
 
 namespace gravsweep::queue {
-
-using db::Database;
-using db::Statement;
-using db::Transaction;
-using nlohmann::json;
-namespace fs = std::filesystem;
 
 namespace {
 

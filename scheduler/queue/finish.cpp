@@ -12,12 +12,6 @@
 
 namespace gravsweep::queue {
 
-using db::Database;
-using db::Statement;
-using db::Transaction;
-using nlohmann::json;
-namespace fs = std::filesystem;
-
 namespace {
 
 /// Closes the attempt row of an attempt that did not complete: its outcome ('failed', 'dead',

@@ -1,14 +1,25 @@
-// What the queue's source files share (not part of the queue's interface): the statements that
-// more than one verb runs inside its own transaction, and the results table's dynamic columns.
+// What the queue's source files share (not part of the queue's interface): the names they use, the
+// statements that more than one verb runs inside its own transaction, and the results table's
+// columns.
 #pragma once
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
 #include <map>
 #include <string>
 #include <vector>
 
 #include "scheduler/queue/dialect.h"
 #include "scheduler/queue/queue.h"
+
+namespace gravsweep::queue {
+// The names every source file of the queue uses.
+using db::Database;
+using db::Statement;
+using db::Transaction;
+using nlohmann::json;
+namespace fs = std::filesystem;
+}  // namespace gravsweep::queue
 
 namespace gravsweep::queue::detail {
 

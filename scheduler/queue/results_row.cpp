@@ -9,10 +9,6 @@
 
 namespace gravsweep::queue::detail {
 
-using db::Database;
-using db::Statement;
-using nlohmann::json;
-
 namespace {
 
 void bind_json_value(Statement& st, int idx, const json& v) {

@@ -11,10 +11,6 @@
 
 namespace gravsweep::queue {
 
-using db::Database;
-using db::Statement;
-using nlohmann::json;
-
 namespace detail {
 
 const std::vector<FixedResultColumn>& fixed_result_columns() {

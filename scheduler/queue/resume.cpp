@@ -5,12 +5,6 @@
 
 namespace gravsweep::queue {
 
-using db::Database;
-using db::Statement;
-using db::Transaction;
-using nlohmann::json;
-namespace fs = std::filesystem;
-
 void remove_lost_files(const CampaignPaths& paths, const Reclaimed& r) {
   std::error_code ec;
   for (const auto& rel : r.output_rels) fs::remove(paths.abs(rel), ec);

@@ -124,12 +124,6 @@ std::string schema_sql(const Dialect& d) {
 
 }  // namespace
 
-using db::Database;
-using db::Statement;
-using db::Transaction;
-using nlohmann::json;
-namespace fs = std::filesystem;
-
 double now_s() { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); }
 
 void ensure_schema(Database& db) {

@@ -6,10 +6,6 @@
 
 namespace gravsweep::queue {
 
-using db::Database;
-using db::Statement;
-using db::Transaction;
-
 namespace {
 
 using SweepKind = std::pair<std::string, std::string>;

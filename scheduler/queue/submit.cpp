@@ -7,12 +7,6 @@
 
 namespace gravsweep::queue {
 
-using db::Database;
-using db::Statement;
-using db::Transaction;
-using nlohmann::json;
-namespace fs = std::filesystem;
-
 namespace {
 
 /// The sweep's row (its spec as submitted last; `submits` counts the submissions).
