@@ -50,16 +50,16 @@ TraceData take_trace_columns(DropResult& dr, double nominal_rate_hz) {
   DropSamples& s = dr.samples;
   const double sample_dt = s.size() > 1 ? s.t_s[1] - s.t_s[0] : 1.0 / nominal_rate_hz;
   TraceData td;
-  td.t_s = std::move(s.t_s);
-  td.depth_m = std::move(s.depth_m);
-  td.velocity_down_m_s = std::move(s.velocity_down_m_s);
-  td.accel_up_m_s2 = std::move(s.accel_up_m_s2);
+  td.raw.t_s = std::move(s.t_s);
+  td.raw.depth_m = std::move(s.depth_m);
+  td.raw.velocity_down_m_s = std::move(s.velocity_down_m_s);
+  td.raw.accel_up_m_s2 = std::move(s.accel_up_m_s2);
   td.omega_rad_s = std::move(s.omega_rad_s);
   td.position_m = std::move(s.position_m);
   td.contacts = std::move(s.contacts);
   td.grain_kinetic_energy_J = std::move(s.grain_kinetic_energy_J);
   s = DropSamples{};  // taken: empty, not a moved-from state
-  td.sample_rate_hz = 1.0 / sample_dt;
+  td.info.sample_rate_hz = 1.0 / sample_dt;
   td.release_height_m = dr.release_height_m;
   td.release_speed_m_s = dr.release_speed_m_s;
   td.stopped = dr.stopped;

@@ -26,9 +26,10 @@ BedFacts bed_facts_of(const System& sys);
 BedFacts load_bed(System& sys, const std::filesystem::path& bed);
 
 /// The drop's record as a trace: the columns of its samples taken over as they are (moved, so the
-/// values the engine wrote are the trace's own and none is copied; `dr.samples` is left empty),
-/// with its release facts and stop flag; the sample rate is the samples' own (`nominal_rate_hz`
-/// for a trace of one sample).
+/// values the engine wrote are the trace's own and none is copied; `dr.samples` is left empty):
+/// the four that processing reads into the trial's trace, `raw`, the others into the record's
+/// own; with its release facts and stop flag. The sample rate, a trial fact, is the samples' own
+/// (`nominal_rate_hz` for a trace of one sample).
 TraceData take_trace_columns(DropResult& dr, double nominal_rate_hz);
 
 /// One grain snapshot: every particle before `projectile` as a grain (the bed's order), the

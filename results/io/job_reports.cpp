@@ -9,23 +9,24 @@ namespace {
 
 /// The depth below the bed's mean surface at the deepest and at the last sample (0: no sample).
 double max_depth_m(const DropRecord& d) {
-  const auto& z = d.trace.depth_m;
+  const auto& z = d.trace.raw.depth_m;
   return z.empty() ? 0.0 : *std::max_element(z.begin(), z.end());
 }
-double final_depth_m(const DropRecord& d) { return d.trace.depth_m.empty() ? 0.0 : d.trace.depth_m.back(); }
+double final_depth_m(const DropRecord& d) { return d.trace.raw.depth_m.empty() ? 0.0 : d.trace.raw.depth_m.back(); }
 
 /// Sect. 2.2's stop criterion (speed < stop.speed_m_s after contact) met: how long after the
 /// paper's collision start (a DEM-side duration next to tstop); none without both.
 std::optional<double> duration_to_rest_s(const DropRecord& d) {
-  if (!d.result.rest_s || !d.metrics) return std::nullopt;
-  return *d.result.rest_s - d.metrics->t_start_s;
+  if (!d.result.rest_s || !d.metrics()) return std::nullopt;
+  return *d.result.rest_s - d.metrics()->t_start_s;
 }
 
 }  // namespace
 
-// Each figure is read where the drop holds it: the trace record (its columns, dt, gravity, sample
-// rate, surface, release speed, stop flag), the engine's result (first contact, rest, steps,
-// spilled grains, release and first-touch heights), the metrics, or the run's own facts.
+// Each figure is read where the drop holds it: the trace record (its columns, dt, release speed,
+// stop flag, and the trial facts in it: gravity, sample rate, the surface as the fill height), the
+// engine's result (first contact, rest, steps, spilled grains, release and first-touch heights),
+// the metrics, or the run's own facts.
 const std::vector<RecordField<DropRecord>>& dem_figure_fields() {
   using D = DropRecord;
   using Maybe = std::optional<double>;
@@ -41,20 +42,20 @@ const std::vector<RecordField<DropRecord>>& dem_figure_fields() {
       {.key = "duration_to_rest_s", .unit = "s", .maybe = duration_to_rest_s},
       {.key = "simulated_time_s",
        .unit = "s",
-       .number = [](const D& d) { return d.trace.t_s.empty() ? 0.0 : d.trace.t_s.back(); }},
+       .number = [](const D& d) { return d.trace.raw.t_s.empty() ? 0.0 : d.trace.raw.t_s.back(); }},
       {.key = "steps", .unit = "1", .count = [](const D& d) { return d.result.steps; }},
       {.key = "dt_s", .unit = "s", .number = [](const D& d) { return d.trace.dt_s; }},
-      {.key = "sample_rate_hz", .unit = "Hz", .number = [](const D& d) { return d.trace.sample_rate_hz; }},
-      {.key = "gravity_m_s2", .unit = "m/s2", .number = [](const D& d) { return d.trace.gravity_m_s2; }},
+      {.key = "sample_rate_hz", .unit = "Hz", .number = [](const D& d) { return d.trace.info.sample_rate_hz; }},
+      {.key = "gravity_m_s2", .unit = "m/s2", .number = [](const D& d) { return d.trace.info.gravity_m_s2; }},
       {.key = "grains", .unit = "1", .count = [](const D& d) { return d.bed_grains; }},
-      {.key = "surface_height_m", .unit = "m", .number = [](const D& d) { return d.trace.surface_height_m; }},
+      {.key = "surface_height_m", .unit = "m", .number = [](const D& d) { return d.trace.info.fill_height_m; }},
       {.key = "release_speed_m_s", .unit = "m/s", .number = [](const D& d) { return d.trace.release_speed_m_s; }},
       {.key = "release_height_above_surface_m",
        .unit = "m",
-       .number = [](const D& d) { return d.trace.release_height_m - d.trace.surface_height_m; }},
+       .number = [](const D& d) { return d.trace.release_height_m - d.trace.info.fill_height_m; }},
       {.key = "first_touch_height_above_surface_m",
        .unit = "m",
-       .number = [](const D& d) { return d.result.first_touch_height_m - d.trace.surface_height_m; }},
+       .number = [](const D& d) { return d.result.first_touch_height_m - d.trace.info.fill_height_m; }},
       {.key = "lateral_offset_m", .unit = "m", .number = [](const D& d) { return d.lateral_offset_m; }},
       {.key = "threads", .unit = "1", .count = [](const D& d) { return d.threads; }},
       {.key = "wall_time_s", .unit = "s", .number = [](const D& d) { return d.wall_time_s; }},

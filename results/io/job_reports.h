@@ -24,18 +24,21 @@ struct CheckpointCounts {
   long long written = 0;               ///< checkpoints this attempt wrote
 };
 
-/// A drop's outputs as its run holds them, in the records where they were made: the paper's
-/// metrics as processing made them, the trace record (its samples' columns, dt, gravity, sample
-/// rate, the bed's surface, the release speed, the stop flag), the engine's result (its samples
+/// A drop's outputs as its run holds them, in the records where they were made: the trace record
+/// (the trial it was measured as: its samples' columns, its facts, dt, the release speed, the stop
+/// flag, and the paper's metrics as processing made them in it), the engine's result (its samples
 /// taken over by the trace; first contact, rest, steps, grains spilled, first touch) and the few
 /// facts of the run kept from the System and the job as they end (the bed's grains, the impact
-/// point, threads, wall time, checkpoints). The DEM's figures are read from it by their table (dem_figure_fields()): no
-/// record of copies of them is made.
+/// point, threads, wall time, checkpoints). The DEM's figures are read from it by their table
+/// (dem_figure_fields()): no record of copies of them is made.
 struct DropRecord {
-  /// The paper's metrics; none when the trace could not be measured: metrics_error says why.
-  std::optional<Metrics> metrics;
+  /// Whether the trace was measured (its processed metrics are the drop's); false: metrics_error
+  /// says why not.
+  bool measured = false;
   std::string metrics_error;
-  TraceData trace;              ///< the drop's trace, as trace.h5 holds it
+  /// The paper's metrics, where processing made them in the trace record; null when unmeasured.
+  [[nodiscard]] const Metrics* metrics() const { return measured ? &trace.processed.metrics : nullptr; }
+  TraceData trace;              ///< the drop's trace, as trace.h5 holds it, and its trial
   DropResult result;            ///< the engine's result, its samples taken by `trace` (left empty)
   long long bed_grains = 0;     ///< grains of the bed it was dropped into
   double lateral_offset_m = 0;  ///< impact point's distance from the container's axis

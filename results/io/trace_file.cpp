@@ -7,17 +7,17 @@
 namespace gravsweep::results {
 
 void TraceData::mark_contact_start() {
-  contact_start_s.reset();
-  for (std::size_t k = 0; k < contacts.size() && k < t_s.size(); ++k) {
+  raw.contact_start_s.reset();
+  for (std::size_t k = 0; k < contacts.size() && k < raw.t_s.size(); ++k) {
     if (contacts[k] > 0) {
-      contact_start_s = t_s[k == 0 ? 0 : k - 1];
+      raw.contact_start_s = raw.t_s[k == 0 ? 0 : k - 1];
       return;
     }
   }
 }
 
 const std::vector<TraceText>& trace_texts() {
-  static const std::vector<TraceText> t = {{"code_version", &TraceData::code_version},
+  static const std::vector<TraceText> t = {{"code_version", &Trial::code_version},
                                            {"scenario", &TraceData::scenario_json},
                                            {"bed_key", &TraceData::bed_key_json},
                                            {"bed_file", &TraceData::bed_file},
@@ -26,26 +26,25 @@ const std::vector<TraceText>& trace_texts() {
 }
 
 const std::vector<TraceAttribute>& trace_attributes() {
-  static const std::vector<TraceAttribute> t = {{"sample_rate_hz", &TraceData::sample_rate_hz},
+  static const std::vector<TraceAttribute> t = {{"sample_rate_hz", &Trial::sample_rate_hz},
                                                 {"dt_s", &TraceData::dt_s},
-                                                {"gravity_m_s2", &TraceData::gravity_m_s2},
-                                                {"surface_height_m", &TraceData::surface_height_m},
+                                                {"gravity_m_s2", &Trial::gravity_m_s2},
+                                                {"surface_height_m", &Trial::fill_height_m},
                                                 {"release_height_m", &TraceData::release_height_m},
                                                 {"release_speed_m_s", &TraceData::release_speed_m_s},
-                                                {"projectile_diameter_m", &TraceData::projectile_diameter_m},
-                                                {"projectile_mass_kg", &TraceData::projectile_mass_kg},
-                                                {"grain_diameter_m", &TraceData::grain_diameter_m}};
+                                                {"projectile_diameter_m", &Trial::projectile_diameter_m},
+                                                {"projectile_mass_kg", &Trial::projectile_mass_kg},
+                                                {"grain_diameter_m", &Trial::grain_diameter_m}};
   return t;
 }
 
 const std::vector<TraceColumn>& trace_columns() {
   static const std::vector<TraceColumn> t = {
-      {"t_s", &TraceData::t_s, 1, "s", "time since release"},
-      {"depth_m", &TraceData::depth_m, 1, "m",
+      {"t_s", &Trace::t_s, 1, "s", "time since release"},
+      {"depth_m", &Trace::depth_m, 1, "m",
        "depth of the projectile's lowest point below the mean bed surface (positive down)"},
-      {"velocity_down_m_s", &TraceData::velocity_down_m_s, 1, "m/s",
-       "vertical velocity of the projectile, positive down"},
-      {"accel_up_m_s2", &TraceData::accel_up_m_s2, 1, "m/s2",
+      {"velocity_down_m_s", &Trace::velocity_down_m_s, 1, "m/s", "vertical velocity of the projectile, positive down"},
+      {"accel_up_m_s2", &Trace::accel_up_m_s2, 1, "m/s2",
        "vertical acceleration, positive up (free fall = -g), mean over the preceding sample interval"},
       {"omega_rad_s", &TraceData::omega_rad_s, 3, "rad/s", "projectile angular velocity (engine frame)"},
       {"position_m", &TraceData::position_m, 3, "m",
@@ -55,18 +54,12 @@ const std::vector<TraceColumn>& trace_columns() {
   return t;
 }
 
-double trace_attribute(const TraceData& d, const std::string& name) {
-  for (const auto& a : trace_attributes())
-    if (name == a.name) return d.*a.value;
-  throw std::logic_error("trace.h5 has no attribute " + name);
-}
-
 namespace {
 
 /// True when every column holds `n` samples of its width.
 bool columns_hold(const TraceData& d, std::size_t n) {
   for (const auto& c : trace_columns())
-    if ((d.*c.values).size() != c.width * n) return false;
+    if (c.values.of(d).size() != c.width * n) return false;
   return d.contacts.size() == n;
 }
 
@@ -80,18 +73,18 @@ void write_trace(const std::filesystem::path& path, const TraceData& d) {
     h5::File f = h5::File::create(tmp);
     h5::set_attr(f.id(), "format", kTraceFormat);
     h5::set_attr(f.id(), "format_version", kTraceFormatVersion);
-    for (const auto& a : trace_texts()) h5::set_attr(f.id(), a.name, d.*a.value);
+    for (const auto& a : trace_texts()) h5::set_attr(f.id(), a.name, a.value.of(d));
     h5::Handle g = h5::create_group(f.id(), "trace");
     h5::set_attr(g, "description",
                  "projectile record, paper frame: depth positive down from the mean bed surface, "
                  "velocity positive down, acceleration positive up (free fall = -g)");
-    for (const auto& a : trace_attributes()) h5::set_attr(g, a.name, d.*a.value);
+    for (const auto& a : trace_attributes()) h5::set_attr(g, a.name, a.value.of(d));
     // Format version 1 had both; gravsweep reads surface_height_m, older versions fill_height_m.
-    h5::set_attr(g, "fill_height_m", d.surface_height_m);
+    h5::set_attr(g, "fill_height_m", d.info.fill_height_m);
     h5::set_attr(g, "stopped", static_cast<long long>(d.stopped ? 1 : 0));
     for (const auto& c : trace_columns()) {
       const std::vector<hsize_t> dims = c.width == 1 ? std::vector<hsize_t>{n} : std::vector<hsize_t>{n, c.width};
-      h5::write_doubles(g, c.name, d.*c.values, dims, c.unit, c.description);
+      h5::write_doubles(g, c.name, c.values.of(d), dims, c.unit, c.description);
     }
     h5::write_int32(g, "contacts", d.contacts, "1", "grains and walls touching the projectile");
     f.close();
@@ -108,13 +101,13 @@ TraceData read_trace(const std::filesystem::path& path) {
     throw h5::H5Error(fmt::format("trace {}: format_version {} is not supported (expected {})", path.string(), version,
                                   kTraceFormatVersion));
   TraceData d;
-  for (const auto& a : trace_texts()) d.*a.value = h5::get_attr_string(f.id(), a.name);
+  for (const auto& a : trace_texts()) a.value.of(d) = h5::get_attr_string(f.id(), a.name);
   h5::Handle g = h5::open_group(f.id(), "trace");
-  for (const auto& a : trace_attributes()) d.*a.value = h5::get_attr_double(g, a.name);
+  for (const auto& a : trace_attributes()) a.value.of(d) = h5::get_attr_double(g, a.name);
   d.stopped = h5::get_attr_int(g, "stopped") != 0;
-  for (const auto& c : trace_columns()) d.*c.values = h5::read_doubles(g, c.name);
+  for (const auto& c : trace_columns()) c.values.of(d) = h5::read_doubles(g, c.name);
   d.contacts = h5::read_int32(g, "contacts");
-  const std::size_t n = d.t_s.size();
+  const std::size_t n = d.size();
   if (!columns_hold(d, n))
     throw h5::H5Error(fmt::format("trace {}: the /trace columns do not all hold {} samples", path.string(), n));
   d.mark_contact_start();

@@ -21,25 +21,6 @@ namespace gravsweep::results {
 
 struct TraceData;
 
-/// A trial with its raw and processed trace, and the options it was processed with.
-struct MeasuredTrial {
-  Trial info;
-  Trace raw;
-  ProcessedTrace processed;
-  /// What `processed` was processed with: set once, by process_trial (metric_options(info), or the
-  /// paper's fixed scales when a short lab record falls back to them), or read back with an
-  /// imported campaign (load_campaign_db). Anything processed beside the trial takes these (the
-  /// model's record that predicts its apeak as measured, the re-integrated line of Fig. 2), so it
-  /// is processed alike without working out again what was applied.
-  MetricOptions options;
-  /// Samples used by trace-level fits: inside the collision, clear of the filter's transient.
-  std::size_t fit_begin = 0, fit_end = 0;  ///< [begin, end)
-  /// A CSV trace only: the file line of each sample and the 1-based column of accel_m_s2, so
-  /// that a processing error about a sample (TraceError) names its line. Empty otherwise.
-  std::vector<int> sample_lines;
-  int accel_column = 0;
-};
-
 struct Campaign {
   std::string directory;
   std::vector<MeasuredTrial> trials;                         ///< the trials read and processed successfully
@@ -104,11 +85,14 @@ struct DemTraceRef {
   std::string job_id;  ///< empty outside a campaign database
   std::filesystem::path path;
 };
-/// Reads one trace.h5 into a trial (source dem, facts from its attributes via trial_fields(),
-/// processing settings from its scenario's /output), not yet processed.
+/// Readies a DEM trace record to be processed as the trial it is (its facts are already the
+/// trial's, read where they live): names it (ref), sets its processing settings from its
+/// scenario's /output and its impact speed (the trace's own at first contact, from its metrics
+/// text, else the release speed). The drop job and every reader of a trace measure it so.
+void prepare_dem_trial(TraceData& trace, const DemTraceRef& ref);
+/// Reads one trace.h5 into a trial (prepare_dem_trial), not yet processed: the record's trial
+/// part, by move (its columns are not copied; the engine's further columns are left behind).
 MeasuredTrial read_dem_trial(const DemTraceRef& ref);
-/// The same from a trace in memory (the drop job measures its own trace through it).
-MeasuredTrial dem_trial_of(const TraceData& trace, const DemTraceRef& ref);
 /// Reads and processes DEM traces; unreadable or unmeasurable ones (no contact before the time
 /// cap, a rebound) become issues naming the trace, the job and the reason.
 Campaign load_dem_campaign(const std::string& label, const std::vector<DemTraceRef>& refs,

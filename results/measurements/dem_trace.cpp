@@ -7,6 +7,7 @@
 #include <fstream>
 #include <set>
 #include <stdexcept>
+#include <utility>
 
 #include "results/io/hdf5.h"
 #include "results/io/trace_file.h"
@@ -17,18 +18,11 @@ namespace gravsweep::results {
 
 namespace fs = std::filesystem;
 
-MeasuredTrial read_dem_trial(const DemTraceRef& ref) { return dem_trial_of(read_trace(ref.path), ref); }
-
-MeasuredTrial dem_trial_of(const TraceData& d, const DemTraceRef& ref) {
-  MeasuredTrial t;
-  Trial& ti = t.info;
+void prepare_dem_trial(TraceData& d, const DemTraceRef& ref) {
+  Trial& ti = d.info;
   ti.trial_id = ref.trial_id;
   ti.job_id = ref.job_id;
-  ti.source = TraceSource::dem;
   ti.trace_file = ref.path.string();
-  ti.code_version = d.code_version;
-  for (const auto& f : trial_fields())
-    if (f.hdf5_attr) ti.*f.number = trace_attribute(d, f.hdf5_attr);
   // Processing settings: the scenario's /output (defaults filled when it was validated).
   const auto s = nlohmann::json::parse(d.scenario_json.empty() ? "{}" : d.scenario_json, nullptr, false);
   if (s.is_object() && s.contains("output") && s["output"].is_object()) {
@@ -41,8 +35,12 @@ MeasuredTrial dem_trial_of(const TraceData& d, const DemTraceRef& ref) {
   ti.impact_speed_m_s = d.release_speed_m_s;
   const auto m = nlohmann::json::parse(d.metrics_json.empty() ? "{}" : d.metrics_json, nullptr, false);
   if (m.is_object() && m.contains("vc_m_s") && m["vc_m_s"].is_number()) ti.impact_speed_m_s = m["vc_m_s"].get<double>();
-  t.raw = d;  // the record's Trace part, as it is
-  return t;
+}
+
+MeasuredTrial read_dem_trial(const DemTraceRef& ref) {
+  TraceData d = read_trace(ref.path);
+  prepare_dem_trial(d, ref);
+  return MeasuredTrial(std::move(d));  // the trial part, its columns moved
 }
 
 Campaign load_dem_campaign(const std::string& label, const std::vector<DemTraceRef>& refs,

@@ -10,29 +10,29 @@
 namespace gravsweep::results {
 
 const std::vector<TrialField>& trial_fields() {
-  // key (JSON, CSV, SQLite), trace.h5 attribute, unit, required in trials.csv, member.
+  // key (JSON, CSV, SQLite), unit, required in trials.csv, member.
   static const std::vector<TrialField> fields = {
-      {"trial_id", nullptr, "", true, nullptr, &Trial::trial_id},
-      {"trace_file", nullptr, "", true, nullptr, &Trial::trace_file},
-      {"gravity_m_s2", "gravity_m_s2", "m/s2", true, &Trial::gravity_m_s2, nullptr},
-      {"impact_speed_m_s", nullptr, "m/s", true, &Trial::impact_speed_m_s, nullptr},
-      {"fill_height_m", "surface_height_m", "m", true, &Trial::fill_height_m, nullptr},  // dem: measured
-      {"projectile_mass_kg", "projectile_mass_kg", "kg", true, &Trial::projectile_mass_kg, nullptr},
-      {"projectile_diameter_m", "projectile_diameter_m", "m", true, &Trial::projectile_diameter_m, nullptr},
-      {"grain_diameter_m", "grain_diameter_m", "m", true, &Trial::grain_diameter_m, nullptr},
-      {"bulk_density_kg_m3", nullptr, "kg/m3", true, &Trial::bulk_density_kg_m3, nullptr},
-      {"sample_rate_hz", "sample_rate_hz", "Hz", true, &Trial::sample_rate_hz, nullptr},
-      {"drop_height_m", nullptr, "m", false, &Trial::drop_height_m, nullptr},
-      {"filter_cutoff_hz", nullptr, "Hz", false, &Trial::filter_cutoff_hz, nullptr},
-      {"end_threshold_g", nullptr, "1", false, &Trial::end_threshold_g, nullptr},
-      {"end_speed_fraction", nullptr, "1", false, &Trial::end_speed_fraction, nullptr},
-      {"time_scale", nullptr, "", false, nullptr, &Trial::time_scale},
-      {"end_rule", nullptr, "", false, nullptr, &Trial::end_rule},
-      {"clipped_at_m_s2", nullptr, "m/s2", false, &Trial::clipped_at_m_s2, nullptr},
-      {"clipped_samples", nullptr, "1", false, &Trial::clipped_samples, nullptr},
-      {"clip_depth_error_m", nullptr, "m", false, &Trial::clip_depth_error_m, nullptr},
-      {"job_id", nullptr, "", false, nullptr, &Trial::job_id},
-      {"code_version", nullptr, "", false, nullptr, &Trial::code_version},
+      {"trial_id", "", true, nullptr, &Trial::trial_id},
+      {"trace_file", "", true, nullptr, &Trial::trace_file},
+      {"gravity_m_s2", "m/s2", true, &Trial::gravity_m_s2, nullptr},
+      {"impact_speed_m_s", "m/s", true, &Trial::impact_speed_m_s, nullptr},
+      {"fill_height_m", "m", true, &Trial::fill_height_m, nullptr},  // dem: the measured surface (trace.h5)
+      {"projectile_mass_kg", "kg", true, &Trial::projectile_mass_kg, nullptr},
+      {"projectile_diameter_m", "m", true, &Trial::projectile_diameter_m, nullptr},
+      {"grain_diameter_m", "m", true, &Trial::grain_diameter_m, nullptr},
+      {"bulk_density_kg_m3", "kg/m3", true, &Trial::bulk_density_kg_m3, nullptr},
+      {"sample_rate_hz", "Hz", true, &Trial::sample_rate_hz, nullptr},
+      {"drop_height_m", "m", false, &Trial::drop_height_m, nullptr},
+      {"filter_cutoff_hz", "Hz", false, &Trial::filter_cutoff_hz, nullptr},
+      {"end_threshold_g", "1", false, &Trial::end_threshold_g, nullptr},
+      {"end_speed_fraction", "1", false, &Trial::end_speed_fraction, nullptr},
+      {"time_scale", "", false, nullptr, &Trial::time_scale},
+      {"end_rule", "", false, nullptr, &Trial::end_rule},
+      {"clipped_at_m_s2", "m/s2", false, &Trial::clipped_at_m_s2, nullptr},
+      {"clipped_samples", "1", false, &Trial::clipped_samples, nullptr},
+      {"clip_depth_error_m", "m", false, &Trial::clip_depth_error_m, nullptr},
+      {"job_id", "", false, nullptr, &Trial::job_id},
+      {"code_version", "", false, nullptr, &Trial::code_version},
   };
   return fields;
 }

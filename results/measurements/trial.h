@@ -1,8 +1,9 @@
-// The one trial record: what is known about one impact before its trace is processed, whether a
-// laboratory record (trials.csv, docs/formats/measurements.md section 2) or a DEM drop (trace.h5 of
-// `gravsweep run` or of a campaign's drop job). Every representation of these fields (CSV header,
-// SQLite column of the imported `trials` table, HDF5 attribute of trace.h5, JSON key) comes from
-// the one table trial_fields(); nothing else lists them.
+// The one trial record's field table: what is known about one impact before its trace is
+// processed, whether a laboratory record (trials.csv, docs/formats/measurements.md section 2) or a
+// DEM drop (trace.h5 of `gravsweep run` or of a campaign's drop job). The record, Trial, is
+// results/processing/trial_record.h. Every name of its fields (CSV header, SQLite column of the
+// imported `trials` table, JSON key) comes from the one table trial_fields(); a DEM trace's
+// attributes are read into the fields themselves (trace_attributes(), results/io/trace_file.h).
 #pragma once
 #include <nlohmann/json.hpp>
 
@@ -12,45 +13,9 @@
 
 #include "results/processing/trace.h"
 #include "results/processing/trace_source.h"
+#include "results/processing/trial_record.h"
 
 namespace gravsweep::results {
-
-struct Trial {
-  std::string trial_id;
-  TraceSource source = TraceSource::lab;
-  std::string trace_file;  ///< relative to the campaign folder (lab) or absolute (dem)
-  double gravity_m_s2 = 0;
-  double impact_speed_m_s = 0;  ///< downward speed at first contact
-  double fill_height_m = 0;     ///< bed depth: the floor below the surface (dem: measured surface height)
-  double projectile_mass_kg = 0;
-  double projectile_diameter_m = 0;
-  double grain_diameter_m = 0;
-  double bulk_density_kg_m3 = 0;
-  double sample_rate_hz = 0;  ///< declared; checked against the timestamps
-  double drop_height_m = 0;   ///< 0 when absent; v = sqrt(2 g h) when the speed is empty
-  // Processing settings (Sunday et al. 2021 Sect. 2.3): the scenario's /output settings for a DEM
-  // drop, the import's --cutoff and the paper's values for a lab record.
-  double filter_cutoff_hz = 500.0;
-  double end_threshold_g = 0.1;
-  double end_speed_fraction = 0.1;
-  /// The time scale of the cut-off and the hold (TimeScale: "froude" or "fixed"; empty: by the
-  /// source, time_scale_for): with froude, filter_cutoff_hz is the cut-off of the paper's drop (1 g,
-  /// D = 10 cm) and the one applied is scaled by sqrt(g / D) (metric_options).
-  std::string time_scale;
-  /// The rule that ends the collision (EndRule: "speed", the default, "paper" or "depth").
-  std::string end_rule = "speed";
-  // A saturated accelerometer, found by process_trial (lab records; 0 when not clipped): the level
-  // of the flat top at the record's largest value, the samples on it, and how far the depth
-  // integrated across it may be off (0 for a record with its own depth). Such a trial's apeak is a
-  // lower bound (clip_exclusion()).
-  double clipped_at_m_s2 = 0;
-  double clipped_samples = 0;
-  double clip_depth_error_m = 0;
-  // Provenance.
-  std::string job_id;                             ///< campaign drop job (dem), empty otherwise
-  std::string code_version;                       ///< gravsweep version that wrote a DEM trace
-  std::map<std::string, std::string> attributes;  ///< other trials.csv columns, kept as they are
-};
 
 /// One problem found while reading: file (relative to the campaign), 1-based line and column
 /// (0 when not applicable) and what was expected.
@@ -68,7 +33,6 @@ struct ImportIssue {
 /// One field of Trial and its names everywhere. A field is numeric (`number`) or text (`text`).
 struct TrialField {
   const char* key;        ///< JSON key, CSV header and SQLite column (one name: units in it)
-  const char* hdf5_attr;  ///< attribute of /trace in trace.h5 that holds it, nullptr if none
   const char* unit;       ///< SI unit ("" for text)
   bool csv_required;      ///< required column of trials.csv (docs/formats/measurements.md 2.1)
   double Trial::*number;  ///< nullptr for text fields

@@ -206,10 +206,11 @@ template <class WriteGrains, class Projectile>
 json fig1_rest_panel(const Fig1Request& rq, std::size_t bed_grains, const TraceData& td, WriteGrains write_grains,
                      Projectile projectile, std::string& what) {
   const std::size_t k = td.size() - 1;
-  json panel{{"title", fmt::format("(b) {} at t = {:.0f} ms, {:.2f} cm deep",
-                                   td.stopped ? "at rest" : "at the time cap", 1000 * td.t_s[k], 100 * td.depth_m[k])},
-             {"grains", "bed.csv"},
-             {"projectile", projectile(k)}};
+  json panel{
+      {"title", fmt::format("(b) {} at t = {:.0f} ms, {:.2f} cm deep", td.stopped ? "at rest" : "at the time cap",
+                            1000 * td.raw.t_s[k], 100 * td.raw.depth_m[k])},
+      {"grains", "bed.csv"},
+      {"projectile", projectile(k)}};
   const std::string snaps = rq.snapshots.empty() ? snapshot_path_for(rq.trace).string() : rq.snapshots;
   if (fs::exists(snaps)) {
     try {
@@ -254,20 +255,20 @@ std::string draw_fig1(const Fig1Request& rq) {
   };
   write_grains("bed.csv", [&](std::size_t i) { return grains.position_m[i]; });
   json panels = json::array();
-  const double R = 0.5 * td.projectile_diameter_m;
+  const double R = 0.5 * td.info.projectile_diameter_m;
   auto projectile = [&](std::size_t k) {
     return json{{"x_m", td.position_m[3 * k]},
                 {"y_m", td.position_m[3 * k + 1]},
                 {"z_m", td.position_m[3 * k + 2]},
                 {"radius_m", R},
-                {"t_s", td.t_s[k]},
-                {"depth_m", td.depth_m[k]}};
+                {"t_s", td.raw.t_s[k]},
+                {"depth_m", td.raw.depth_m[k]}};
   };
   std::string what = fmt::format("{} grains", grains.size());
   if (rq.trace.empty()) panels.push_back(json{{"title", "prepared bed"}, {"grains", "bed.csv"}});
   if (!rq.trace.empty() && rq.at != "rest")
     panels.push_back(json{{"title", fmt::format("(a) release, {:.1f} cm above the surface",
-                                                100 * (td.release_height_m - td.surface_height_m))},
+                                                100 * (td.release_height_m - td.info.fill_height_m))},
                           {"grains", "bed.csv"},
                           {"projectile", projectile(0)}});
   if (!rq.trace.empty() && rq.at != "release")

@@ -118,17 +118,17 @@ std::optional<results::BedFacts> bed_of(db::Database& db, const queue::CampaignP
 /// and velocity_m_s (every k-th sample: they are smooth). Returns the new sample rate.
 double write_trace_csv(const fs::path& path, const results::TraceData& td, double rate_hz) {
   const std::size_t step =
-      std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(td.sample_rate_hz / rate_hz)));
-  const auto t = results::every_nth(td.t_s, step);
-  const auto a = results::decimate(td.accel_up_m_s2, td.sample_rate_hz, step);
-  const auto z = results::every_nth(td.depth_m, step);
-  const auto v = results::every_nth(td.velocity_down_m_s, step);
+      std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(td.info.sample_rate_hz / rate_hz)));
+  const auto t = results::every_nth(td.raw.t_s, step);
+  const auto a = results::decimate(td.raw.accel_up_m_s2, td.info.sample_rate_hz, step);
+  const auto z = results::every_nth(td.raw.depth_m, step);
+  const auto v = results::every_nth(td.raw.velocity_down_m_s, step);
   std::ofstream f(path, std::ios::binary);
   if (!f) throw std::runtime_error(fmt::format("{}: cannot write", path.string()));
   f << "t_s,accel_m_s2,position_m,velocity_m_s\n";
   for (std::size_t i = 0; i < t.size(); ++i) f << fmt::format("{:.6f},{:.6g},{:.7g},{:.6g}\n", t[i], a[i], z[i], v[i]);
   if (!f) throw std::runtime_error(fmt::format("{}: write error", path.string()));
-  return td.sample_rate_hz / static_cast<double>(step);
+  return td.info.sample_rate_hz / static_cast<double>(step);
 }
 
 /// One trials.csv row: the trial record of the drop (read_dem_trial: the same facts and
@@ -153,8 +153,9 @@ std::vector<std::string> trial_row(const std::string& job, const std::string& sw
   const auto metric = [&](const char* k) {
     return m.is_object() && m.contains(k) && m[k].is_number() ? m[k].dump() : std::string();
   };
-  for (std::string v : {std::string("dem"), td.contact_start_s ? num(*td.contact_start_s) : std::string(), sweep,
-                        "scenarios/" + job + ".json", num(td.dt_s), metric("grains"), metric("lateral_offset_m")})
+  for (std::string v :
+       {std::string("dem"), td.raw.contact_start_s ? num(*td.raw.contact_start_s) : std::string(), sweep,
+        "scenarios/" + job + ".json", num(td.dt_s), metric("grains"), metric("lateral_offset_m")})
     row.push_back(std::move(v));
   return row;
 }

@@ -268,36 +268,37 @@ DropSnapshots snapshot_hooks(const Scenario& s, const std::vector<double>& grain
 }
 
 /// The drop's record as a trace (its samples' columns taken over, `dr.samples` left empty), with
-/// the facts a reader of the trace needs (scenario, bed key and file, code version).
+/// the facts a reader of the trace needs (scenario, bed key and file, code version), each written
+/// where the trial it is measured as reads it.
 results::TraceData trace_of(DropResult& dr, const Scenario& s, const json& validated, const results::BedFacts& bed,
                             const std::filesystem::path& bed_in) {
   results::TraceData td = results::take_trace_columns(dr, s.output.sample_rate_hz);
+  results::Trial& trial = td.info;
+  trial.gravity_m_s2 = s.gravity_m_s2;
+  trial.fill_height_m = bed.surface_height_m;  // the measured surface: the depth's zero
+  trial.projectile_diameter_m = s.projectile.diameter_m;
+  trial.projectile_mass_kg = s.projectile.mass_kg;
+  trial.grain_diameter_m = s.grains.diameter_m;
+  trial.code_version = pipeline::build_version();
   td.dt_s = s.dt_s;
-  td.gravity_m_s2 = s.gravity_m_s2;
-  td.surface_height_m = bed.surface_height_m;
-  td.projectile_diameter_m = s.projectile.diameter_m;
-  td.projectile_mass_kg = s.projectile.mass_kg;
-  td.grain_diameter_m = s.grains.diameter_m;
   td.scenario_json = validated.dump();
   td.bed_key_json = bed_key_of_validated(validated).dump();
   td.bed_file = std::filesystem::absolute(bed_in).string();
-  td.code_version = pipeline::build_version();
   return td;
 }
 
-/// Sect. 2.3 through the one processing entry (results::process_trial): the trial's facts from
-/// the trace (fill height = the measured surface height) and the scenario's /output settings,
-/// exactly as a campaign reading this trace back measures it; `error` says why there are none
-/// (a trace that cannot be measured).
-std::optional<results::Metrics> paper_metrics(const results::TraceData& td, const std::filesystem::path& trace_out,
-                                              std::string& error) {
+/// Sect. 2.3 through the one processing entry (results::process_trial), on the trace record in
+/// place (it is the trial: its processed trace and metrics are written into it): the scenario's
+/// /output settings, exactly as a campaign reading this trace back measures it. False, and
+/// `error` why, when the trace cannot be measured.
+bool measure(results::TraceData& td, const std::filesystem::path& trace_out, std::string& error) {
   try {
-    results::MeasuredTrial trial = results::dem_trial_of(td, {"", "", trace_out});
-    results::process_trial(trial);
-    return std::move(trial.processed.metrics);  // the metrics as processing made them
+    results::prepare_dem_trial(td, {"", "", trace_out});
+    results::process_trial(td);
+    return true;
   } catch (const std::exception& e) {
     error = e.what();
-    return std::nullopt;
+    return false;
   }
 }
 
@@ -337,12 +338,12 @@ DropJobResult run_drop_job(const json& scenario, const std::filesystem::path& be
   const double wall_s = seconds_since(t0) + ckpt.prior_wall_time_s();
 
   // The run's outputs are its records themselves, moved into what the runner returns (no copy
-  // into JSON or into a record of figures): the trace, the engine's result, the metrics.
+  // into JSON or into a record of figures): the trace with its metrics, the engine's result.
   auto outputs = std::make_shared<sweep::DropOutputs>();
   results::DropRecord& rec = *outputs;
   rec.trace = trace_of(dr, s, validated, bed, bed_in);
   rec.result = std::move(dr);
-  rec.metrics = paper_metrics(rec.trace, trace_out, rec.metrics_error);
+  rec.measured = measure(rec.trace, trace_out, rec.metrics_error);
   rec.bed_grains = static_cast<long long>(bed_grains);
   rec.lateral_offset_m = std::hypot(projectile.lateral_offset_x_m, projectile.lateral_offset_y_m);
   rec.threads = sys.threads();

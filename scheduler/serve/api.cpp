@@ -153,13 +153,13 @@ json trace_json(const std::filesystem::path& file, std::int64_t points) {
   const auto stride = std::max<std::size_t>(1, (n + static_cast<std::size_t>(points) - 1) / points);
   return {{"samples", n},
           {"stride", stride},
-          {"gravity_m_s2", d.gravity_m_s2},
-          {"projectile_diameter_m", d.projectile_diameter_m},
+          {"gravity_m_s2", d.info.gravity_m_s2},
+          {"projectile_diameter_m", d.info.projectile_diameter_m},
           {"stopped", d.stopped},
-          {"t_s", thinned(d.t_s, stride)},
-          {"accel_up_m_s2", thinned(d.accel_up_m_s2, stride)},
-          {"depth_m", thinned(d.depth_m, stride)},
-          {"velocity_down_m_s", thinned(d.velocity_down_m_s, stride)}};
+          {"t_s", thinned(d.raw.t_s, stride)},
+          {"accel_up_m_s2", thinned(d.raw.accel_up_m_s2, stride)},
+          {"depth_m", thinned(d.raw.depth_m, stride)},
+          {"velocity_down_m_s", thinned(d.raw.velocity_down_m_s, stride)}};
 }
 
 Reply drop_unchecked(db::Database& db, const queue::CampaignPaths* paths, const std::string& id, const Params& p) {

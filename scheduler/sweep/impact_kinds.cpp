@@ -31,13 +31,14 @@ queue::JobKind drop_kind() {
 }
 
 void DropOutputs::each_output(const Visit& visit) const {
+  const results::Metrics* m = metrics();
   for (const auto& f : results::metric_fields()) {
-    if (metrics)
-      visit(f.key, results::metric_json(*metrics, f));
+    if (m)
+      visit(f.key, results::metric_json(*m, f));
     else if (!f.text)
       visit(f.key, nullptr);  // unmeasured; the note is left out (NULL)
   }
-  if (!metrics) visit(kMetricsErrorKey, metrics_error);
+  if (!m) visit(kMetricsErrorKey, metrics_error);
   for (const auto& f : results::dem_figure_fields()) visit(f.key, results::field_json<results::DropRecord>(*this, f));
 }
 

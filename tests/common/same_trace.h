@@ -14,10 +14,10 @@ namespace gravsweep::test {
 inline void expect_same_trace_columns(const std::filesystem::path& a_path, const std::filesystem::path& b_path) {
   const results::TraceData a = results::read_trace(a_path), b = results::read_trace(b_path);
   ASSERT_EQ(a.size(), b.size());
-  EXPECT_EQ(a.t_s, b.t_s);
-  EXPECT_EQ(a.depth_m, b.depth_m);
-  EXPECT_EQ(a.velocity_down_m_s, b.velocity_down_m_s);
-  EXPECT_EQ(a.accel_up_m_s2, b.accel_up_m_s2);
+  EXPECT_EQ(a.raw.t_s, b.raw.t_s);
+  EXPECT_EQ(a.raw.depth_m, b.raw.depth_m);
+  EXPECT_EQ(a.raw.velocity_down_m_s, b.raw.velocity_down_m_s);
+  EXPECT_EQ(a.raw.accel_up_m_s2, b.raw.accel_up_m_s2);
   EXPECT_EQ(a.omega_rad_s, b.omega_rad_s);
   EXPECT_EQ(a.position_m, b.position_m);
   EXPECT_EQ(a.contacts, b.contacts);

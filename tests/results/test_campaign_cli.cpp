@@ -148,7 +148,7 @@ TEST_F(CampaignCli, ADropThatCannotBeMeasuredIsListedWithTheReason) {
   for (const auto& e : fs::directory_iterator(copy / "c.files/traces")) victim = e.path();
   ASSERT_FALSE(victim.empty());
   auto td = gravsweep::results::read_trace(victim);
-  for (auto& a : td.accel_up_m_s2) a = -td.gravity_m_s2;  // free fall only
+  for (auto& a : td.raw.accel_up_m_s2) a = -td.info.gravity_m_s2;  // free fall only
   fs::remove(victim);
   gravsweep::results::write_trace(victim, td);
   const Cmd r = run("measurements import '" + (copy / "c.db").string() + "' --db '" + (copy / "t.db").string() + "'");

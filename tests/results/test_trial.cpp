@@ -56,10 +56,10 @@ void write_dem_trace(const fs::path& p, const Poncelet& k, double fs_hz, const s
     const double t = i / fs_hz;
     double v, z;
     k.state(t - t_contact, v, z);
-    d.t_s.push_back(t);
-    d.depth_m.push_back(z);
-    d.velocity_down_m_s.push_back(v);
-    d.accel_up_m_s2.push_back(k.accel_up(t - t_contact));
+    d.raw.t_s.push_back(t);
+    d.raw.depth_m.push_back(z);
+    d.raw.velocity_down_m_s.push_back(v);
+    d.raw.accel_up_m_s2.push_back(k.accel_up(t - t_contact));
     for (int c = 0; c < 3; ++c) {
       d.omega_rad_s.push_back(0.0);
       d.position_m.push_back(c == 2 ? 0.2 - z : 0.0);
@@ -67,20 +67,20 @@ void write_dem_trace(const fs::path& p, const Poncelet& k, double fs_hz, const s
     d.contacts.push_back(t >= t_contact ? 5 : 0);
     d.grain_kinetic_energy_J.push_back(0.0);
   }
-  d.sample_rate_hz = fs_hz;
+  d.info.sample_rate_hz = fs_hz;
   d.dt_s = 1e-5;
-  d.gravity_m_s2 = k.g;
-  d.surface_height_m = 0.1;
+  d.info.gravity_m_s2 = k.g;
+  d.info.fill_height_m = 0.1;
   d.release_height_m = 0.15;
   d.release_speed_m_s = k.v0 - k.g * t_contact;
-  d.projectile_diameter_m = 0.1;
-  d.projectile_mass_kg = k.m;
-  d.grain_diameter_m = 0.01;
+  d.info.projectile_diameter_m = 0.1;
+  d.info.projectile_mass_kg = k.m;
+  d.info.grain_diameter_m = 0.01;
   d.stopped = true;
   d.scenario_json = scenario_json;
   d.bed_key_json = "{}";
   d.metrics_json = "{\"vc_m_s\": " + std::to_string(k.v0) + "}";
-  d.code_version = "test";
+  d.info.code_version = "test";
   fs::create_directories(p.parent_path());
   write_trace(p, d);
 }
@@ -110,14 +110,11 @@ std::string issues_of(const Campaign& c) {
 
 }  // namespace
 
-TEST(TrialRecord, OneFieldTableGivesCsvSqlHdf5AndJsonNamesAndRoundTrips) {
+TEST(TrialRecord, OneFieldTableGivesCsvSqlAndJsonNamesAndRoundTrips) {
   std::set<std::string> keys;
   for (const auto& f : trial_fields()) {
     EXPECT_TRUE(keys.insert(f.key).second) << "field listed twice: " << f.key;
     EXPECT_TRUE((f.number != nullptr) != (f.text != nullptr)) << f.key;
-    if (f.hdf5_attr) {
-      EXPECT_NE(f.number, nullptr) << f.key;
-    }
   }
   // The required columns of docs/formats/measurements.md section 2.1, no more, no less.
   std::set<std::string> required;
@@ -369,9 +366,9 @@ TEST(OneEntry, ADemTrialsFillHeightIsTheTracesMeasuredSurfaceHeight) {
   const fs::path p = d.path / "a/trace.h5";
   write_dem_trace(p, k, 10000, R"({"output": {"filter_cutoff_hz": 500}})");
   TraceData td = read_trace(p);
-  td.surface_height_m = 0.0937;  // settled below a nominal fill of 0.1 m
+  td.info.fill_height_m = 0.0937;  // settled below a nominal fill of 0.1 m
   write_trace(p, td);
-  EXPECT_DOUBLE_EQ(read_trace(p).surface_height_m, 0.0937);
+  EXPECT_DOUBLE_EQ(read_trace(p).info.fill_height_m, 0.0937);
   const MeasuredTrial t = read_dem_trial({"a", "job1", p});
   EXPECT_DOUBLE_EQ(t.info.fill_height_m, 0.0937);
   EXPECT_DOUBLE_EQ(metric_options(t.info).fill_height_m.value_or(0), 0.0937);  // the rebound's floor

@@ -9,6 +9,8 @@
 #include "engine/scenario/impact.h"
 #include "engine/scenario/paper_params.h"
 #include "results/io/engine_records.h"
+#include "results/io/trace_file.h"
+#include "results/measurements/campaign.h"
 
 namespace gravsweep {
 namespace {
@@ -87,19 +89,50 @@ TEST(Drop, TheTraceRecordTakesTheSampleColumnsOverWithoutACopy) {
       s.omega_rad_s.data(), s.position_m.data(), s.contacts.data(),          s.grain_kinetic_energy_J.data()};
   const results::TraceData td = results::take_trace_columns(r, 1e4);
   const std::vector<const void*> taken{
-      td.t_s.data(),         td.depth_m.data(),    td.velocity_down_m_s.data(), td.accel_up_m_s2.data(),
-      td.omega_rad_s.data(), td.position_m.data(), td.contacts.data(),          td.grain_kinetic_energy_J.data()};
+      td.raw.t_s.data(),           td.raw.depth_m.data(),           td.raw.velocity_down_m_s.data(),
+      td.raw.accel_up_m_s2.data(), td.omega_rad_s.data(),           td.position_m.data(),
+      td.contacts.data(),          td.grain_kinetic_energy_J.data()};
   EXPECT_EQ(taken, buffers);
   EXPECT_TRUE(r.samples.empty());
-  EXPECT_EQ(td.t_s, before.t_s);
-  EXPECT_EQ(td.depth_m, before.depth_m);
+  EXPECT_EQ(td.raw.t_s, before.t_s);
+  EXPECT_EQ(td.raw.depth_m, before.depth_m);
   EXPECT_EQ(td.position_m, before.position_m);
   EXPECT_EQ(td.contacts, before.contacts);
   EXPECT_EQ(td.release_speed_m_s, r.release_speed_m_s);
   EXPECT_EQ(td.stopped, r.stopped);
-  EXPECT_NEAR(td.sample_rate_hz, 1e4, 1e-6);  // the samples' own spacing
-  ASSERT_TRUE(td.contact_start_s.has_value());
-  EXPECT_LT(*td.contact_start_s, *r.first_contact_s);  // the last sample before the first contact
+  EXPECT_NEAR(td.info.sample_rate_hz, 1e4, 1e-6);  // the samples' own spacing
+  ASSERT_TRUE(td.raw.contact_start_s.has_value());
+  EXPECT_LT(*td.raw.contact_start_s, *r.first_contact_s);  // the last sample before the first contact
+}
+
+// The trace record is the trial it is measured as: process_trial reads the columns the engine
+// wrote where the record took them over (the same buffers, no copy into a trial of its own) and
+// writes the processed trace, the metrics and the options into the record itself.
+TEST(Drop, TheTraceRecordIsTheTrialProcessedInPlaceFromTheEnginesColumns) {
+  EmptyContainer c(9.81);
+  ProjectileSpec p;
+  p.impact_speed_m_s = 0.7;
+  p.start_gap_m = 0.01;
+  DropResult r = drop_projectile(c.sys, 0.05, p, DropStop{}, 1e4);
+  const std::vector<const void*> buffers{r.samples.t_s.data(), r.samples.depth_m.data(),
+                                         r.samples.velocity_down_m_s.data(), r.samples.accel_up_m_s2.data()};
+  results::TraceData td = results::take_trace_columns(r, 1e4);
+  td.info.gravity_m_s2 = 9.81;
+  td.info.fill_height_m = 0.05;
+  td.info.projectile_diameter_m = p.diameter_m;
+  td.info.projectile_mass_kg = p.mass_kg;
+  td.info.grain_diameter_m = 0.01;
+  results::prepare_dem_trial(td, {"floor", "", "floor.h5"});
+  results::MeasuredTrial& trial = td;  // the record is the trial: no copy is made of it
+  ASSERT_NO_THROW(results::process_trial(trial));
+  const std::vector<const void*> processed_from{td.raw.t_s.data(), td.raw.depth_m.data(),
+                                                td.raw.velocity_down_m_s.data(), td.raw.accel_up_m_s2.data()};
+  EXPECT_EQ(processed_from, buffers);
+  EXPECT_EQ(td.processed.t_s, td.raw.t_s);
+  // No grains: it lands on the floor, 5 cm below the surface, at the speed it gained falling there.
+  EXPECT_NEAR(td.processed.metrics.vc_m_s, std::sqrt(0.7 * 0.7 + 2 * 9.81 * 0.05), 0.01);
+  EXPECT_EQ(td.options.gravity_m_s2, 9.81);
+  EXPECT_EQ(td.options.impact_speed_m_s, td.release_speed_m_s);  // no metrics text yet: the release
 }
 
 TEST(Drop, DropHeightModeFallsFromRestWithTheOffsets) {

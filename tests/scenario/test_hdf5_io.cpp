@@ -7,6 +7,8 @@
 #include <fstream>
 #include <memory>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "results/io/bed_file.h"
 #include "results/io/hdf5.h"
@@ -50,10 +52,10 @@ results::BedFacts sample_facts() {
 results::TraceData sample_trace() {
   results::TraceData d;
   for (int i = 0; i < 20; ++i) {
-    d.t_s.push_back(1e-4 * i);
-    d.depth_m.push_back(-0.005 + 1e-4 * i);
-    d.velocity_down_m_s.push_back(1.0);
-    d.accel_up_m_s2.push_back(-9.81);
+    d.raw.t_s.push_back(1e-4 * i);
+    d.raw.depth_m.push_back(-0.005 + 1e-4 * i);
+    d.raw.velocity_down_m_s.push_back(1.0);
+    d.raw.accel_up_m_s2.push_back(-9.81);
     for (int k = 0; k < 3; ++k) {
       d.omega_rad_s.push_back(0.0);
       d.position_m.push_back(k == 2 ? 0.15 : 0.0);
@@ -61,9 +63,9 @@ results::TraceData sample_trace() {
     d.contacts.push_back(i / 10);
     d.grain_kinetic_energy_J.push_back(1e-3 * i);
   }
-  d.sample_rate_hz = 1e4;
+  d.info.sample_rate_hz = 1e4;
   d.dt_s = 1e-6;
-  d.gravity_m_s2 = 9.81;
+  d.info.gravity_m_s2 = 9.81;
   d.stopped = true;
   d.metrics_json = R"({"zstop_m":0.03})";
   return d;
@@ -163,18 +165,64 @@ TEST(Hdf5Io, TraceRoundTripFeedsTheMetrics) {
   const auto d = sample_trace();
   results::write_trace(dir.path / "trace.h5", d);
   const auto r = results::read_trace(dir.path / "trace.h5");
-  EXPECT_EQ(r.depth_m, d.depth_m);
+  EXPECT_EQ(r.raw.depth_m, d.raw.depth_m);
   EXPECT_EQ(r.contacts, d.contacts);
   EXPECT_EQ(r.metrics_json, d.metrics_json);
   EXPECT_TRUE(r.stopped);
-  const results::Trace& t = r;  // a DEM record is the processing's Trace
+  const results::Trace& t = r.raw;  // the processing's Trace, the record's own
   EXPECT_EQ(t.source, results::TraceSource::dem);
+  EXPECT_EQ(r.info.source, results::TraceSource::dem);
+  EXPECT_EQ(r.info.sample_rate_hz, 1e4);  // a trial fact, read where the trial holds it
   // The engine's first contact, read back from the contacts: sample 10 is the first that counts
   // one, so the collision starts at the sample before it.
   ASSERT_TRUE(t.contact_start_s.has_value());
-  EXPECT_DOUBLE_EQ(*t.contact_start_s, d.t_s[9]);
-  EXPECT_EQ(t.accel_up_m_s2, d.accel_up_m_s2);
-  EXPECT_EQ(t.velocity_down_m_s, d.velocity_down_m_s);
+  EXPECT_DOUBLE_EQ(*t.contact_start_s, d.raw.t_s[9]);
+  EXPECT_EQ(t.accel_up_m_s2, d.raw.accel_up_m_s2);
+  EXPECT_EQ(t.velocity_down_m_s, d.raw.velocity_down_m_s);
+}
+
+// trace.h5 keeps format version 1's layout, whichever part of the record holds a field: the same
+// names in the same order, the trial's facts written from the record's trial part and read back
+// into it (surface_height_m is the trial's fill height, written once more as fill_height_m).
+TEST(Hdf5Io, TheTraceTablesKeepFormatVersion1sNamesOrderAndValues) {
+  std::vector<std::string> texts, attributes, columns;
+  for (const auto& t : results::trace_texts()) texts.emplace_back(t.name);
+  for (const auto& a : results::trace_attributes()) attributes.emplace_back(a.name);
+  for (const auto& c : results::trace_columns()) columns.emplace_back(c.name);
+  EXPECT_EQ(texts, (std::vector<std::string>{"code_version", "scenario", "bed_key", "bed_file", "metrics"}));
+  EXPECT_EQ(attributes, (std::vector<std::string>{"sample_rate_hz", "dt_s", "gravity_m_s2", "surface_height_m",
+                                                  "release_height_m", "release_speed_m_s", "projectile_diameter_m",
+                                                  "projectile_mass_kg", "grain_diameter_m"}));
+  EXPECT_EQ(columns, (std::vector<std::string>{"t_s", "depth_m", "velocity_down_m_s", "accel_up_m_s2", "omega_rad_s",
+                                               "position_m", "grain_kinetic_energy_J"}));
+  test::TempDir dir;
+  results::TraceData d = sample_trace();
+  d.info.fill_height_m = 0.0625;
+  d.info.projectile_diameter_m = 0.04;
+  d.info.projectile_mass_kg = 0.25;
+  d.info.grain_diameter_m = 0.01;
+  d.info.code_version = "v1";
+  d.release_height_m = 0.125;
+  results::write_trace(dir.path / "trace.h5", d);
+  {
+    auto f = results::h5::File::open_read(dir.path / "trace.h5");
+    EXPECT_EQ(results::h5::get_attr_string(f.id(), "code_version"), "v1");
+    auto g = results::h5::open_group(f.id(), "trace");
+    EXPECT_EQ(results::h5::get_attr_double(g, "surface_height_m"), 0.0625);
+    EXPECT_EQ(results::h5::get_attr_double(g, "fill_height_m"), 0.0625);
+    EXPECT_EQ(results::h5::get_attr_double(g, "projectile_mass_kg"), 0.25);
+    EXPECT_EQ(results::h5::get_attr_double(g, "release_height_m"), 0.125);
+  }
+  const results::TraceData r = results::read_trace(dir.path / "trace.h5");
+  EXPECT_EQ(r.info.fill_height_m, 0.0625);
+  EXPECT_EQ(r.info.projectile_diameter_m, 0.04);
+  EXPECT_EQ(r.info.projectile_mass_kg, 0.25);
+  EXPECT_EQ(r.info.grain_diameter_m, 0.01);
+  EXPECT_EQ(r.info.gravity_m_s2, 9.81);
+  EXPECT_EQ(r.info.code_version, "v1");
+  EXPECT_EQ(r.release_height_m, 0.125);
+  EXPECT_EQ(r.raw.t_s, d.raw.t_s);
+  EXPECT_EQ(r.grain_kinetic_energy_J, d.grain_kinetic_energy_J);
 }
 
 TEST(Hdf5Io, ErrorsNameTheFileAndTheMissingPiece) {

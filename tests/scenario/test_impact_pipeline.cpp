@@ -17,6 +17,7 @@
 #include "results/io/bed_file.h"
 #include "results/io/job_reports.h"
 #include "results/io/trace_file.h"
+#include "results/measurements/campaign.h"
 #include "scenario_helpers.h"
 #include "scheduler/pipeline/impact_job.h"
 #include "scheduler/pipeline/scenario_spec.h"
@@ -83,14 +84,14 @@ TEST_F(ImpactPipeline, DropIsRecordedAndMeasured) {
   ASSERT_FALSE(m.contains("metrics_error")) << m.dump(2);
   const auto tr = results::read_trace(drop_->trace_path);
   ASSERT_GT(tr.size(), 100u);
-  EXPECT_NEAR(tr.sample_rate_hz, 1e4, 1e-6);
+  EXPECT_NEAR(tr.info.sample_rate_hz, 1e4, 1e-6);
   // Starts 5 mm above the first grain under the projectile (not above the mean
   // surface, which a proud grain may stand above), in free fall: accel_up reads -g.
   const double touch_m = m["first_touch_height_above_surface_m"].get<double>();
   EXPECT_GT(touch_m, -0.01);
   EXPECT_LT(touch_m, 0.01);
-  EXPECT_NEAR(tr.depth_m.front(), -(touch_m + 0.005), 1e-9);
-  EXPECT_NEAR(tr.accel_up_m_s2[1], -9.81, 1e-6);
+  EXPECT_NEAR(tr.raw.depth_m.front(), -(touch_m + 0.005), 1e-9);
+  EXPECT_NEAR(tr.raw.accel_up_m_s2[1], -9.81, 1e-6);
   EXPECT_EQ(tr.contacts.front(), 0);
   // The paper's metrics: vc is the requested 1 m/s (the start gap is measured from the grain
   // the projectile touches first; sampling at 10 kHz moves it by g / 10 kHz at most).
@@ -116,14 +117,40 @@ TEST_F(ImpactPipeline, DropIsRecordedAndMeasured) {
   EXPECT_GT(m["duration_to_rest_s"].get<double>(), 0.0);
   // The DEM's final depth is the trace's last depth below the surface; the processed record's
   // final_depth_m (from the collision start) stays beside it, not replaced by it.
-  EXPECT_NEAR(m["final_depth_below_surface_m"].get<double>(), tr.depth_m.back(), 1e-15);
-  EXPECT_NEAR(m["final_depth_m"].get<double>(), tr.depth_m.back() - m["start_depth_m"].get<double>(), 1e-9);
+  EXPECT_NEAR(m["final_depth_below_surface_m"].get<double>(), tr.raw.depth_m.back(), 1e-15);
+  EXPECT_NEAR(m["final_depth_m"].get<double>(), tr.raw.depth_m.back() - m["start_depth_m"].get<double>(), 1e-9);
   EXPECT_GT(m["wall_time_s"].get<double>(), 0.0);
   EXPECT_TRUE(phases_->count("drop"));
   // Energy went into the grains.
   double ke_max = 0;
   for (double e : tr.grain_kinetic_energy_J) ke_max = std::max(ke_max, e);
   EXPECT_GT(ke_max, 1e-5);
+}
+
+// The drop's trace record is the trial it is measured as: processing wrote the processed trace and
+// the metrics into the record itself, from the record's own columns, and those metrics are the
+// drop's outputs (no MeasuredTrial made of a copy of the trace, no Metrics kept beside it). A
+// campaign reading the trace file back measures the same trial.
+TEST_F(ImpactPipeline, TheDropsTraceRecordIsTheTrialItIsMeasuredAs) {
+  const auto* rec = dynamic_cast<const results::DropRecord*>(drop_->record.get());
+  ASSERT_NE(rec, nullptr);
+  ASSERT_TRUE(rec->measured) << rec->metrics_error;
+  const results::TraceData& td = rec->trace;
+  EXPECT_EQ(rec->metrics(), &td.processed.metrics);
+  EXPECT_EQ(td.processed.t_s, td.raw.t_s);
+  EXPECT_EQ(td.info.source, results::TraceSource::dem);
+  EXPECT_EQ(td.info.gravity_m_s2, 9.81);
+  EXPECT_EQ(td.options.gravity_m_s2, td.info.gravity_m_s2);
+  EXPECT_EQ(td.options.fill_height_m, td.info.fill_height_m);  // the measured surface
+  EXPECT_EQ(drop_->outputs_json()["zstop_m"], td.processed.metrics.zstop_m);
+  results::MeasuredTrial back = results::read_dem_trial({"back", "", drop_->trace_path});
+  results::process_trial(back);
+  EXPECT_EQ(back.info.fill_height_m, td.info.fill_height_m);
+  EXPECT_EQ(back.info.projectile_mass_kg, td.info.projectile_mass_kg);
+  EXPECT_EQ(back.raw.accel_up_m_s2, td.raw.accel_up_m_s2);
+  EXPECT_EQ(back.processed.metrics.zstop_m, td.processed.metrics.zstop_m);
+  EXPECT_EQ(back.processed.metrics.apeak_m_s2, td.processed.metrics.apeak_m_s2);
+  EXPECT_EQ(back.processed.metrics.tstop_s, td.processed.metrics.tstop_s);
 }
 
 TEST_F(ImpactPipeline, BedReuseEqualsPreparingTheBedAgain) {
@@ -139,8 +166,8 @@ TEST_F(ImpactPipeline, BedReuseEqualsPreparingTheBedAgain) {
   // ... and so is a drop into it, compared with the drop into the reused first bed.
   const auto d2 = run_drop_job(test::tiny_scenario(), again.bed_path, dir_->path / "trace2.h5", 1, {}, nullptr);
   const auto t1 = results::read_trace(drop_->trace_path), t2 = results::read_trace(d2.trace_path);
-  EXPECT_EQ(t1.depth_m, t2.depth_m);
-  EXPECT_EQ(t1.accel_up_m_s2, t2.accel_up_m_s2);
+  EXPECT_EQ(t1.raw.depth_m, t2.raw.depth_m);
+  EXPECT_EQ(t1.raw.accel_up_m_s2, t2.raw.accel_up_m_s2);
   EXPECT_EQ(drop_->outputs_json()["zstop_m"], d2.outputs_json()["zstop_m"]);
   EXPECT_EQ(drop_->outputs_json()["apeak_m_s2"], d2.outputs_json()["apeak_m_s2"]);
   // Another seed gives another bed.
@@ -208,7 +235,7 @@ TEST_F(ImpactPipeline, ABedPreparedWithItsOwnMaterialsServesDropsWithOtherMateri
   const double first_contact_s = d.outputs_json().at("first_contact_s");
   double released_J = 0;
   std::size_t before = 0;
-  for (std::size_t k = 0; k < tr.t_s.size() && tr.t_s[k] < first_contact_s; ++k, ++before)
+  for (std::size_t k = 0; k < tr.raw.t_s.size() && tr.raw.t_s[k] < first_contact_s; ++k, ++before)
     released_J = std::max(released_J, tr.grain_kinetic_energy_J[k]);
   ASSERT_GE(before, 3u);  // samples between release and contact (5 mm default gap at 1 m/s: ~5 ms)
   const double impact_ke_J = 0.5 * 0.25 * 1.0 * 1.0;  // tiny_scenario: 0.25 kg at 1 m/s

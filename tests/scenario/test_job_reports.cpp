@@ -43,11 +43,11 @@ TEST(JobReports, TheDemFiguresAreReadFromTheDropsOwnRecord) {
   // No record of copies: each figure is read where the drop holds it (the trace, the engine's
   // result, the metrics, the run's facts), the depths and durations computed from them.
   DropRecord d;
-  d.trace.t_s = {0.0, 0.1, 0.2};
-  d.trace.depth_m = {-0.01, 0.03, 0.02};
+  d.trace.raw.t_s = {0.0, 0.1, 0.2};
+  d.trace.raw.depth_m = {-0.01, 0.03, 0.02};
   d.trace.dt_s = 1e-5;
-  d.trace.sample_rate_hz = 10.0;
-  d.trace.surface_height_m = 0.0625;  // binary fractions: exact differences
+  d.trace.info.sample_rate_hz = 10.0;
+  d.trace.info.fill_height_m = 0.0625;  // the measured surface; binary fractions: exact differences
   d.trace.release_height_m = 0.078125;
   d.trace.release_speed_m_s = 0.5;
   d.trace.stopped = true;
@@ -76,8 +76,11 @@ TEST(JobReports, TheDemFiguresAreReadFromTheDropsOwnRecord) {
   EXPECT_TRUE(j["resumed_at_s"].is_null());
   EXPECT_EQ(j["release_height_above_surface_m"], 0.015625);
   EXPECT_EQ(j["first_touch_height_above_surface_m"], 0.0078125);
-  d.metrics = Metrics{};
-  d.metrics->t_start_s = 0.125;
+  // Measured: the metrics are the ones processing made in the trace record (no copy beside it).
+  d.trace.processed.metrics.t_start_s = 0.125;
+  EXPECT_EQ(d.metrics(), nullptr);
+  d.measured = true;
+  EXPECT_EQ(d.metrics(), &d.trace.processed.metrics);
   j = json_of();
   EXPECT_EQ(j["duration_to_rest_s"], 0.25);
   // Every key of the table, once.

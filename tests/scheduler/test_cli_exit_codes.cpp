@@ -29,10 +29,10 @@ void write_small_trace(const fs::path& p) {
   for (int i = 0; i < 400; ++i) {
     const double t = i / kRate_hz;
     const bool falling = i < 100;
-    d.t_s.push_back(t);
-    d.depth_m.push_back(falling ? -kV0 * (0.01 - t) : 0.0);
-    d.velocity_down_m_s.push_back(falling ? kV0 : 0.0);
-    d.accel_up_m_s2.push_back(falling ? -kG : 0.0);
+    d.raw.t_s.push_back(t);
+    d.raw.depth_m.push_back(falling ? -kV0 * (0.01 - t) : 0.0);
+    d.raw.velocity_down_m_s.push_back(falling ? kV0 : 0.0);
+    d.raw.accel_up_m_s2.push_back(falling ? -kG : 0.0);
     for (int c = 0; c < 3; ++c) {
       d.omega_rad_s.push_back(0.0);
       d.position_m.push_back(0.0);
@@ -40,20 +40,20 @@ void write_small_trace(const fs::path& p) {
     d.contacts.push_back(falling ? 0 : 3);
     d.grain_kinetic_energy_J.push_back(0.0);
   }
-  d.sample_rate_hz = kRate_hz;
+  d.info.sample_rate_hz = kRate_hz;
   d.dt_s = 1e-5;
-  d.gravity_m_s2 = kG;
-  d.surface_height_m = 0.04;
+  d.info.gravity_m_s2 = kG;
+  d.info.fill_height_m = 0.04;
   d.release_height_m = 0.05;
   d.release_speed_m_s = kV0;
-  d.projectile_diameter_m = 0.03;
-  d.projectile_mass_kg = 0.03;
-  d.grain_diameter_m = 0.01;
+  d.info.projectile_diameter_m = 0.03;
+  d.info.projectile_mass_kg = 0.03;
+  d.info.grain_diameter_m = 0.01;
   d.stopped = true;
   d.scenario_json = "{}";
   d.bed_key_json = "{}";
   d.metrics_json = "{}";
-  d.code_version = "test";
+  d.info.code_version = "test";
   fs::create_directories(p.parent_path());
   results::write_trace(p, d);
 }

@@ -190,8 +190,9 @@ TEST_P(ResultColumns, ADropsRecordIsBoundToItsColumnsAsItHoldsItsValues) {
     auto c = claim(db, me, paths, 60);
     ASSERT_TRUE(c && c->kind == sweep::drop_kind());
     auto outputs = std::make_shared<sweep::DropOutputs>();
+    outputs->measured = measured;
     if (measured)
-      outputs->metrics = m;
+      outputs->trace.processed.metrics = m;
     else
       outputs->metrics_error = "no contact";
     outputs->result.steps = 12345;
