@@ -131,12 +131,12 @@ double write_trace_csv(const fs::path& path, const results::TraceData& td, doubl
   return td.info.sample_rate_hz / static_cast<double>(step);
 }
 
-/// One trials.csv row: the trial record of the drop (read_dem_trial: the same facts and
-/// processing settings the model verbs use), pointing at the exported trace and its rate.
-std::vector<std::string> trial_row(const std::string& job, const std::string& sweep, const fs::path& trace_path,
-                                   const results::TraceData& td, const std::optional<results::BedFacts>& bed,
-                                   double rate_hz) {
-  results::Trial ti = results::read_dem_trial({job, job, trace_path}).info;
+/// One trials.csv row: the trial record of the drop (prepared by prepare_dem_trial: the same facts
+/// and processing settings the model verbs use), pointing at the exported trace and its rate.
+std::vector<std::string> trial_row(const std::string& sweep, const results::TraceData& td,
+                                   const std::optional<results::BedFacts>& bed, double rate_hz) {
+  results::Trial ti = td.info;
+  const std::string& job = ti.job_id;
   ti.trace_file = "traces/" + job + ".csv";
   ti.sample_rate_hz = rate_hz;
   ti.bulk_density_kg_m3 = NAN;
@@ -206,11 +206,12 @@ void run_export(const ExportOptions& o) {
     if (!exported(r)) continue;
     const std::string job = r[c_job].get<std::string>();
     const fs::path trace_path = paths.abs(r[c_trace].get<std::string>());
-    const results::TraceData td = results::read_trace(trace_path);
+    results::TraceData td = results::read_trace(trace_path);
+    results::prepare_dem_trial(td, {job, job, trace_path});
     const auto& bed = beds.at(r[c_bed].is_string() ? r[c_bed].get<std::string>() : std::string());
     const double rate = write_trace_csv(out / "traces" / (job + ".csv"), td, o.rate_hz);
     write_text_file(out / "scenarios" / (job + ".json"), json::parse(td.scenario_json).dump(2) + "\n");
-    trials.add(trial_row(job, r[c_sweep].get<std::string>(), trace_path, td, bed, rate));
+    trials.add(trial_row(r[c_sweep].get<std::string>(), td, bed, rate));
     std::vector<std::string> cells;
     for (const auto& v : r) cells.push_back(v.is_null() ? "" : v.is_string() ? v.get<std::string>() : v.dump());
     results_csv.add(std::move(cells));
