@@ -28,7 +28,7 @@ struct SpecProblem {
 
 /// Spec fields are invalid: every problem found, in order, in a scenario spec
 /// (scheduler/pipeline/scenario_spec.h), a sweep spec (scheduler/sweep/spec.h) or a model spec
-/// (results/model/model.h): the one error type of all three. Derives
+/// (results/model/model_spec.h): the one error type of all three. Derives
 /// from ConfigError, so the CLI exits with code 2. pointer()/found()/expected() are those of the
 /// first problem.
 class SpecError : public ConfigError {

@@ -2,7 +2,7 @@
 // validators: the one way a spec file is read (read_spec_file) and checked (spec/json_schema.h),
 // problems collected in spec/problems.h. Hand checks stay only for what a schema cannot say
 // (cross-field rules), next to the spec they belong to: scheduler/pipeline/scenario_spec.cpp,
-// scheduler/sweep/spec.cpp, results/model/model.cpp.
+// scheduler/sweep/spec.cpp, results/model/model_spec.cpp.
 #pragma once
 #include <nlohmann/json.hpp>
 

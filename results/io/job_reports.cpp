@@ -66,8 +66,6 @@ const std::vector<RecordField<DropRecord>>& dem_figure_fields() {
   return fields;
 }
 
-nlohmann::json dem_figures_json(const DropRecord& d) { return record_json(d, dem_figure_fields()); }
-
 const std::vector<RecordField<BedSummary>>& bed_summary_fields() {
   using B = BedSummary;
   static const std::vector<RecordField<B>> fields = {

@@ -53,8 +53,6 @@ struct DropRecord {
 /// metrics (metric_fields()): the processed `final_depth_m` is measured from the collision start,
 /// `final_depth_below_surface_m` from the surface.
 const std::vector<RecordField<DropRecord>>& dem_figure_fields();
-/// Every figure of d, {key: value} (record_json over dem_figure_fields()).
-nlohmann::json dem_figures_json(const DropRecord& d);
 
 /// A prepared bed's report (Sect. 2.2: pour, settle, flatten, relax), kept in bed.h5's `report`
 /// attribute and in the bed job's results. A number a bed of an older build did not record reads

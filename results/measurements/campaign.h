@@ -1,4 +1,5 @@
-// Measurement campaigns: trials (results/measurements/trial.h) with their traces, processed as
+// Measurement campaigns: trials (results/processing/trial_record.h, their field table
+// results/measurements/trial.h) with their traces, processed as
 // Sunday et al. 2021 Sect. 2.3 does (results/processing/trace.h) through one entry,
 // process_trial(). Readers: lab campaign folders (trials.csv + traces/*.csv, lab_csv.cpp), DEM
 // traces (trace.h5 of `gravsweep run` or of a campaign's drop jobs, dem_trace.cpp), and the

@@ -30,7 +30,7 @@ results::Table trial_residuals(const results::FittedModel& fm, const results::Ca
   results::Table t({"trial_id", "gravity_m_s2", "vc_m_s", "fill_height_m", "trace_rms_m_s2", "dzstop_mm", "dtstop_ms",
                     "dapeak_m_s2"});
   // apeak as measured: the model's record filtered like the trial, with the other trials'
-  // fluctuations about the model at its level (results/model/model.h).
+  // fluctuations about the model at its level (results/model/predict.h).
   std::vector<std::vector<double>> fluct;
   for (const auto& tr : c.trials) fluct.push_back(results::relative_residuals(fm, tr));
   for (std::size_t i = 0; i < c.trials.size(); ++i) {

@@ -289,8 +289,9 @@ results::TraceData trace_of(DropResult& dr, const Scenario& s, const json& valid
 
 /// Sect. 2.3 through the one processing entry (results::process_trial), on the trace record in
 /// place (it is the trial: its processed trace and metrics are written into it): the scenario's
-/// /output settings, exactly as a campaign reading this trace back measures it. False, and
-/// `error` why, when the trace cannot be measured.
+/// /output settings, as a campaign reading this trace back measures it (the trial's impact speed,
+/// which processing uses only for a trace without its own velocity, is the release speed here and
+/// the measured vc there). False, and `error` why, when the trace cannot be measured.
 bool measure(results::TraceData& td, const std::filesystem::path& trace_out, std::string& error) {
   try {
     results::prepare_dem_trial(td, {"", "", trace_out});

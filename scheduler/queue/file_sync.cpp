@@ -9,10 +9,9 @@
 #include <stdexcept>
 
 #include "scheduler/queue/worker.h"
+#include "scheduler/queue/queue_internal.h"
 
 namespace gravsweep::queue {
-
-namespace fs = std::filesystem;
 
 void fsync_path(const fs::path& path) {
   const int fd = ::open(path.c_str(), O_RDONLY);

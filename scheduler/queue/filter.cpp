@@ -8,10 +8,9 @@
 
 #include "scheduler/queue/dialect.h"
 #include "scheduler/queue/queue.h"
+#include "scheduler/queue/queue_internal.h"
 
 namespace gravsweep::queue {
-
-using nlohmann::json;
 
 namespace {
 

@@ -277,7 +277,6 @@ nlohmann::json running_json(const RunningJob& r) {
 }  // namespace
 
 nlohmann::json status_json(const Status& s) {
-  using nlohmann::json;
   json j;
   j["sweeps"] = json::array();
   for (const auto& c : s.per_sweep)

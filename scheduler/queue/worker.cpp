@@ -23,12 +23,10 @@
 #include "scheduler/queue/campaign.h"
 #include "scheduler/queue/exit_codes.h"
 #include "scheduler/queue/canonical.h"
+#include "scheduler/queue/queue_internal.h"
 #include "scheduler/queue/worker_heartbeat.h"
 
 namespace gravsweep::queue {
-
-namespace fs = std::filesystem;
-using nlohmann::json;
 
 namespace {
 

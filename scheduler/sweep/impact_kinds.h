@@ -18,8 +18,8 @@ queue::JobKind bed_kind();
 queue::JobKind drop_kind();
 
 /// A drop's outputs as its runner reports them (queue::RunOutput::record): the drop's own record
-/// (results::DropRecord: the paper's metrics as processing made them, the trace record and the
-/// engine's result, owned by move, and the run's facts), read by the tables that declare
+/// (results::DropRecord: the trace record, which is the trial with the paper's metrics as processing
+/// made them in it, and the engine's result, owned by move, and the run's facts), read by the tables that declare
 /// drop_kind()'s outputs (metric_fields(), dem_figure_fields()) where a value is needed.
 struct DropOutputs final : queue::OutputRecord, results::DropRecord {
   void each_output(const Visit& visit) const override;

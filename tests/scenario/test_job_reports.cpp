@@ -59,7 +59,7 @@ TEST(JobReports, TheDemFiguresAreReadFromTheDropsOwnRecord) {
   d.bed_grains = 2200;
   d.threads = 2;
   d.checkpoints.written = 1;
-  const auto json_of = [&] { return nlohmann::json::parse(dem_figures_json(d).dump()); };
+  const auto json_of = [&] { return nlohmann::json::parse(record_json(d, dem_figure_fields()).dump()); };
   nlohmann::json j = json_of();
   EXPECT_EQ(j["max_depth_m"], 0.03);
   EXPECT_EQ(j["final_depth_below_surface_m"], 0.02);
@@ -85,7 +85,7 @@ TEST(JobReports, TheDemFiguresAreReadFromTheDropsOwnRecord) {
   EXPECT_EQ(j["duration_to_rest_s"], 0.25);
   // Every key of the table, once.
   std::vector<std::string> keys;
-  const nlohmann::json all = dem_figures_json(d);
+  const nlohmann::json all = record_json(d, dem_figure_fields());
   for (const auto& [key, value] : all.items()) keys.push_back(key);
   std::vector<std::string> table;
   for (const auto& f : dem_figure_fields()) table.emplace_back(f.key);

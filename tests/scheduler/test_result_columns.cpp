@@ -206,7 +206,7 @@ TEST_P(ResultColumns, ADropsRecordIsBoundToItsColumnsAsItHoldsItsValues) {
     for (const auto& f : results::metric_fields())
       if (measured || !f.text) text[f.key] = measured ? json(m)[f.key] : json(nullptr);
     if (!measured) text["metrics_error"] = "no contact";
-    text.update(results::dem_figures_json(*outputs));
+    text.update(results::record_json<results::DropRecord>(*outputs, results::dem_figure_fields()));
     EXPECT_EQ(d.outputs_json(), text);
     ASSERT_TRUE(complete(db, *c, d));
     const char* metrics_where =
