@@ -30,6 +30,15 @@ struct EmptyContainer {
   }
 };
 
+/// A 0.7 m/s drop onto a surface 5 cm above the floor of an empty container at 9.81 m/s2, started
+/// 1 cm above it (start_gap_m), sampled at 10 kHz: the short drop the trace record's tests use.
+DropResult short_drop(EmptyContainer& c) {
+  ProjectileSpec p;
+  p.impact_speed_m_s = 0.7;
+  p.start_gap_m = 0.01;
+  return drop_projectile(c.sys, 0.05, p, DropStop{}, 1e4);
+}
+
 /// Velocity (down) when the trace's depth crosses zero, by linear interpolation.
 double speed_at_surface(const DropResult& r) {
   const auto& z = r.samples.depth_m;
@@ -77,10 +86,7 @@ TEST(Drop, ImpactSpeedModeReachesTheSurfaceAtThatSpeed) {
 // same buffers, so no value is copied), with the release facts, and leaves the result's empty.
 TEST(Drop, TheTraceRecordTakesTheSampleColumnsOverWithoutACopy) {
   EmptyContainer c(9.81);
-  ProjectileSpec p;
-  p.impact_speed_m_s = 0.7;
-  p.start_gap_m = 0.01;
-  DropResult r = drop_projectile(c.sys, 0.05, p, DropStop{}, 1e4);
+  DropResult r = short_drop(c);
   ASSERT_TRUE(r.samples.consistent());
   const DropSamples before = r.samples;  // the values, to compare
   const DropSamples& s = r.samples;
@@ -110,17 +116,14 @@ TEST(Drop, TheTraceRecordTakesTheSampleColumnsOverWithoutACopy) {
 // writes the processed trace, the metrics and the options into the record itself.
 TEST(Drop, TheTraceRecordIsTheTrialProcessedInPlaceFromTheEnginesColumns) {
   EmptyContainer c(9.81);
-  ProjectileSpec p;
-  p.impact_speed_m_s = 0.7;
-  p.start_gap_m = 0.01;
-  DropResult r = drop_projectile(c.sys, 0.05, p, DropStop{}, 1e4);
+  DropResult r = short_drop(c);
   const std::vector<const void*> buffers{r.samples.t_s.data(), r.samples.depth_m.data(),
                                          r.samples.velocity_down_m_s.data(), r.samples.accel_up_m_s2.data()};
   results::TraceData td = results::take_trace_columns(r, 1e4);
   td.info.gravity_m_s2 = 9.81;
   td.info.fill_height_m = 0.05;
-  td.info.projectile_diameter_m = p.diameter_m;
-  td.info.projectile_mass_kg = p.mass_kg;
+  td.info.projectile_diameter_m = ProjectileSpec{}.diameter_m;  // short_drop's projectile
+  td.info.projectile_mass_kg = ProjectileSpec{}.mass_kg;
   td.info.grain_diameter_m = 0.01;
   results::prepare_dem_trial(td, {"floor", "", "floor.h5"});
   results::MeasuredTrial& trial = td;  // the record is the trial: no copy is made of it
