@@ -23,6 +23,12 @@ struct ContactGeometry {
   bool wall;          ///< body 2 is a fixed wall
 };
 
+/// The effective mass m* = m1 m2 / (m1 + m2) of two bodies, kg; a fixed body (mass +inf) gives
+/// the other's mass.
+GRAVSWEEP_INLINE double effective_mass_kg(double m1_kg, double m2_kg) {
+  return std::isinf(m1_kg) ? m2_kg : std::isinf(m2_kg) ? m1_kg : m1_kg * m2_kg / (m1_kg + m2_kg);
+}
+
 /// Per-contact state that survives from step to step (and across neighbour-list rebuilds): the
 /// part every law and model uses, 48 bytes, stored for every listed pair.
 struct ContactHistory {

@@ -99,11 +99,11 @@ GRAVSWEEP_INLINE void visit_touching(const Particles& p, ContactHistory* hist, s
   const double limit = rsum - kMaxOverlapFraction * r_min;
   if (dist2 < limit * limit) worst.consider((rsum - std::sqrt(dist2)) / r_min, static_cast<long long>(i), j, -1);
   const double mi = inv_m[i] == 0 ? kInf : M[i], mj = inv_m[j] == 0 ? kInf : M[j];
-  const double m_eff = std::isinf(mi) ? mj : std::isinf(mj) ? mi : mi * mj / (mi + mj);
-  visit(TouchingPair{k, i, j, d, dist2, m_eff}, hist[k]);
+  visit(TouchingPair{k, i, j, d, dist2, effective_mass_kg(mi, mj)}, hist[k]);
 }
 
-/// The pair skeleton every particle-particle path shares (scalar and batched): rows [row_begin,
+/// The pair skeleton of the scalar particle-particle path (the batched path writes its lanes
+/// straight from the filter, pair_loop_batched; the two share the filter's rule): rows [row_begin,
 /// row_end) of the half neighbour list, this thread's share (force_loop cuts it with
 /// balanced_cut); a listed pair that no longer touches has its history erased; two fixed
 /// particles are skipped; an overlap beyond kMaxOverlapFraction is recorded in `worst` (the exact
@@ -192,20 +192,61 @@ struct HasBatch<Law, Rolling, std::void_t<typename Law::Batch>>
 template <class Law, class Rolling>
 inline constexpr bool kHasBatch = HasBatch<Law, Rolling>::value;
 
-/// The particle-particle part of force_loop for a law with a Batch (kHasBatch): the touching
-/// pairs of this thread's share are gathered into batches, evaluated vectorised, and scattered
-/// back in list order.
+/// The rest of a batch's lanes, once the pair filter has written each touching pair's slot,
+/// particles and centre offset (HertzBatch::put): drops a pair of two fixed particles (lanes
+/// after it move up one), records an overlap beyond kMaxOverlapFraction in `worst`, and gathers
+/// radii, masses, velocities, spins, coefficients and history (HertzBatch::fill). The
+/// same arithmetic and list order as visit_touching: results bit for bit those of the per-pair
+/// path. A separate pass over the lanes, so that the filter writes each pair once.
+template <class Batch>
+GRAVSWEEP_INLINE void gather_lanes(const ForceContext& c, const Vec3* V, const Vec3* W, Batch& batch,
+                                   OverlapFailure& worst) {
+  const Particles& p = c.p;
+  const double* R = p.radius_m.data();
+  const double* M = p.mass_kg.data();
+  const double* inv_m = p.inv_mass_1_kg.data();
+  const std::uint8_t* mat = p.material.data();
+  const ContactHistory* hist = c.nlist.history.data();
+  int kept = 0;
+  for (int b = 0; b < batch.count; ++b) {
+    const std::uint32_t i = batch.i[b], j = batch.j[b];
+    if (inv_m[i] == 0 && inv_m[j] == 0) continue;  // two fixed particles
+    if (kept != b) batch.move_lane(b, kept);
+    const double ri = R[i], rj = R[j], dist2 = batch.dist2[kept];
+    const double rsum = ri + rj;
+    const double r_min = std::min(ri, rj);
+    const double limit = rsum - kMaxOverlapFraction * r_min;
+    if (dist2 < limit * limit) worst.consider((rsum - std::sqrt(dist2)) / r_min, static_cast<long long>(i), j, -1);
+    const double mi = inv_m[i] == 0 ? kInf : M[i], mj = inv_m[j] == 0 ? kInf : M[j];
+    batch.fill(kept, ri, rj, mi, mj, V[i], V[j], W[i], W[j], c.pairs(mat[i], mat[j]), hist[batch.k[kept]]);
+    ++kept;
+  }
+  batch.count = kept;
+}
+
+/// The particle-particle part of force_loop for a law with a Batch (kHasBatch): rows [rows.begin,
+/// rows.end) of the half neighbour list, this thread's share (force_loop cuts it with
+/// balanced_cut). The pair filter writes each listed pair's slot, particles and centre offset
+/// straight into the batch's next lane, which only a touching pair keeps; a listed pair that no
+/// longer touches has its history erased. A full batch is gathered (gather_lanes), evaluated
+/// vectorised and scattered back in list order. kFilter (a share of at least c.filter_min_pairs
+/// listed pairs, filter_pairs): the lane is written whether or not the pair touches, without a
+/// branch on the distance test (whether a listed pair touches is a coin toss at rest, about 60 %
+/// of the listed pairs); otherwise a branch per listed pair.
 template <class Batch, bool kRolling, bool kFilter>
 void pair_loop_batched(ForceContext& c, const ThreadRows& rows, Vec3* F, Vec3* T, long long& contacts, double& energy,
                        OverlapFailure& worst) {
   const Particles& p = c.p;
+  const Vec3* X = p.position_m.data();
   const Vec3* V = c.use_eval_velocities ? p.eval_velocity_m_s.data() : p.velocity_m_s.data();
   const Vec3* W = c.use_eval_velocities ? p.eval_omega_rad_s.data() : p.omega_rad_s.data();
   const double* R = p.radius_m.data();
-  const std::uint8_t* mat = p.material.data();
+  const std::uint32_t* off = c.nlist.offset.data();
+  const std::uint32_t* nbr = c.nlist.neighbor.data();
   ContactHistory* hist = c.nlist.history.data();
   Batch batch;
-  auto flush = [&] {
+  auto flush = [&]() GRAVSWEEP_INLINE_LAMBDA {
+    gather_lanes(c, V, W, batch, worst);
     batch.template compute<kRolling>(c.options, c.dt_s);
     for (int b = 0; b < batch.count; ++b) {
       ContactHistory& h = hist[batch.k[b]];
@@ -227,11 +268,31 @@ void pair_loop_batched(ForceContext& c, const ThreadRows& rows, Vec3* F, Vec3* T
     contacts += batch.count;
     batch.count = 0;
   };
-  for_each_touching_pair<kFilter>(c, rows.begin, rows.end, worst, [&](const TouchingPair& t, ContactHistory& h) {
-    const std::uint32_t i = t.i, j = t.j;
-    batch.add(t.k, i, j, t.d_m, t.dist2_m2, R[i], R[j], t.m_eff_kg, V[i], V[j], W[i], W[j], c.pairs(mat[i], mat[j]), h);
-    if (batch.full()) flush();
-  });
+  for (std::size_t i = rows.begin; i < rows.end; ++i) {
+    const Vec3 xi = X[i];
+    const double ri = R[i];
+    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
+      const std::uint32_t j = nbr[k];
+      const Vec3 d = X[j] - xi;
+      const double rsum = ri + R[j];
+      const double dist2 = d.squaredNorm();
+      const bool touching = dist2 < rsum * rsum;
+      ContactHistory& h = hist[k];
+      if constexpr (kFilter) {
+        if (h.active & !touching) h.active = false;                // contact ended: history erased (no write otherwise)
+        batch.put(k, static_cast<std::uint32_t>(i), j, d, dist2);  // kept only when touching
+        batch.count += static_cast<int>(touching);
+      } else {
+        if (!touching) {
+          if (h.active) h.active = false;  // contact ended: history erased (no write otherwise)
+          continue;
+        }
+        batch.put(k, static_cast<std::uint32_t>(i), j, d, dist2);
+        ++batch.count;
+      }
+      if (batch.full()) flush();
+    }
+  }
   if (batch.count > 0) flush();
 }
 

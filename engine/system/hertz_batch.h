@@ -36,12 +36,15 @@ struct HertzBatch {
   int count = 0;
   // Where to scatter.
   std::uint32_t k[kSize], i[kSize], j[kSize];
-  // Inputs: centre offset j - i, radii, effective mass, velocities (v2 - v1), spins.
+  // Inputs: centre offset j - i, radii, masses (+inf: fixed; compute() forms m* from them, a
+  // division per lane vectorised), velocities (v2 - v1), spins.
   alignas(64) double dx[kSize], dy[kSize], dz[kSize], dist2[kSize];
-  alignas(64) double r1[kSize], r2[kSize], m_eff[kSize];
+  alignas(64) double r1[kSize], r2[kSize], m1[kSize], m2[kSize], m_eff[kSize];
   alignas(64) double dvx[kSize], dvy[kSize], dvz[kSize];
   alignas(64) double w1x[kSize], w1y[kSize], w1z[kSize], w2x[kSize], w2y[kSize], w2z[kSize];
-  // Pair coefficients.
+  // Pair coefficients: where each lane's are (fill), then copied into the lanes by compute()
+  // (load_coefficients).
+  const PairCoefficients* coefficients[kSize];
   alignas(64) double E[kSize], G[kSize], damp_n[kSize], damp_t[kSize], mu_s[kSize], mu_r[kSize], mu_t[kSize];
   // History in (fresh contacts come with shear 0, duration 0 and their gate) and out.
   alignas(64) double sx[kSize], sy[kSize], sz[kSize], duration[kSize], gate[kSize];
@@ -53,11 +56,11 @@ struct HertzBatch {
 
   [[nodiscard]] bool full() const { return count == kSize; }
 
-  /// Appends one touching pair; h is its history (a new contact when !h.active).
-  GRAVSWEEP_INLINE void add(std::uint32_t kk, std::uint32_t ii, std::uint32_t jj, const Vec3& d, double d2, double ri,
-                            double rj, double meff, const Vec3& vi, const Vec3& vj, const Vec3& wi, const Vec3& wj,
-                            const PairCoefficients& pc, const ContactHistory& h) {
-    const int b = count++;
+  /// Writes lane `count` (not yet kept): list slot kk, particles ii < jj, centre offset
+  /// d = x_j - x_i (m) and |d|^2. The pair filter writes every listed pair here and advances
+  /// `count` only for a touching one; fill() completes a kept lane.
+  GRAVSWEEP_INLINE void put(std::uint32_t kk, std::uint32_t ii, std::uint32_t jj, const Vec3& d, double d2) {
+    const int b = count;
     k[b] = kk;
     i[b] = ii;
     j[b] = jj;
@@ -65,9 +68,27 @@ struct HertzBatch {
     dy[b] = d.y();
     dz[b] = d.z();
     dist2[b] = d2;
+  }
+
+  /// Moves what put() wrote from lane `from` to lane `to` (a dropped lane's place).
+  GRAVSWEEP_INLINE void move_lane(int from, int to) {
+    k[to] = k[from];
+    i[to] = i[from];
+    j[to] = j[from];
+    dx[to] = dx[from];
+    dy[to] = dy[from];
+    dz[to] = dz[from];
+    dist2[to] = dist2[from];
+  }
+
+  /// Completes lane b after put(): radii, masses (kg, +inf for a fixed body), velocities, spins,
+  /// the pair's coefficients and its history h (a new contact when !h.active).
+  GRAVSWEEP_INLINE void fill(int b, double ri, double rj, double mi, double mj, const Vec3& vi, const Vec3& vj,
+                             const Vec3& wi, const Vec3& wj, const PairCoefficients& pc, const ContactHistory& h) {
     r1[b] = ri;
     r2[b] = rj;
-    m_eff[b] = meff;
+    m1[b] = mi;
+    m2[b] = mj;
     dvx[b] = vj.x() - vi.x();
     dvy[b] = vj.y() - vi.y();
     dvz[b] = vj.z() - vi.z();
@@ -77,13 +98,7 @@ struct HertzBatch {
     w2x[b] = wj.x();
     w2y[b] = wj.y();
     w2z[b] = wj.z();
-    E[b] = pc.E_eff_Pa;
-    G[b] = pc.G_eff_Pa;
-    damp_n[b] = pc.damping_prefactor_n;
-    damp_t[b] = pc.damping_prefactor_t;
-    mu_s[b] = pc.mu_static;
-    mu_r[b] = pc.mu_rolling;
-    mu_t[b] = pc.mu_twisting;
+    coefficients[b] = &pc;
     if (h.active) {
       sx[b] = h.shear_m.x();
       sy[b] = h.shear_m.y();
@@ -94,9 +109,18 @@ struct HertzBatch {
     } else {
       sx[b] = sy[b] = sz[b] = 0;
       duration[b] = 0;
-      gate[b] = HertzChrono::gate_s(pc.E_eff_Pa, pc.damping_prefactor_n, ri * rj / (ri + rj), meff);
+      gate[b] =
+          HertzChrono::gate_s(pc.E_eff_Pa, pc.damping_prefactor_n, ri * rj / (ri + rj), effective_mass_kg(mi, mj));
       fresh[b] = 1;
     }
+  }
+
+  /// Appends one touching pair whole (put, fill) with its effective mass meff: h is its history.
+  GRAVSWEEP_INLINE void add(std::uint32_t kk, std::uint32_t ii, std::uint32_t jj, const Vec3& d, double d2, double ri,
+                            double rj, double meff, const Vec3& vi, const Vec3& vj, const Vec3& wi, const Vec3& wj,
+                            const PairCoefficients& pc, const ContactHistory& h) {
+    put(kk, ii, jj, d, d2);
+    fill(count++, ri, rj, meff, kInf, vi, vj, wi, wj, pc, h);
   }
 
   /// Evaluates the batch: HertzChrono::evaluate, then (kRolling) RollingSunday::apply.
@@ -104,6 +128,9 @@ struct HertzBatch {
   void compute(const ContactOptions& opt, double dt_s);
 
  private:
+  /// Copies each lane's pair coefficients into E ... mu_t: one value broadcast when every lane
+  /// has the same pair of materials (a bed of one material), else lane by lane.
+  void load_coefficients();
   struct Lever;
   struct Spins;
   struct Torques;
@@ -164,9 +191,41 @@ inline void HertzBatch::add_sunday(int b, bool on, double Fn, const Lever& L, co
   q.q2z = spin ? q.q2z - Mz : q.q2z;
 }
 
+inline void HertzBatch::load_coefficients() {
+  const int nb = count;
+  bool uniform = true;
+  for (int b = 1; b < nb; ++b) uniform &= coefficients[b] == coefficients[0];
+  if (uniform && nb > 0) {
+    const PairCoefficients& pc = *coefficients[0];
+    std::fill_n(E, nb, pc.E_eff_Pa);
+    std::fill_n(G, nb, pc.G_eff_Pa);
+    std::fill_n(damp_n, nb, pc.damping_prefactor_n);
+    std::fill_n(damp_t, nb, pc.damping_prefactor_t);
+    std::fill_n(mu_s, nb, pc.mu_static);
+    std::fill_n(mu_r, nb, pc.mu_rolling);
+    std::fill_n(mu_t, nb, pc.mu_twisting);
+    return;
+  }
+  for (int b = 0; b < nb; ++b) {
+    const PairCoefficients& pc = *coefficients[b];
+    E[b] = pc.E_eff_Pa;
+    G[b] = pc.G_eff_Pa;
+    damp_n[b] = pc.damping_prefactor_n;
+    damp_t[b] = pc.damping_prefactor_t;
+    mu_s[b] = pc.mu_static;
+    mu_r[b] = pc.mu_rolling;
+    mu_t[b] = pc.mu_twisting;
+  }
+}
+
 template <bool kRolling>
 void HertzBatch::compute(const ContactOptions& opt, double dt_s) {
+  load_coefficients();
   const int nb = count;
+  // m* in a loop of its own: inlined into the contact's expressions below, GCC's vectorised m*
+  // moved the 1 g drop's trace from the per-pair value's (not bit for bit).
+#pragma omp simd
+  for (int b = 0; b < nb; ++b) m_eff[b] = effective_mass_kg(m1[b], m2[b]);
   const bool clamp = opt.clamp_normal;
   const double min_roll = opt.min_roll_vel_m_s, min_spin = opt.min_spin_vel_rad_s;
   constexpr double kTiny2 = kTinyLength_m * kTinyLength_m;

@@ -127,6 +127,45 @@ TEST(PairFilter, BothWaysGiveTheSameTrajectories) {
   }
 }
 
+// A pair of two fixed particles is dropped from the batch of touching pairs, and the pairs after
+// it in the same batch keep their own lanes: the lattice's grains, a fixed pair (overlapping) and
+// a free grain resting on one of the two fixed ones move bit for bit as when the fixed particles
+// lie apart (their pair not listed), with the same contact counts; both pair-filter ways, 1 and 2
+// threads.
+TEST(PairFilter, AFixedPairLeavesTheBatchAndThePairsAfterItKeepTheirLanes) {
+  const double r = kBeadRadius_m, m = bead_mass_kg();
+  auto build = [&](System& s, bool fixed_pair_touches) {
+    fill(s, false);
+    const Vec3 base(0.3, 0.3, 0.05);
+    const Vec3 other = fixed_pair_touches ? base + Vec3(1.6 * r, 0, 0) : base + Vec3(0, 0.2, 0);
+    s.particles.add(other, r, m, 0, SizeClass::grain, true);
+    s.particles.add(base, r, m, 0, SizeClass::grain, true);
+    s.particles.add(base + Vec3(0, 0, 1.98 * r), r, m, 0, SizeClass::grain);
+  };
+  for (int threads : {1, 2})
+    for (std::uint32_t min_pairs : {0u, UINT32_MAX}) {
+      SystemConfig c = layout_config("hertz", "sunday");
+      c.pair_filter_min_pairs = min_pairs;
+      c.threads = threads;
+      c.parallel_min_particles = 1;
+      System a(c), b(c);
+      build(a, true);
+      build(b, false);
+      const std::size_t moved = a.particles.size() - 3, resting = a.particles.size() - 1;
+      for (int s = 0; s < kSteps; ++s) {
+        a.step();
+        b.step();
+        ASSERT_EQ(a.stats().contacts, b.stats().contacts) << "step " << s << ", " << threads << " threads";
+        if (s == 0) ASSERT_GE(a.contact_counts()[resting], 1) << "the free grain touches a fixed one";
+      }
+      for (std::size_t k = 0; k < a.particles.size(); ++k) {
+        if (k == moved) continue;  // the fixed particle placed apart in b
+        EXPECT_EQ(a.particles.position_m[k], b.particles.position_m[k]) << "particle " << k;
+        EXPECT_EQ(a.particles.omega_rad_s[k], b.particles.omega_rad_s[k]) << "particle " << k;
+      }
+    }
+}
+
 // contact_count(i) (the projectile's contacts in every trace sample) counts the pairs listed under
 // i and under its partners' rows, and i's walls: after a force pass it equals contact_counts() and
 // the spheres and walls that overlap i at the positions of that pass.
