@@ -331,16 +331,16 @@ void VerletList::carry_histories(std::vector<std::uint32_t> new_offset, std::vec
   work_offset.assign(n + 1, 0);
   for (std::size_t i = 0; i < n; ++i)
     work_offset[i + 1] =
-        work_offset[i] + (offset[i + 1] - offset[i]) + kTouchingWork * touching_in_row[i + 1] + kRowWork;
+        work_offset[i] + (offset[i + 1] - offset[i]) + work.touching * touching_in_row[i + 1] + work.row;
 }
 
-void VerletList::add_wall_work(const std::vector<std::uint32_t>& codes, std::size_t walls, std::uint32_t work) {
+void VerletList::add_wall_work(const std::vector<std::uint32_t>& codes, std::size_t walls) {
   if (walls == 0 || work_offset.empty()) return;
   const std::size_t n = work_offset.size() - 1;
   std::uint32_t extra = 0;
   std::size_t k = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    for (; k < codes.size() && codes[k] / walls <= i; ++k) extra += work;
+    for (; k < codes.size() && codes[k] / walls <= i; ++k) extra += work.wall;
     work_offset[i + 1] += extra;
   }
 }

@@ -16,14 +16,25 @@
 namespace gravsweep {
 
 /// Work of a row of the pair loop, in units of a listed pair that does not touch (a distance
-/// test): a row costs kRowWork, a touching pair kTouchingWork more (the contact law). Set so
-/// that the two threads of the 0.1 m/s2 drop spend equal time in pair + wall work (perf per
-/// thread: 35.5 % / 35.8 % of the samples at 6 and 9; 3 and 6 left thread 0 15 % more, 10 and 14
-/// left thread 1 10 % more; BENCHMARKS.md).
+/// test): a row costs kRowWork, a touching pair kTouchingWork more (the contact law), a wall
+/// candidate kWallWork. Touching 6 was set on the 0.1 m/s2 drop (perf per thread: 35.5 % /
+/// 35.8 % of the samples at 6 and 9; 3 and 6 left thread 0 15 % more, 10 and 14 left thread 1
+/// 10 % more); the wall weight 4 on the committed settled beds once the batched pair loop wrote
+/// its lanes from the filter (`gravsweep bench --pair-work`: the paper bed's two threads 315 /
+/// 318 us of loops a step at 4, 306 / 352 at 9; the sweep bed 746 / 743 at 4, 729 / 769 at 9;
+/// the first 0.3 s of the 0.1 m/s2 drop the same at 4 and 9; BENCHMARKS.md).
 inline constexpr std::uint32_t kRowWork = 2;
 inline constexpr std::uint32_t kTouchingWork = 6;
 /// Work of a particle-wall candidate in the same units (System adds it, add_wall_work).
-inline constexpr std::uint32_t kWallWork = 9;
+inline constexpr std::uint32_t kWallWork = 4;
+
+/// The work model the rows are split by (SystemConfig::pair_work; `gravsweep bench --pair-work`
+/// measures others): a row, a touching pair beyond its distance test, a wall candidate.
+struct PairWork {
+  std::uint32_t row = kRowWork;
+  std::uint32_t touching = kTouchingWork;
+  std::uint32_t wall = kWallWork;
+};
 
 /// The listed pairs of one thread's share from which the pair loop (force_loop.h,
 /// for_each_touching_pair) filters before it visits. Below it a branch per listed pair costs
@@ -64,13 +75,15 @@ class VerletList {
   /// Beside history, only when frame histories are kept (set_frame_history); else empty.
   std::vector<FrameHistory> frame_history;
   /// Pair-loop work before row i, for splitting the rows between threads (force_loop.h,
-  /// balanced_rows): the sum over earlier rows of listed pairs + kTouchingWork x touching pairs
-  /// (active histories carried over at the build) + kRowWork. Set by build(); empty after
+  /// balanced_rows): the sum over earlier rows of listed pairs + work.touching x touching pairs
+  /// (active histories carried over at the build) + work.row. Set by build(); empty after
   /// clear(), extend() and remap() until the next build (the split then weighs listed pairs only).
   std::vector<std::uint32_t> work_offset;
-  /// Adds `work` per particle-wall candidate to the work prefix of the last build (codes
+  /// The weights of work_offset (System sets them from SystemConfig::pair_work).
+  PairWork work;
+  /// Adds work.wall per particle-wall candidate to the work prefix of the last build (codes
   /// particle * walls + wall, increasing, as System keeps them); nothing when there is none.
-  void add_wall_work(const std::vector<std::uint32_t>& codes, std::size_t walls, std::uint32_t work);
+  void add_wall_work(const std::vector<std::uint32_t>& codes, std::size_t walls);
 
   /// Keep a FrameHistory per pair (the law or rolling model uses_frame_history). Switching it on
   /// gives every listed pair an empty record.

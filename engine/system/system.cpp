@@ -137,6 +137,7 @@ void System::initialize() {
   const bool frames = uses_frame_history(config_.contact_law, config_.rolling_model);
   if (nlist_.offset.size() != particles.size() + 1) nlist_.clear();
   nlist_.set_frame_history(frames);
+  nlist_.work = config_.pair_work;
   if (wall_count_at_build_ != walls.size() || wall_history_.size() != wall_candidates_.size()) {
     wall_candidates_.clear();  // walls changed without invalidate(): their histories end
     wall_history_.clear();
@@ -180,7 +181,7 @@ void System::rebuild_neighbors() {
   wall_history_ = std::move(hist);
   wall_frame_history_ = std::move(frame);
   wall_count_at_build_ = nw;
-  nlist_.add_wall_work(wall_candidates_, nw, kWallWork);
+  nlist_.add_wall_work(wall_candidates_, nw);
   rebuild_due_ = false;
 }
 

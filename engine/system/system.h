@@ -37,6 +37,8 @@ struct SystemConfig {
   /// Listed pairs of a thread's share from which the pair loop filters touching pairs without a
   /// branch before it visits them (force_loop.h, kFilterMinPairs); results are the same either way.
   std::uint32_t pair_filter_min_pairs = kFilterMinPairs;
+  /// The work model the pair loop's rows are split between threads by (verlet_list.h).
+  PairWork pair_work{};
   std::optional<Domain> domain;
   bool track_energy = false;    ///< accumulate the normal spring energy
   bool check_time_step = true;  ///< reject dt above the law's stability bound

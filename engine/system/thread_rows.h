@@ -48,10 +48,10 @@ struct ThreadRows {
 };
 
 /// The first row of thread k of nt (k = nt: n): balanced_cut on the work prefix of the last list
-/// build, or on the listed pairs alone (plus kRowWork a row) when rows changed since.
+/// build, or on the listed pairs alone (plus list.work.row a row) when rows changed since.
 inline std::size_t first_row(const VerletList& list, std::size_t n, int k, int nt) {
   const bool weighed = list.work_offset.size() == n + 1;
-  return balanced_cut(weighed ? list.work_offset.data() : list.offset.data(), weighed ? 0 : kRowWork, n, k, nt);
+  return balanced_cut(weighed ? list.work_offset.data() : list.offset.data(), weighed ? 0 : list.work.row, n, k, nt);
 }
 
 }  // namespace gravsweep

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/neighbor/verlet_list.h"
 #include "engine/scenario/bed.h"
 #include "engine/scenario/paper_params.h"
 #include "engine/scenario/tile.h"
@@ -36,8 +37,10 @@ struct BenchOptions {
   double tile_relax_s = 0.01;                         ///< relaxation of a tiled bed before timing
   double diameter_m = 0.315;
   std::string bed_file;
-  std::string checkpoint_dir;              ///< --checkpoint-dir: measure a drop checkpoint there
-  std::size_t checkpoint_samples = 10000;  ///< trace samples in it (1 s at the paper's 10 kHz)
+  std::string checkpoint_dir;                             ///< --checkpoint-dir: measure a drop checkpoint there
+  std::size_t checkpoint_samples = 10000;                 ///< trace samples in it (1 s at the paper's 10 kHz)
+  std::uint32_t pair_filter_min_pairs = kFilterMinPairs;  ///< SystemConfig::pair_filter_min_pairs
+  std::vector<std::uint32_t> pair_work{kRowWork, kTouchingWork, kWallWork};  ///< SystemConfig::pair_work
 };
 
 struct BenchRow {
@@ -67,6 +70,8 @@ BenchRow time_bed(const System& bed, const std::string& label, const BenchOption
   SystemConfig cfg = bed.config();
   cfg.dt_s = o.dt_s;
   cfg.threads = threads;
+  cfg.pair_filter_min_pairs = o.pair_filter_min_pairs;
+  cfg.pair_work = PairWork{o.pair_work[0], o.pair_work[1], o.pair_work[2]};
   System sys(cfg);
   sys.particles = bed.particles;
   sys.walls = bed.walls;
@@ -215,6 +220,10 @@ void run_bench(const BenchOptions& o) {
   const char* spins = std::getenv("GOMP_SPINCOUNT");
   fmt::print("OpenMP barrier waits: OMP_WAIT_POLICY={}, GOMP_SPINCOUNT={}.\n", policy ? policy : "(unset)",
              spins ? spins : "(unset)");
+  fmt::print(
+      "Pair filter without a branch from {} listed pairs in a thread's share; rows split by a work of {} a row,\n"
+      "{} a touching pair beyond its distance test and {} a wall candidate (listed pair 1).\n",
+      o.pair_filter_min_pairs, o.pair_work[0], o.pair_work[1], o.pair_work[2]);
 }
 
 }  // namespace
@@ -265,6 +274,16 @@ void setup_bench(CLI::App& app) {
                   "into this folder and print its size and the seconds to write, read and restore it")
       ->check(CLI::ExistingDirectory);
   sub->add_option("--checkpoint-samples", opt->checkpoint_samples, "trace samples in the measured checkpoint")
+      ->capture_default_str();
+  sub->add_option("--pair-filter-min-pairs", opt->pair_filter_min_pairs,
+                  "listed pairs in a thread's share from which the pair loop filters them without a branch "
+                  "(0: always, 4294967295: never); the results are bit for bit the same either way")
+      ->capture_default_str();
+  sub->add_option("--pair-work", opt->pair_work,
+                  "the work model that splits the pair loop's rows between threads: ROW,TOUCHING,WALL in units of a "
+                  "listed pair's distance test (compare the per-thread loop times it prints)")
+      ->delimiter(',')
+      ->expected(3)
       ->capture_default_str();
   sub->callback([opt]() { run_bench(*opt); });
 }

@@ -110,6 +110,27 @@ TEST(VerletList, WorkPrefixWeighsTouchingPairsAndGoesWhenTheRowsChange) {
   EXPECT_EQ(l.work_offset.size(), p.size() + 1);
 }
 
+// The work model is the list's own (SystemConfig::pair_work, `gravsweep bench --pair-work`): other
+// weights give the prefix those weights, and a wall candidate adds its weight to the rows from its
+// particle's on.
+TEST(VerletList, WorkPrefixTakesTheListsWeights) {
+  Particles p = random_particles(200, 3);
+  VerletList l;
+  l.work = PairWork{5, 3, 7};
+  l.build(p, 0.001, 1);
+  std::size_t active = 0;
+  for (std::size_t k = 0; k < l.history.size(); k += 2, ++active) l.history[k].active = true;
+  l.build(p, 0.001, 1);
+  ASSERT_EQ(l.work_offset.size(), p.size() + 1);
+  EXPECT_EQ(l.work_offset.back(), l.pairs() + 3 * active + 5 * p.size());
+  const std::uint32_t before_10 = l.work_offset[10], before_11 = l.work_offset[11], last = l.work_offset.back();
+  const std::size_t walls = 2;
+  l.add_wall_work({static_cast<std::uint32_t>(10 * walls), static_cast<std::uint32_t>(10 * walls + 1)}, walls);
+  EXPECT_EQ(l.work_offset[10], before_10) << "rows before particle 10 keep their work";
+  EXPECT_EQ(l.work_offset[11], before_11 + 2 * 7) << "particle 10's two wall candidates";
+  EXPECT_EQ(l.work_offset.back(), last + 2 * 7);
+}
+
 TEST(BalancedRows, SplitsTheWorkNotTheRows) {
   // 100 rows: the first 50 heavy (10 each, the compressed bottom of a bed), the rest light (1).
   std::vector<std::uint32_t> work(101, 0);
