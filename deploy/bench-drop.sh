@@ -3,10 +3,13 @@
 # of `gravsweep run SPEC --bed BED --threads 2 --snapshot-interval 0` with SPEC's /stop/max_time_s
 # cut to SECONDS (default 0.12), interleaved with a second binary when one is given; then the
 # minimum and median wall seconds of each binary and its projectile's deepest point (the same
-# depth to the last digit means the same arithmetic).
+# depth to the last digit means the same arithmetic). SPEC is a scenario, or a sweep spec whose
+# base is taken at Froude number FR (default 1: v = FR sqrt(g D)), as deploy/bench-gravity.sh
+# does; AT_REST=loose sets /at_rest's fractions to 1 (a bed that still creeps is timed, not
+# refused).
 #
 #   deploy/bench-drop.sh SPEC.json BED.h5 [OTHER_GRAVSWEEP] [ROUNDS] [SECONDS]
-#   deploy/bench-drop.sh examples/impact_low_g.json data/reproduction/beds/8318ca9692b4d76c94b3.h5 /tmp/gravsweep-main
+#   AT_REST=loose deploy/bench-drop.sh examples/gravity_sweep/g0.1.json data/gravity_sweep/beds/efa0c202f64195f5cfd0.h5 /tmp/gravsweep-main 3 0.3
 #
 # Run it on an otherwise idle machine; the load average is printed with the results.
 set -euo pipefail
@@ -23,11 +26,17 @@ binaries=("$this")
 [ -n "$other" ] && binaries+=("$other")
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-"$py" - "$spec" "$seconds" "$work/spec.json" <<'PY'
-import json, sys
+"$py" - "$spec" "$seconds" "$work/spec.json" "${FR:-1}" "${AT_REST:-}" <<'PY'
+import json, math, sys
 spec = json.load(open(sys.argv[1]))
+if "base" in spec:  # a sweep spec: its base at Froude number FR
+    spec = spec["base"]
+    spec["projectile"]["impact_speed_m_s"] = float(sys.argv[4]) * math.sqrt(
+        spec["gravity_m_s2"] * spec["projectile"]["diameter_m"])
 spec.pop("$schema", None)
 spec.setdefault("stop", {})["max_time_s"] = float(sys.argv[2])
+if sys.argv[5] == "loose":
+    spec["at_rest"] = {"surface_speed_fraction": 1, "rms_speed_fraction": 1}
 json.dump(spec, open(sys.argv[3], "w"), indent=1)
 PY
 for r in $(seq 1 "$rounds"); do

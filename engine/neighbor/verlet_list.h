@@ -37,7 +37,7 @@ struct PairWork {
 };
 
 /// The listed pairs of one thread's share from which the pair loop (force_loop.h,
-/// for_each_touching_pair) filters before it visits. Below it a branch per listed pair costs
+/// filter_listed_pairs) filters without a branch. Below it a branch per listed pair costs
 /// less: the branch predictor of the machine of BENCHMARKS.md learns the repeating touch pattern
 /// of ~15,000 pairs (the paper's 8,600-grain bed on 2 threads: 39.5 ns per particle-step with the
 /// branch, 43.4 filtered) but not of ~33,000 (the 18,200-grain bed of the 0.1 m/s2 drop on 2

@@ -73,14 +73,24 @@ struct TouchingPair {
   double dist2_m2, m_eff_kg;
 };
 
-/// The touching pairs of a stretch of the half list, in list order, as the filter of
-/// for_each_touching_pair leaves them for the visits: slot, particles, centre offset, |d|^2.
+/// The touching pairs of a stretch of the half list, in list order, as filter_listed_pairs leaves
+/// them for the scalar path's visits: slot, particles, centre offset, |d|^2.
 struct TouchingBuffer {
   static constexpr int kSize = 64;
   int count = 0;
   std::uint32_t k[kSize], i[kSize], j[kSize];
   Vec3 d_m[kSize];
   double dist2_m2[kSize];
+  /// Writes slot `count` (kept when the filter advances `count`): list slot kk, particles ii < jj,
+  /// centre offset d = x_j - x_i (m), |d|^2.
+  GRAVSWEEP_INLINE void put(std::uint32_t kk, std::uint32_t ii, std::uint32_t jj, const Vec3& d, double d2) {
+    k[count] = kk;
+    i[count] = ii;
+    j[count] = jj;
+    d_m[count] = d;
+    dist2_m2[count] = d2;
+  }
+  [[nodiscard]] bool full() const { return count == kSize; }
 };
 
 /// What both ways of for_each_touching_pair do with a touching pair (slot k, rows i < j with
@@ -102,33 +112,26 @@ GRAVSWEEP_INLINE void visit_touching(const Particles& p, ContactHistory* hist, s
   visit(TouchingPair{k, i, j, d, dist2, effective_mass_kg(mi, mj)}, hist[k]);
 }
 
-/// The pair skeleton of the scalar particle-particle path (the batched path writes its lanes
-/// straight from the filter, pair_loop_batched; the two share the filter's rule): rows [row_begin,
-/// row_end) of the half neighbour list, this thread's share (force_loop cuts it with
-/// balanced_cut); a listed pair that no longer touches has its history erased; two fixed
-/// particles are skipped; an overlap beyond kMaxOverlapFraction is recorded in `worst` (the exact
-/// ratio is computed only then); visit(const TouchingPair&, ContactHistory&) evaluates the rest.
-/// kFilter (a share of at least c.filter_min_pairs listed pairs, filter_pairs): two passes over
-/// each stretch of TouchingBuffer::kSize touching pairs, a filter without a branch on the
-/// distance test (whether a listed pair touches is a coin toss at rest, about 60 % of the listed
-/// pairs), then the visits in list order. Otherwise one pass with a branch per listed pair.
-/// Always inlined: called through a lambda, the batch state of the caller would otherwise be read
-/// through references on every pair (slower on the 1 g drop, measured: docs/history/benchmarks.md).
-template <bool kFilter, class Visit>
-GRAVSWEEP_INLINE void for_each_touching_pair(ForceContext& c, std::size_t row_begin, std::size_t row_end,
-                                             OverlapFailure& worst, Visit&& visit) {
+/// The pair filter of both particle-particle paths: rows [row_begin, row_end) of the half
+/// neighbour list, this thread's share (force_loop cuts it with balanced_cut). Each listed pair
+/// that touches is written into the next slot of `lanes` (a TouchingBuffer or a law's batch:
+/// put(k, i, j, d, |d|^2) writes slot `count`, which only a touching pair keeps), in list order;
+/// a listed pair that no longer touches has its history erased; drain() empties full lanes (and
+/// sets count to 0), and the last ones. kFilter (a share of at least c.filter_min_pairs listed
+/// pairs, filter_pairs): the slot is written whether or not the pair touches, without a branch on
+/// the distance test (whether a listed pair touches is a coin toss at rest, about 60 % of the
+/// listed pairs); otherwise a branch per listed pair. Always inlined: called through a lambda,
+/// the lanes of the caller would otherwise be read through references on every pair (slower on
+/// the 1 g drop, measured: docs/history/benchmarks.md).
+template <bool kFilter, class Lanes, class Drain>
+GRAVSWEEP_INLINE void filter_listed_pairs(ForceContext& c, std::size_t row_begin, std::size_t row_end, Lanes& lanes,
+                                          Drain&& drain) {
   const Particles& p = c.p;
   const Vec3* X = p.position_m.data();
   const double* R = p.radius_m.data();
   const std::uint32_t* off = c.nlist.offset.data();
   const std::uint32_t* nbr = c.nlist.neighbor.data();
   ContactHistory* hist = c.nlist.history.data();
-  TouchingBuffer buf;                                  // kFilter only
-  auto visit_buffer = [&]() GRAVSWEEP_INLINE_LAMBDA {  // inlined at both calls (see above)
-    for (int b = 0; b < buf.count; ++b)
-      visit_touching(p, hist, buf.k[b], buf.i[b], buf.j[b], R[buf.i[b]], buf.d_m[b], buf.dist2_m2[b], worst, visit);
-    buf.count = 0;
-  };
   for (std::size_t i = row_begin; i < row_end; ++i) {
     const Vec3 xi = X[i];
     const double ri = R[i];
@@ -140,26 +143,39 @@ GRAVSWEEP_INLINE void for_each_touching_pair(ForceContext& c, std::size_t row_be
       const bool touching = dist2 < rsum * rsum;
       ContactHistory& h = hist[k];
       if constexpr (kFilter) {
-        if (h.active & !touching) h.active = false;  // contact ended: history erased (no write otherwise)
-        // Written whether or not the pair touches; only a touching pair keeps its slot.
-        const int b = buf.count;
-        buf.k[b] = k;
-        buf.i[b] = static_cast<std::uint32_t>(i);
-        buf.j[b] = j;
-        buf.d_m[b] = d;
-        buf.dist2_m2[b] = dist2;
-        buf.count = b + static_cast<int>(touching);
-        if (buf.count == TouchingBuffer::kSize) visit_buffer();
+        if (h.active & !touching) h.active = false;                // contact ended: history erased (no write otherwise)
+        lanes.put(k, static_cast<std::uint32_t>(i), j, d, dist2);  // kept only when touching
+        lanes.count += static_cast<int>(touching);
       } else {
         if (!touching) {
           if (h.active) h.active = false;  // contact ended: history erased (no write otherwise)
           continue;
         }
-        visit_touching(p, hist, k, static_cast<std::uint32_t>(i), j, ri, d, dist2, worst, visit);
+        lanes.put(k, static_cast<std::uint32_t>(i), j, d, dist2);
+        ++lanes.count;
       }
+      if (lanes.full()) drain();
     }
   }
-  if constexpr (kFilter) visit_buffer();
+  if (lanes.count > 0) drain();
+}
+
+/// The scalar path's pairs: filter_listed_pairs into a TouchingBuffer, each touching pair then
+/// visited in list order (visit_touching): two fixed particles are skipped, an overlap beyond
+/// kMaxOverlapFraction is recorded in `worst` (the exact ratio computed only then), and
+/// visit(const TouchingPair&, ContactHistory&) evaluates the rest.
+template <bool kFilter, class Visit>
+GRAVSWEEP_INLINE void for_each_touching_pair(ForceContext& c, std::size_t row_begin, std::size_t row_end,
+                                             OverlapFailure& worst, Visit&& visit) {
+  const Particles& p = c.p;
+  const double* R = p.radius_m.data();
+  ContactHistory* hist = c.nlist.history.data();
+  TouchingBuffer buf;
+  filter_listed_pairs<kFilter>(c, row_begin, row_end, buf, [&]() GRAVSWEEP_INLINE_LAMBDA {
+    for (int b = 0; b < buf.count; ++b)
+      visit_touching(p, hist, buf.k[b], buf.i[b], buf.j[b], R[buf.i[b]], buf.d_m[b], buf.dist2_m2[b], worst, visit);
+    buf.count = 0;
+  });
 }
 
 /// True when this thread's rows hold at least c.filter_min_pairs listed pairs: its pair loop
@@ -224,25 +240,16 @@ GRAVSWEEP_INLINE void gather_lanes(const ForceContext& c, const Vec3* V, const V
   batch.count = kept;
 }
 
-/// The particle-particle part of force_loop for a law with a Batch (kHasBatch): rows [rows.begin,
-/// rows.end) of the half neighbour list, this thread's share (force_loop cuts it with
-/// balanced_cut). The pair filter writes each listed pair's slot, particles and centre offset
-/// straight into the batch's next lane, which only a touching pair keeps; a listed pair that no
-/// longer touches has its history erased. A full batch is gathered (gather_lanes), evaluated
-/// vectorised and scattered back in list order. kFilter (a share of at least c.filter_min_pairs
-/// listed pairs, filter_pairs): the lane is written whether or not the pair touches, without a
-/// branch on the distance test (whether a listed pair touches is a coin toss at rest, about 60 %
-/// of the listed pairs); otherwise a branch per listed pair.
+/// The particle-particle part of force_loop for a law with a Batch (kHasBatch): the pair filter
+/// (filter_listed_pairs) writes each listed pair's slot, particles and centre offset straight into
+/// the batch's next lane; a full batch is gathered (gather_lanes), evaluated vectorised and
+/// scattered back in list order.
 template <class Batch, bool kRolling, bool kFilter>
 void pair_loop_batched(ForceContext& c, const ThreadRows& rows, Vec3* F, Vec3* T, long long& contacts, double& energy,
                        OverlapFailure& worst) {
   const Particles& p = c.p;
-  const Vec3* X = p.position_m.data();
   const Vec3* V = c.use_eval_velocities ? p.eval_velocity_m_s.data() : p.velocity_m_s.data();
   const Vec3* W = c.use_eval_velocities ? p.eval_omega_rad_s.data() : p.omega_rad_s.data();
-  const double* R = p.radius_m.data();
-  const std::uint32_t* off = c.nlist.offset.data();
-  const std::uint32_t* nbr = c.nlist.neighbor.data();
   ContactHistory* hist = c.nlist.history.data();
   Batch batch;
   auto flush = [&]() GRAVSWEEP_INLINE_LAMBDA {
@@ -268,32 +275,7 @@ void pair_loop_batched(ForceContext& c, const ThreadRows& rows, Vec3* F, Vec3* T
     contacts += batch.count;
     batch.count = 0;
   };
-  for (std::size_t i = rows.begin; i < rows.end; ++i) {
-    const Vec3 xi = X[i];
-    const double ri = R[i];
-    for (std::uint32_t k = off[i]; k < off[i + 1]; ++k) {
-      const std::uint32_t j = nbr[k];
-      const Vec3 d = X[j] - xi;
-      const double rsum = ri + R[j];
-      const double dist2 = d.squaredNorm();
-      const bool touching = dist2 < rsum * rsum;
-      ContactHistory& h = hist[k];
-      if constexpr (kFilter) {
-        if (h.active & !touching) h.active = false;                // contact ended: history erased (no write otherwise)
-        batch.put(k, static_cast<std::uint32_t>(i), j, d, dist2);  // kept only when touching
-        batch.count += static_cast<int>(touching);
-      } else {
-        if (!touching) {
-          if (h.active) h.active = false;  // contact ended: history erased (no write otherwise)
-          continue;
-        }
-        batch.put(k, static_cast<std::uint32_t>(i), j, d, dist2);
-        ++batch.count;
-      }
-      if (batch.full()) flush();
-    }
-  }
-  if (batch.count > 0) flush();
+  filter_listed_pairs<kFilter>(c, rows.begin, rows.end, batch, flush);
 }
 
 /// The particle-particle part of force_loop for every other (law, rolling) pair: one contact at
